@@ -1,0 +1,7 @@
+"""hiper: a persistent, queryable scene memory for mobile robots, built from RGB-D logs.
+
+The library has one public entry per stage; the CLI (``hiper``) is a thin layer over it.
+"""
+
+__version__ = "0.1.0"
+__all__ = ["__version__"]

@@ -1,0 +1,3 @@
+from hiper_cli.cli import main
+
+main()

@@ -1,0 +1,272 @@
+"""The knowledge entities of the HIPer model: observations, instances, analyses, environments.
+
+Observations (o) are anchored to the sensor frame and the pose id they were seen from, so an
+optimised trajectory can recompute every instance. Instances (i) live in the map frame and keep
+the uuids of the observations they were formed from. Analyses (a) hold learned features.
+
+High-level attributes (uuid, frame, last update, class, box) are plain fields; low-level data
+(plane model and contour, point blobs, image boxes, trajectories, fused points) live in ``data``,
+a JSON-serialisable dict. ``to_dict``/``from_dict`` give the document form stored in the
+knowledge base. Units: metres, seconds, radians.
+"""
+
+from __future__ import annotations
+
+import uuid as _uuid
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.errors import DataError
+
+__all__ = [
+    "LAYERS",
+    "Analysis",
+    "Box3D",
+    "Environment",
+    "Instance",
+    "Layer",
+    "Observation",
+    "State",
+    "new_uuid",
+]
+
+Layer = Literal["environment", "background", "foreground", "map"]
+LAYERS: tuple[str, ...] = ("environment", "background", "foreground", "map")
+State = Literal["static", "dynamic"]
+
+
+def new_uuid() -> str:
+    return str(_uuid.uuid4())
+
+
+@dataclass(frozen=True)
+class Box3D:
+    """An oriented box: centre (3,) and full extent (3,) in metres, axes ``R`` (3×3) in its frame.
+
+    The columns of ``R`` are the box axes expressed in the frame the box is given in.
+    """
+
+    center_m: NDArray[np.float64]
+    extent_m: NDArray[np.float64]
+    R: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
+
+    def __post_init__(self) -> None:
+        c = np.asarray(self.center_m, dtype=np.float64).reshape(-1)
+        e = np.asarray(self.extent_m, dtype=np.float64).reshape(-1)
+        R = np.asarray(self.R, dtype=np.float64)
+        if c.shape != (3,) or e.shape != (3,) or R.shape != (3, 3):
+            raise DataError(
+                f"box: expected centre (3,), extent (3,), R (3, 3); got {c.shape}, {e.shape}, {R.shape}"
+            )
+        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(e)) and np.all(np.isfinite(R))):
+            raise DataError("box: centre, extent and R must be finite")
+        if np.any(e < 0):
+            raise DataError(f"box: extent must be non-negative, got {e.tolist()}")
+        object.__setattr__(self, "center_m", c)
+        object.__setattr__(self, "extent_m", e)
+        object.__setattr__(self, "R", R)
+
+    @classmethod
+    def from_points(cls, points_m: NDArray[np.float64]) -> Box3D:
+        """The axis-aligned box around (N, 3) points."""
+        pts = np.asarray(points_m, dtype=np.float64).reshape(-1, 3)
+        if len(pts) == 0:
+            raise DataError("box: cannot bound an empty point set")
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        return cls((lo + hi) / 2.0, hi - lo)
+
+    def corners(self) -> NDArray[np.float64]:
+        """The 8 corners (8, 3) in the box's frame."""
+        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+        return self.center_m + (signs * (self.extent_m / 2.0)) @ self.R.T
+
+    def transformed(self, T_b_a: NDArray[np.float64]) -> Box3D:
+        """This box (given in frame a) expressed in frame b."""
+        return Box3D(T_b_a[:3, :3] @ self.center_m + T_b_a[:3, 3], self.extent_m, T_b_a[:3, :3] @ self.R)
+
+    def aabb(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(min, max) corners of the axis-aligned box that contains this box."""
+        half = np.abs(self.R) @ (self.extent_m / 2.0)
+        return self.center_m - half, self.center_m + half
+
+    @property
+    def volume_m3(self) -> float:
+        return float(np.prod(self.extent_m))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "center_m": self.center_m.tolist(),
+            "extent_m": self.extent_m.tolist(),
+            "R": self.R.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Box3D:
+        return cls(np.array(d["center_m"]), np.array(d["extent_m"]), np.array(d.get("R", np.eye(3))))
+
+
+@dataclass
+class Observation:
+    """One perception of something at one instant, in the sensor frame of pose ``pose_id``.
+
+    ``box`` is in ``frame_id`` (the camera optical frame for both layers).
+    ``data`` (low-level): background: ``plane_cam`` [a, b, c, d] and ``contour_cam`` (K, 3);
+    foreground: ``points_cam`` (subsampled (K, 3)), ``image_box_xyxy`` (pixels), ``detection``.
+    """
+
+    layer: Literal["background", "foreground"]
+    class_name: str
+    confidence: float
+    stamp_s: float
+    pose_id: int
+    box: Box3D
+    frame_id: str = "camera"
+    instance_uuid: str | None = None
+    data: dict[str, Any] = field(default_factory=dict)
+    uuid: str = field(default_factory=new_uuid)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "uuid": self.uuid,
+            "type": "observation",
+            "layer": self.layer,
+            "class": self.class_name,
+            "confidence": float(self.confidence),
+            "stamp_s": float(self.stamp_s),
+            "pose_id": int(self.pose_id),
+            "frame_id": self.frame_id,
+            "box": self.box.to_dict(),
+            "instance_uuid": self.instance_uuid,
+            "data": self.data,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Observation:
+        return cls(
+            layer=d["layer"],
+            class_name=d["class"],
+            confidence=float(d["confidence"]),
+            stamp_s=float(d["stamp_s"]),
+            pose_id=int(d["pose_id"]),
+            box=Box3D.from_dict(d["box"]),
+            frame_id=d.get("frame_id", "camera"),
+            instance_uuid=d.get("instance_uuid"),
+            data=d.get("data", {}),
+            uuid=d["uuid"],
+        )
+
+
+@dataclass
+class Instance:
+    """A thing in the scene, aggregated from observations, in the map frame.
+
+    ``data`` (low-level): background: ``plane_map`` [a, b, c, d], ``contour_map`` (K, 3);
+    foreground: ``trajectory`` rows [stamp_s, x, y, z, vx, vy, vz] in the map frame.
+    """
+
+    layer: Literal["background", "foreground"]
+    class_name: str
+    box: Box3D
+    first_seen_s: float
+    last_seen_s: float
+    state: State = "static"
+    confidence: float = 1.0
+    observation_uuids: list[str] = field(default_factory=list)
+    frame_id: str = "map"
+    data: dict[str, Any] = field(default_factory=dict)
+    uuid: str = field(default_factory=new_uuid)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "uuid": self.uuid,
+            "type": "instance",
+            "layer": self.layer,
+            "class": self.class_name,
+            "box": self.box.to_dict(),
+            "first_seen_s": float(self.first_seen_s),
+            "last_seen_s": float(self.last_seen_s),
+            "state": self.state,
+            "confidence": float(self.confidence),
+            "observation_uuids": list(self.observation_uuids),
+            "frame_id": self.frame_id,
+            "data": self.data,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Instance:
+        return cls(
+            layer=d["layer"],
+            class_name=d["class"],
+            box=Box3D.from_dict(d["box"]),
+            first_seen_s=float(d["first_seen_s"]),
+            last_seen_s=float(d["last_seen_s"]),
+            state=d.get("state", "static"),
+            confidence=float(d.get("confidence", 1.0)),
+            observation_uuids=list(d.get("observation_uuids", [])),
+            frame_id=d.get("frame_id", "map"),
+            data=d.get("data", {}),
+            uuid=d["uuid"],
+        )
+
+
+@dataclass
+class Analysis:
+    """A learned feature: ``kind`` is ``ods``, ``size``, ``altitude``, ``heatmap``, ...
+
+    ``values`` holds the numbers (for ``ods``: mean_mps, cl_mps, cu_mps, ratio, sigma_mps).
+    """
+
+    kind: str
+    class_name: str
+    t_start_s: float
+    t_end_s: float
+    values: dict[str, Any]
+    created_s: float
+    uuid: str = field(default_factory=new_uuid)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "uuid": self.uuid,
+            "type": "analysis",
+            "kind": self.kind,
+            "class": self.class_name,
+            "t_start_s": self.t_start_s,
+            "t_end_s": self.t_end_s,
+            "values": self.values,
+            "created_s": self.created_s,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Analysis:
+        return cls(
+            kind=d["kind"],
+            class_name=d["class"],
+            t_start_s=float(d["t_start_s"]),
+            t_end_s=float(d["t_end_s"]),
+            values=d["values"],
+            created_s=float(d["created_s"]),
+            uuid=d["uuid"],
+        )
+
+
+@dataclass
+class Environment:
+    """A place the robot knows; several sessions (logs) accumulate into one environment.
+
+    ``data`` may hold the map (occupancy grid: ``resolution_m``, ``origin_m``, ``image``) and
+    the robot trajectory rows [stamp_s, x, y, z, qx, qy, qz, qw].
+    """
+
+    name: str
+    data: dict[str, Any] = field(default_factory=dict)
+    uuid: str = field(default_factory=new_uuid)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"uuid": self.uuid, "type": "environment", "name": self.name, "data": self.data}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Environment:
+        return cls(name=d["name"], data=d.get("data", {}), uuid=d["uuid"])

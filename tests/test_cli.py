@@ -1,0 +1,51 @@
+"""The CLI answers --help quickly, documents every command with an example, and exits cleanly."""
+
+import subprocess
+import sys
+
+import click
+import pytest
+import typer.main
+from typer.testing import CliRunner
+
+from hiper_cli import __version__
+from hiper_cli.cli import app
+
+runner = CliRunner()
+
+
+def _all_commands():
+    root = typer.main.get_command(app)
+    stack = [((), root)]
+    while stack:
+        path, cmd = stack.pop()
+        if isinstance(cmd, click.Group):
+            for name, sub in cmd.commands.items():
+                stack.append(((*path, name), sub))
+        else:
+            yield path, cmd
+
+
+def test_version():
+    result = runner.invoke(app, ["--version"])
+    assert result.exit_code == 0
+    assert __version__ in result.output
+
+
+COMMANDS = list(_all_commands())
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) for p, _ in COMMANDS])
+def test_every_command_has_an_example(path, cmd):
+    assert "Example:" in (cmd.help or ""), f"hiper {' '.join(path)} has no 'Example:' in its help"
+
+
+def test_help_does_not_import_heavy_packages():
+    code = (
+        "import sys; from hiper_cli.cli import app; "
+        "heavy = [m for m in ('numpy', 'open3d', 'pyoxigraph', 'onnxruntime', 'scipy') "
+        "if m in sys.modules]; "
+        "print(','.join(heavy))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "", f"hiper --help imports {out.stdout.strip()}"
