@@ -1,0 +1,1 @@
+"""Measurements against ground truth: the paper's tables, ours beside them."""

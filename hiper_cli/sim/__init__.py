@@ -1,0 +1,1 @@
+"""Synthetic long-term RGB-D logs with ground truth (``hiper sim``)."""
