@@ -144,3 +144,25 @@ def test_read_frame_random_access(scene):
     frame = reader.read_frame(4)
     np.testing.assert_array_equal(frame.rgb, frames[4].rgb)
     assert frame.pose_id == 4
+
+
+@pytest.mark.parametrize("to", ["rosbag1", "rosbag2", "mcap", "tum"])
+def test_convert_round_trip(scene, tmp_path, to):
+    frames, paths = scene
+    source = paths["rosbag1"] if to == "tum" else paths["tum"]
+    out = tmp_path / ("out.bag" if to == "rosbag1" else "out")
+    result = CliRunner().invoke(app, ["convert", str(source), str(out), "--to", to, "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["frames_written"] == 6 and report["skipped"] == []
+    assert_same_frames(frames, list(open_log(out)), depth_atol=1e-6)
+
+
+def test_convert_rejects_bad_choices(scene, tmp_path):
+    _, paths = scene
+    result = CliRunner().invoke(app, ["convert", str(paths["tum"]), str(tmp_path / "o"), "--to", "rosbag3"])
+    assert result.exit_code != 0
+    assert "--to rosbag3: unknown; expected one of tum, rosbag1, rosbag2, mcap" in result.output
+    result = CliRunner().invoke(app, ["convert", str(paths["tum"]), str(paths["mcap"]), "--to", "mcap"])
+    assert result.exit_code != 0
+    assert "exists already; choose a new output path" in result.output
