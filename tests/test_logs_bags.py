@@ -138,12 +138,15 @@ def test_poses_flag_replaces_bag_poses(tmp_path):
     np.testing.assert_allclose(got[2].T_map_cam, T[2], atol=1e-6)
 
 
-def test_read_frame_random_access(scene):
+@pytest.mark.parametrize("kind", FORMATS)
+def test_read_frame_random_access(scene, kind):
     frames, paths = scene
-    reader = open_log(paths["rosbag1"])
-    frame = reader.read_frame(4)
-    np.testing.assert_array_equal(frame.rgb, frames[4].rgb)
-    assert frame.pose_id == 4
+    reader = open_log(paths[kind])
+    for k in (4, 0):
+        frame = reader.read_frame(k)
+        np.testing.assert_array_equal(frame.rgb, frames[k].rgb)
+        np.testing.assert_allclose(frame.depth_m, frames[k].depth_m, atol=1e-6)
+        assert frame.pose_id == k
 
 
 @pytest.mark.parametrize("to", ["rosbag1", "rosbag2", "mcap", "tum"])

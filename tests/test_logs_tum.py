@@ -136,3 +136,14 @@ def test_writer_refuses_non_increasing_stamps(tmp_path):
             writer.write(frames[0])
     with pytest.raises(LogError, match="folder exists and is not empty"):
         TumWriter(tmp_path / "log", CAMERA)
+
+
+def test_depth_scale_flag_applies_to_a_tum_folder(tmp_path):
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+
+    root = write_tum(tmp_path / "log", make_frames(n=2, detections=False))
+    result = CliRunner().invoke(app, ["info", str(root), "--depth-scale", "1000", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["camera"]["depth_scale"] == 1000.0

@@ -75,7 +75,7 @@ def open_log_from_flags(
     camera_frame: str | None = None,
 ) -> LogReader:
     """Build the camera and topic choices from the flags and call ``open_log``."""
-    from hiper_cli.perceive.logs import TUM_PRESETS, BagTopics, load_camera_json, open_log
+    from hiper_cli.perceive.logs import TUM_PRESETS, BagTopics, detect_format, load_camera_json, open_log
     from hiper_cli.types import CameraIntrinsics
 
     pinhole = {"--fx": fx, "--fy": fy, "--cx": cx, "--cy": cy, "--width": width, "--height": height}
@@ -97,6 +97,10 @@ def open_log_from_flags(
                               "--fx --fy --cx --cy --width --height, or --camera camera.json")
         intrinsics = CameraIntrinsics(width=int(width or 0), height=int(height or 0), fx=float(fx or 0),
                                       fy=float(fy or 0), cx=float(cx or 0), cy=float(cy or 0))
+    if intrinsics is None and depth_scale is not None and detect_format(log) == "tum":
+        from hiper_cli.perceive.logs.tum import tum_camera
+
+        intrinsics = tum_camera(log)[0]
     if intrinsics is not None and depth_scale is not None:
         from dataclasses import replace
 

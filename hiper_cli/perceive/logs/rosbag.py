@@ -177,7 +177,12 @@ def _detections_from_msg(msg: Any) -> Detections:
 
 @dataclass
 class BagReader(IndexedLog):
-    """Reader of one bag (see the module docstring); ``locator`` = ((topic, index), (topic, index))."""
+    """Reader of one bag (see the module docstring).
+
+    An entry's ``locator`` holds, for colour then depth, ``(topic, index, bag_time_ns, rank)``:
+    the message's index on its topic, its bag time and its rank among that topic's messages
+    with the same bag time (for random access).
+    """
 
     bag: Path = field(default_factory=Path)
     ros1: bool = False
@@ -205,7 +210,7 @@ class BagReader(IndexedLog):
     def _decoded(self) -> Iterator[tuple[int, ImagePair | LogError]]:
         need: dict[tuple[str, int], list[tuple[int, str]]] = {}
         for k, entry in enumerate(self.entries):
-            for role, (topic, index) in zip(("rgb", "depth"), entry.locator, strict=True):
+            for role, (topic, index, _, _) in zip(("rgb", "depth"), entry.locator, strict=True):
                 need.setdefault((topic, index), []).append((k, role))
         ready: dict[int, dict[str, Any]] = {}
         counters = {self.rgb_topic: 0, self.depth_topic: 0}
@@ -248,10 +253,11 @@ class BagReader(IndexedLog):
         reader = _open_reader(self.bag, self.ros1)
         try:
             images = []
-            for role, (topic, index) in zip(("rgb", "depth"), entry.locator, strict=True):
+            for role, (topic, index, time_ns, rank) in zip(("rgb", "depth"), entry.locator, strict=True):
                 conns = [c for c in reader.connections if c.topic == topic]
-                for i, (conn, _, raw) in enumerate(reader.messages(connections=conns)):
-                    if i == index:
+                found = reader.messages(connections=conns, start=time_ns, stop=time_ns + 1)
+                for i, (conn, _, raw) in enumerate(found):
+                    if i == rank:
                         images.append(self._decode(reader, conn, raw, role, index))
                         break
                 else:
@@ -332,13 +338,17 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
     stream = {t.topic for t in found.values() if t.msgtype in wanted_types} | {rgb_topic, depth_topic}
     det_topic = _pick(path, found, topics.detections_topic, (DETECTIONS,), "detections")
     stamps: dict[str, list[float]] = {rgb_topic: [], depth_topic: []}
+    places: dict[str, list[tuple[int, int]]] = {rgb_topic: [], depth_topic: []}  # (bag time, rank)
+    ranks: dict[tuple[str, int], int] = {}
     tf = TfTree()
     pose_rows: dict[str, list[tuple[float, NDArray[np.float64], str]]] = {}
     det_rows: list[tuple[float, Detections]] = []
     conns = [c for c in reader.connections if c.topic in stream]
-    for conn, _, raw in reader.messages(connections=conns):
+    for conn, time_ns, raw in reader.messages(connections=conns):
         if conn.topic in stamps:
             stamps[conn.topic].append(_header_prefix(raw, ros1)[0])
+            rank = ranks[(conn.topic, time_ns)] = ranks.get((conn.topic, time_ns), -1) + 1
+            places[conn.topic].append((time_ns, rank))
             continue
         msg = reader.deserialize(raw, conn.msgtype)
         where = f"{path} {conn.topic}"
@@ -390,7 +400,8 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
                 pos = int(np.argmin(np.abs(det_stamps[det_order] - stamp)))
                 if abs(det_stamps[det_order][pos] - stamp) <= max_dt_s:
                     detections = det_rows[int(det_order[pos])][1]
-        entries.append(FrameEntry(stamp, T[k], source, ((rgb_topic, ri), (depth_topic, di)), detections))
+        locator = ((rgb_topic, ri, *places[rgb_topic][ri]), (depth_topic, di, *places[depth_topic][di]))
+        entries.append(FrameEntry(stamp, T[k], source, locator, detections))
     if not entries:
         raise LogError(f"{path}: no colour image stamp has a pose ({pose_source}); check --pose-topic, "
                        "--map-frame/--camera-frame or pass --poses traj.txt")
