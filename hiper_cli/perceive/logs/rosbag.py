@@ -267,7 +267,7 @@ class BagReader(IndexedLog):
         return images[0], images[1]
 
 
-def _collect(path: Path, reader: Any, topics: BagTopics) -> dict[str, _Topic]:
+def _collect(reader: Any) -> dict[str, _Topic]:
     out: dict[str, _Topic] = {}
     for conn in reader.connections:
         entry = out.setdefault(conn.topic, _Topic(conn.topic, conn.msgtype, 0))
@@ -297,7 +297,7 @@ def open_bag(path: Path, kind: str, *, poses: Trajectory | None, camera: CameraI
 
 def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory | None,
            camera: CameraIntrinsics | None, max_dt_s: float, topics: BagTopics) -> BagReader:
-    found = _collect(path, reader, topics)
+    found = _collect(reader)
     images = [t for t in found.values() if t.msgtype in (IMAGE, COMPRESSED)]
     for t in images:
         t.first = _first(reader, t.topic)
@@ -308,10 +308,10 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
         raise LogError(f"{path}: no colour image topic (sensor_msgs/Image or CompressedImage with "
                        "rgb8/bgr8); "
                        "pass --rgb-topic")
-    depth_topic = _pick(path, found, topics.depth_topic, (IMAGE, COMPRESSED), "depth",
-                        _near(rgb_topic, depth_like) if depth_like else [])
-    if topics.depth_topic is None and depth_like:
-        depth_topic = _near(rgb_topic, depth_like)[0]
+    if topics.depth_topic is None:
+        depth_topic = _near(rgb_topic, depth_like)[0] if depth_like else None
+    else:
+        depth_topic = _pick(path, found, topics.depth_topic, (IMAGE, COMPRESSED), "depth")
     if depth_topic is None:
         raise LogError(f"{path}: no depth image topic (16UC1, mono16 or 32FC1); pass --depth-topic")
     for topic, role in ((rgb_topic, "rgb"), (depth_topic, "depth")):
@@ -439,9 +439,14 @@ def _poses(path: Path, found: dict[str, _Topic], topics: BagTopics, tf: TfTree,
     if found[chosen].msgtype == TF:
         T, valid = tf.lookup(topics.map_frame, camera_frame, stamps_s, max_dt_s, f"{path} {chosen}")
         return T, valid, f"tf {topics.map_frame} -> {camera_frame}", f"{path} {chosen}"
-    rows = sorted(pose_rows.get(chosen, []), key=lambda r: r[0])
+    rows = pose_rows.get(chosen, [])
     if not rows:
         raise LogError(f"{path}: pose topic '{chosen}' has no messages; pass another --pose-topic or --poses")
+    for i in range(1, len(rows)):
+        if rows[i][0] < rows[i - 1][0]:
+            raise LogError(f"{path} {chosen}: pose message #{i} stamp {rows[i][0]:.6f} goes back in time "
+                           f"after {rows[i - 1][0]:.6f}; the recording mixes runs or clocks: cut the bag "
+                           "or pass --poses traj.txt")
     keep = [0] + [i for i in range(1, len(rows)) if rows[i][0] > rows[i - 1][0]]
     trajectory = Trajectory.from_matrices(np.array([rows[i][0] for i in keep]),
                                           np.stack([rows[i][1] for i in keep]), source=f"{path} {chosen}")
