@@ -169,3 +169,21 @@ def test_convert_rejects_bad_choices(scene, tmp_path):
     result = CliRunner().invoke(app, ["convert", str(paths["tum"]), str(paths["mcap"]), "--to", "mcap"])
     assert result.exit_code != 0
     assert "exists already; choose a new output path" in result.output
+
+
+def test_detections_of_both_vision_msgs_layouts():
+    from types import SimpleNamespace as NS
+
+    from hiper_cli.perceive.logs.rosbag import _detections_from_msg
+
+    ros2 = NS(detections=[NS(results=[NS(hypothesis=NS(class_id="person", score=0.4)),
+                                      NS(hypothesis=NS(class_id="chair", score=0.9))],
+                             bbox=NS(center=NS(position=NS(x=10.0, y=20.0), theta=0.0), size_x=4.0,
+                                     size_y=6.0))])
+    ros1 = NS(detections=[NS(results=[NS(id=62, score=0.7)],
+                             bbox=NS(center=NS(x=10.0, y=20.0, theta=0.0), size_x=4.0, size_y=6.0))])
+    for msg, name, score in ((ros2, "chair", 0.9), (ros1, "62", 0.7)):
+        dets = _detections_from_msg(msg)
+        assert dets.class_names == (name,)
+        np.testing.assert_allclose(dets.xyxy, [[8.0, 17.0, 12.0, 23.0]])
+        assert dets.scores[0] == pytest.approx(score)
