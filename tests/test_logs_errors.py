@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from hiper_cli.cli import app
 from hiper_cli.errors import LogError
-from hiper_cli.perceive.logs import BagTopics, TumWriter, open_log, read_tum_trajectory
+from hiper_cli.perceive.logs import TUM_PRESETS, BagTopics, TumWriter, open_log, read_tum_trajectory
 from hiper_cli.perceive.logs.bag_writer import BagWriter
 
 runner = CliRunner()
@@ -237,3 +237,20 @@ def test_installed_entry_point_exits_non_zero(tmp_path):
                             capture_output=True, text=True)
     assert result.returncode == 1
     assert "no such file or folder" in result.stderr
+
+
+def test_bag_size_mismatches_are_caught_when_opening(tmp_path):
+    path = bag(tmp_path)
+    with pytest.raises(LogError, match=r"colour topic '/camera/color/image_raw' is 32×24 but the intrinsics "
+                                       r"\(flags\) are for 640×480"):
+        open_log(path, camera=TUM_PRESETS["fr1"])
+
+
+class HalfDepth(BagWriter):
+    def _image(self, stamp_s, frame_id, image, encoding):
+        return super()._image(stamp_s, frame_id, image[::2, ::2] if encoding == "16UC1" else image, encoding)
+
+
+def test_unregistered_depth(tmp_path):
+    path = bag(tmp_path, writer_class=HalfDepth)
+    cli_fails(["info", path], "depth topic '/camera/aligned_depth_to_color/image_raw' is 16×12 but colour")

@@ -275,6 +275,13 @@ def _collect(reader: Any) -> dict[str, _Topic]:
     return out
 
 
+def _size(topic: _Topic) -> tuple[int, int] | None:
+    """(width, height) of a raw image topic's first message; None for compressed images."""
+    if topic.msgtype != IMAGE or topic.first is None:
+        return None
+    return int(topic.first.width), int(topic.first.height)
+
+
 def _first(reader: Any, topic: str) -> Any:
     conns = [c for c in reader.connections if c.topic == topic]
     for conn, _, raw in reader.messages(connections=conns):
@@ -332,6 +339,16 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
         sources["camera"] = f"{path} {info_topic}"
     else:
         sources["camera"] = "flags"
+    rgb_size = _size(found[rgb_topic])
+    depth_size = _size(found[depth_topic])
+    if rgb_size and depth_size and rgb_size != depth_size:
+        raise LogError(f"{path}: depth topic '{depth_topic}' is {depth_size[0]}×{depth_size[1]} but colour "
+                       f"topic '{rgb_topic}' is {rgb_size[0]}×{rgb_size[1]}; pass --depth-topic with depth "
+                       "registered to the colour camera (e.g. /camera/aligned_depth_to_color/image_raw)")
+    if rgb_size and rgb_size != (camera.width, camera.height):
+        raise LogError(f"{path}: colour topic '{rgb_topic}' is {rgb_size[0]}×{rgb_size[1]} but the "
+                       f"intrinsics ({sources['camera']}) are for {camera.width}×{camera.height}; pass "
+                       "--info-topic of the colour camera or the right --camera")
 
     # colour and depth stamps (headers only), detections, poses: one pass
     wanted_types = {TF, ODOMETRY, DETECTIONS, *POSE_TYPES}
