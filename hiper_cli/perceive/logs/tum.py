@@ -171,6 +171,19 @@ class TumReader(IndexedLog):
         return read_rgb_file(rgb_path), read_depth_png(depth_path, self.camera.depth_scale)
 
 
+def _check_size(entry: FrameEntry, camera: CameraIntrinsics, camera_source: str) -> None:
+    """Refuse intrinsics of another size than the first readable colour image, before iterating."""
+    try:
+        rgb = read_rgb_file(entry.locator[0])
+    except LogError:
+        return  # counted as a skipped frame while iterating
+    height, width = rgb.shape[:2]
+    if (width, height) != (camera.width, camera.height):
+        raise LogError(f"{entry.locator[0]}: image is {width}×{height} but the camera intrinsics "
+                       f"({camera_source}) are for {camera.width}×{camera.height}; pass the right "
+                       "camera.json or camera flags")
+
+
 def open_tum(root: Path, *, poses: Trajectory | None = None, camera: CameraIntrinsics | None = None,
              max_dt_s: float = 0.02) -> TumReader:
     """Index a TUM folder; ``poses`` replaces ``groundtruth.txt``, ``camera`` the folder's intrinsics."""
@@ -231,6 +244,7 @@ def open_tum(root: Path, *, poses: Trajectory | None = None, camera: CameraIntri
         raise LogError(f"{root}: no image stamp lies within the poses' time span "
                        f"{trajectory.stamps_s[0]:.6f}..{trajectory.stamps_s[-1]:.6f}; "
                        "check that --poses belongs to this log")
+    _check_size(entries[0], cam, camera_source)
     return TumReader(
         path=str(root), format="tum", camera=cam, entries=entries, pose_source=pose_source,
         sources=sources, has_detections=det_stamps is not None, index_skipped=index_skipped,
