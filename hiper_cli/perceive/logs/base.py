@@ -129,7 +129,7 @@ class LogInfo:
         return out
 
 
-@dataclass
+@dataclass(eq=False)
 class IndexedLog:
     """Base of the readers: subclasses fill ``entries`` and implement ``_read_images``."""
 

@@ -175,7 +175,7 @@ def _detections_from_msg(msg: Any) -> Detections:
     return Detections.from_records(records)
 
 
-@dataclass
+@dataclass(eq=False)
 class BagReader(IndexedLog):
     """Reader of one bag (see the module docstring).
 
