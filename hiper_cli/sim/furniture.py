@@ -68,21 +68,28 @@ def couch(length_m: float, fabric: Color, cushion: Color) -> Mesh:
         parts.append(box((-0.25, y0 + 0.01, 0.52), (-0.13, y0 + width - 0.01, 0.8), cushion))
     for sx in (-1, 1):
         for sy in (-1, 1):
-            parts.append(box((sx * 0.4 - 0.03, sy * (ly - 0.05) - 0.03, 0.0),
-                             (sx * 0.4 + 0.03, sy * (ly - 0.05) + 0.03, 0.08), (0.1, 0.08, 0.06)))
+            parts.append(
+                box(
+                    (sx * 0.4 - 0.03, sy * (ly - 0.05) - 0.03, 0.0),
+                    (sx * 0.4 + 0.03, sy * (ly - 0.05) + 0.03, 0.08),
+                    (0.1, 0.08, 0.06),
+                )
+            )
     return Mesh.concat(parts)
 
 
 def bed(length_m: float, width_m: float, frame: Color, sheet: Color, pillow: Color) -> Mesh:
     """A bed along +x (head board at -x): frame, mattress, pillow, blanket."""
     lx, ly = length_m / 2.0, width_m / 2.0
-    return Mesh.concat([
-        box((-lx, -ly, 0.0), (lx, ly, 0.3), frame),
-        box((-lx + 0.02, -ly + 0.02, 0.3), (lx - 0.02, ly - 0.02, 0.5), (0.95, 0.95, 0.93)),
-        box((lx * -1 + 0.05, -ly + 0.1, 0.5), (-lx + 0.45, ly - 0.1, 0.6), pillow),
-        box((-lx + 0.6, -ly + 0.0, 0.5), (lx - 0.0, ly - 0.0, 0.56), sheet),
-        box((-lx - 0.05, -ly, 0.0), (-lx, ly, 0.95), frame),
-    ])
+    return Mesh.concat(
+        [
+            box((-lx, -ly, 0.0), (lx, ly, 0.3), frame),
+            box((-lx + 0.02, -ly + 0.02, 0.3), (lx - 0.02, ly - 0.02, 0.5), (0.95, 0.95, 0.93)),
+            box((lx * -1 + 0.05, -ly + 0.1, 0.5), (-lx + 0.45, ly - 0.1, 0.6), pillow),
+            box((-lx + 0.6, -ly + 0.0, 0.5), (lx - 0.0, ly - 0.0, 0.56), sheet),
+            box((-lx - 0.05, -ly, 0.0), (-lx, ly, 0.95), frame),
+        ]
+    )
 
 
 def shelf(width_m: float, height_m: float, wood: Color, rng: np.random.Generator) -> Mesh:
@@ -113,22 +120,26 @@ def bottle(height_m: float, glass: Color, cap: Color = (0.9, 0.9, 0.9)) -> Mesh:
     """A bottle: body, shoulder, neck and cap."""
     r = 0.11 * height_m + 0.01
     body = 0.62 * height_m
-    return Mesh.concat([
-        cylinder(r, 0.0, body, glass, 14),
-        frustum(r, 0.35 * r, body, 0.8 * height_m, glass, 14),
-        cylinder(0.35 * r, 0.8 * height_m, 0.96 * height_m, glass, 10),
-        cylinder(0.4 * r, 0.96 * height_m, height_m, cap, 10),
-    ])
+    return Mesh.concat(
+        [
+            cylinder(r, 0.0, body, glass, 14),
+            frustum(r, 0.35 * r, body, 0.8 * height_m, glass, 14),
+            cylinder(0.35 * r, 0.8 * height_m, 0.96 * height_m, glass, 10),
+            cylinder(0.4 * r, 0.96 * height_m, height_m, cap, 10),
+        ]
+    )
 
 
 def cup(color: Color) -> Mesh:
     """A mug 10 cm tall with a handle."""
-    return Mesh.concat([
-        cylinder(0.04, 0.0, 0.1, color, 14, cap=(0.25, 0.15, 0.1)),
-        box((0.04, -0.008, 0.025), (0.07, 0.008, 0.035), color),
-        box((0.06, -0.008, 0.025), (0.07, 0.008, 0.085), color),
-        box((0.04, -0.008, 0.075), (0.07, 0.008, 0.085), color),
-    ])
+    return Mesh.concat(
+        [
+            cylinder(0.04, 0.0, 0.1, color, 14, cap=(0.25, 0.15, 0.1)),
+            box((0.04, -0.008, 0.025), (0.07, 0.008, 0.035), color),
+            box((0.06, -0.008, 0.025), (0.07, 0.008, 0.085), color),
+            box((0.04, -0.008, 0.075), (0.07, 0.008, 0.085), color),
+        ]
+    )
 
 
 def plant(pot: Color) -> Mesh:
@@ -143,8 +154,15 @@ def plant(pot: Color) -> Mesh:
     return Mesh.concat(parts)
 
 
-def framed_person(width_m: float, height_m: float, frame: Color, backdrop: Color, figure_h_m: float,
-                  depth_m: float = 0.03, rng: np.random.Generator | None = None) -> Mesh:
+def framed_person(
+    width_m: float,
+    height_m: float,
+    frame: Color,
+    backdrop: Color,
+    figure_h_m: float,
+    depth_m: float = 0.03,
+    rng: np.random.Generator | None = None,
+) -> Mesh:
     """A flat picture facing +x (its back at x = 0): a frame, a backdrop and a painted person.
 
     The person is a flattened human mesh, so an RGB detector sees a person where the depth
@@ -153,7 +171,9 @@ def framed_person(width_m: float, height_m: float, frame: Color, backdrop: Color
     lw, base = width_m / 2.0, 0.0
     parts = [
         box((0.0, -lw, base), (depth_m, lw, base + height_m), frame),
-        box((depth_m, -lw + 0.04, base + 0.04), (depth_m + 0.002, lw - 0.04, base + height_m - 0.04), backdrop),
+        box(
+            (depth_m, -lw + 0.04, base + 0.04), (depth_m + 0.002, lw - 0.04, base + height_m - 0.04), backdrop
+        ),
     ]
     g = rng or np.random.default_rng(0)
     skin = (0.9, 0.72, 0.6) if g.random() < 0.5 else (0.55, 0.38, 0.26)
@@ -182,8 +202,13 @@ def cart(rng: np.random.Generator) -> Mesh:
         parts.append(box((-0.4, -0.25, z), (0.4, 0.25, z + 0.03), body))
     for sx in (-1, 1):
         for sy in (-1, 1):
-            parts.append(box((sx * 0.38 - 0.02, sy * 0.23 - 0.02, 0.1), (sx * 0.38 + 0.02, sy * 0.23 + 0.02, 0.9),
-                             (0.6, 0.6, 0.62)))
+            parts.append(
+                box(
+                    (sx * 0.38 - 0.02, sy * 0.23 - 0.02, 0.1),
+                    (sx * 0.38 + 0.02, sy * 0.23 + 0.02, 0.9),
+                    (0.6, 0.6, 0.62),
+                )
+            )
             parts.append(cylinder(0.05, 0.0, 0.1, (0.1, 0.1, 0.1), 8).translated((sx * 0.35, sy * 0.22, 0.0)))
     parts.append(box((-0.44, -0.2, 0.9), (-0.41, 0.2, 1.0), (0.2, 0.45, 0.75)))
     for k in range(3):
@@ -197,6 +222,11 @@ def stairs(steps: int, width_m: float, color: Color) -> Mesh:
     parts = []
     for k in range(steps):
         shade = 0.9 if k % 2 else 1.0
-        parts.append(box((k * 0.28, -width_m / 2, 0.0), ((k + 1) * 0.28, width_m / 2, (k + 1) * 0.17),
-                         (color[0] * shade, color[1] * shade, color[2] * shade)))
+        parts.append(
+            box(
+                (k * 0.28, -width_m / 2, 0.0),
+                ((k + 1) * 0.28, width_m / 2, (k + 1) * 0.17),
+                (color[0] * shade, color[1] * shade, color[2] * shade),
+            )
+        )
     return Mesh.concat(parts)

@@ -31,12 +31,18 @@ _CUBE_V = np.array(
 )
 _CUBE_T = np.array(
     [
-        [0, 1, 3], [0, 3, 2],  # -x
-        [4, 6, 7], [4, 7, 5],  # +x
-        [0, 4, 5], [0, 5, 1],  # -y
-        [2, 3, 7], [2, 7, 6],  # +y
-        [0, 2, 6], [0, 6, 4],  # -z
-        [1, 5, 7], [1, 7, 3],  # +z
+        [0, 1, 3],
+        [0, 3, 2],  # -x
+        [4, 6, 7],
+        [4, 7, 5],  # +x
+        [0, 4, 5],
+        [0, 5, 1],  # -y
+        [2, 3, 7],
+        [2, 7, 6],  # +y
+        [0, 2, 6],
+        [0, 6, 4],  # -z
+        [1, 5, 7],
+        [1, 7, 3],  # +z
     ],
     dtype=np.int64,
 )
@@ -145,8 +151,11 @@ def sphere(radius_m: float, color: Color, rings: int = 6, segments: int = 10) ->
         for j in range(segments):
             theta = 2 * math.pi * j / segments
             vertices.append(
-                [radius_m * math.sin(phi) * math.cos(theta), radius_m * math.sin(phi) * math.sin(theta),
-                 radius_m * math.cos(phi)]
+                [
+                    radius_m * math.sin(phi) * math.cos(theta),
+                    radius_m * math.sin(phi) * math.sin(theta),
+                    radius_m * math.cos(phi),
+                ]
             )
     vertices.append([0.0, 0.0, -radius_m])
     last = len(vertices) - 1
@@ -168,7 +177,12 @@ def sphere(radius_m: float, color: Color, rings: int = 6, segments: int = 10) ->
     )
 
 
-SKIN_TONES: tuple[Color, ...] = ((0.94, 0.78, 0.66), (0.80, 0.60, 0.45), (0.55, 0.38, 0.26), (0.36, 0.24, 0.16))
+SKIN_TONES: tuple[Color, ...] = (
+    (0.94, 0.78, 0.66),
+    (0.80, 0.60, 0.45),
+    (0.55, 0.38, 0.26),
+    (0.36, 0.24, 0.16),
+)
 
 
 def human(
@@ -198,15 +212,21 @@ def human(
         dx = swing * side
         leg = cylinder(0.075 * s, 0.08 * s, hip_z + 0.02 * s, trousers, 8)
         parts.append(_lean(leg, dx, hip_z).translated((0.0, y, 0.0)))
-        parts.append(box((-0.06 * s + dx, y - 0.055 * s, 0.0), (0.13 * s + dx, y + 0.055 * s, 0.08 * s),
-                         (0.12, 0.12, 0.12)))
+        parts.append(
+            box(
+                (-0.06 * s + dx, y - 0.055 * s, 0.0),
+                (0.13 * s + dx, y + 0.055 * s, 0.08 * s),
+                (0.12, 0.12, 0.12),
+            )
+        )
         ay = side * 0.215 * s
         arm = cylinder(0.05 * s, 0.84 * s, shoulder_z - 0.02 * s, shirt, 8)
         parts.append(_lean(arm, -dx * 0.8, shoulder_z).translated((0.0, ay, 0.0)))
         hand = sphere(0.05 * s, skin, 4, 8).translated((-dx * 0.8 * 0.7, ay, 0.80 * s))
         parts.append(hand)
-    parts.append(box((-0.11 * s, -0.17 * s, hip_z - 0.04 * s), (0.11 * s, 0.17 * s, hip_z + 0.12 * s),
-                     trousers))
+    parts.append(
+        box((-0.11 * s, -0.17 * s, hip_z - 0.04 * s), (0.11 * s, 0.17 * s, hip_z + 0.12 * s), trousers)
+    )
     parts.append(box((-0.12 * s, -0.18 * s, hip_z + 0.10 * s), (0.12 * s, 0.18 * s, shoulder_z), shirt))
     parts.append(cylinder(0.05 * s, shoulder_z - 0.01 * s, shoulder_z + 0.07 * s, skin, 8))
     head_z = height_m - head_r

@@ -56,7 +56,9 @@ class NoiseModel:
             if not 0.0 <= value <= 1.0:
                 raise ConfigError(f"noise model: {name}={value}; expected a probability in [0, 1]")
         if self.jitter_frac < 0 or self.false_positives_per_image < 0 or self.min_pixels < 1:
-            raise ConfigError("noise model: jitter_frac and false_positives_per_image must be >= 0, min_pixels >= 1")
+            raise ConfigError(
+                "noise model: jitter_frac and false_positives_per_image must be >= 0, min_pixels >= 1"
+            )
 
     @classmethod
     def perfect(cls) -> NoiseModel:
@@ -82,7 +84,12 @@ class NoiseModel:
 
 
 def _box(mask_rows: NDArray[np.int64], mask_cols: NDArray[np.int64]) -> list[float]:
-    return [float(mask_cols.min()), float(mask_rows.min()), float(mask_cols.max() + 1), float(mask_rows.max() + 1)]
+    return [
+        float(mask_cols.min()),
+        float(mask_rows.min()),
+        float(mask_cols.max() + 1),
+        float(mask_rows.max() + 1),
+    ]
 
 
 def detect(
@@ -98,7 +105,7 @@ def detect(
     that show a person. Returns records ``{"xyxy", "class", "score", "instance_id"}``.
     """
     h, w = ids.shape
-    min_px = max(1, int(round(model.min_pixels * (h * w) / (640 * 480))))
+    min_px = max(1, round(model.min_pixels * (h * w) / (640 * 480)))
     present, counts = np.unique(ids[ids > 0], return_counts=True)
     out: list[dict[str, Any]] = []
     for inst, count in zip(present.tolist(), counts.tolist(), strict=True):
@@ -112,8 +119,14 @@ def detect(
         box = _box(rows, cols)
         if is_picture:
             if rng.random() < model.picture_person_rate:
-                out.append(_record(_jitter(box, 2 * model.jitter_frac, rng, w, h), "person",
-                                   float(rng.uniform(*model.fp_score_range)), None))
+                out.append(
+                    _record(
+                        _jitter(box, 2 * model.jitter_frac, rng, w, h),
+                        "person",
+                        float(rng.uniform(*model.fp_score_range)),
+                        None,
+                    )
+                )
             if name not in model.classes:
                 continue
         if rng.random() < model.miss_rate:
@@ -122,13 +135,21 @@ def detect(
         if label in CONFUSIONS and rng.random() < model.confusion_rate:
             options = CONFUSIONS[label]
             label = options[int(rng.integers(len(options)))]
-        out.append(_record(_jitter(box, model.jitter_frac, rng, w, h), label,
-                           float(rng.uniform(*model.score_range)), int(inst)))
+        out.append(
+            _record(
+                _jitter(box, model.jitter_frac, rng, w, h),
+                label,
+                float(rng.uniform(*model.score_range)),
+                int(inst),
+            )
+        )
     for _ in range(int(rng.poisson(model.false_positives_per_image))):
         bw, bh = float(rng.uniform(0.05, 0.3)) * w, float(rng.uniform(0.05, 0.4)) * h
         x0, y0 = float(rng.uniform(0, w - bw)), float(rng.uniform(0, h - bh))
         label = FP_CLASSES[int(rng.integers(len(FP_CLASSES)))]
-        out.append(_record([x0, y0, x0 + bw, y0 + bh], label, float(rng.uniform(*model.fp_score_range)), None))
+        out.append(
+            _record([x0, y0, x0 + bw, y0 + bh], label, float(rng.uniform(*model.fp_score_range)), None)
+        )
     return out
 
 
@@ -144,4 +165,9 @@ def _jitter(box: list[float], frac: float, rng: np.random.Generator, w: int, h: 
 
 
 def _record(xyxy: list[float], label: str, score: float, instance_id: int | None) -> dict[str, Any]:
-    return {"xyxy": [round(v, 2) for v in xyxy], "class": label, "score": round(score, 4), "instance_id": instance_id}
+    return {
+        "xyxy": [round(v, 2) for v in xyxy],
+        "class": label,
+        "score": round(score, 4),
+        "instance_id": instance_id,
+    }

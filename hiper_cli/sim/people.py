@@ -68,15 +68,13 @@ class Crowd:
             if self.paths[i]:
                 d = np.asarray(self.paths[i][0]) - self.pos[i]
                 self.heading[i] = math.atan2(d[1], d[0])
-                self.vel[i] = self.specs[i].speed_mps * np.array([math.cos(self.heading[i]),
-                                                                  math.sin(self.heading[i])])
+                self.vel[i] = self.specs[i].speed_mps * np.array(
+                    [math.cos(self.heading[i]), math.sin(self.heading[i])]
+                )
 
     def _new_path(self, i: int) -> None:
         spec = self.specs[i]
-        if spec.goals:
-            goal = spec.goals[self.goal_index[i] % len(spec.goals)]
-        else:
-            goal = self._random_goal()
+        goal = spec.goals[self.goal_index[i] % len(spec.goals)] if spec.goals else self._random_goal()
         self.paths[i] = self.grid.astar(tuple(self.pos[i]), goal)[1:]
 
     def _random_goal(self) -> XY:
@@ -89,7 +87,9 @@ class Crowd:
                 return p
         return self.grid.nearest_free(p)
 
-    def step(self, dt_s: float, robot_xy: XY | None = None, extra_obstacles: list[Rect] | None = None) -> None:
+    def step(
+        self, dt_s: float, robot_xy: XY | None = None, extra_obstacles: list[Rect] | None = None
+    ) -> None:
         """Advance everyone by ``dt_s`` (in sub-steps of ``config.dt_s``)."""
         steps = max(1, math.ceil(dt_s / self.cfg.dt_s - 1e-9))
         for _ in range(steps):
@@ -153,7 +153,9 @@ class Crowd:
             if np.linalg.norm(new_vel[i]) > 1e-6:
                 self.heading[i] = math.atan2(new_vel[i][1], new_vel[i][0])
 
-    def _move(self, p: NDArray[np.float64], step: NDArray[np.float64], obstacles: list[Rect]) -> NDArray[np.float64]:
+    def _move(
+        self, p: NDArray[np.float64], step: NDArray[np.float64], obstacles: list[Rect]
+    ) -> NDArray[np.float64]:
         """Move by ``step`` but keep ``body_radius_m`` clear of every wall (slide along it)."""
         q = p + step
         for r in self.world.walls:
@@ -194,7 +196,9 @@ class Carts:
         for i, spec in enumerate(self.specs):
             self.vel[i] = 0.0
             if not moving:
-                self.wait_until[i] = max(self.wait_until[i], self.t_s + float(self.rng.uniform(0, spec.wait_s[0])))
+                self.wait_until[i] = max(
+                    self.wait_until[i], self.t_s + float(self.rng.uniform(0, spec.wait_s[0]))
+                )
                 continue
             if self.t_s < self.wait_until[i]:
                 continue
@@ -218,5 +222,12 @@ class Carts:
         out = []
         for i, spec in enumerate(self.specs):
             lo, hi = spec.mesh.bounds()
-            out.append((self.pos[i, 0] + lo[0], self.pos[i, 1] + lo[1], self.pos[i, 0] + hi[0], self.pos[i, 1] + hi[1]))
+            out.append(
+                (
+                    self.pos[i, 0] + lo[0],
+                    self.pos[i, 1] + lo[1],
+                    self.pos[i, 0] + hi[0],
+                    self.pos[i, 1] + hi[1],
+                )
+            )
         return out

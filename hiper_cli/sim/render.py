@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,7 +22,7 @@ from hiper_cli.errors import ConfigError
 from hiper_cli.sim.meshes import Mesh
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["DepthNoise", "RenderConfig", "Renderer", "RenderOutput", "camera_for"]
+__all__ = ["DepthNoise", "RenderConfig", "RenderOutput", "Renderer", "camera_for"]
 
 
 @dataclass(frozen=True)
@@ -62,8 +63,13 @@ class RenderConfig:
 def camera_for(config: RenderConfig) -> CameraIntrinsics:
     f = config.focal_px_at_640 * config.width / 640.0
     return CameraIntrinsics(
-        width=config.width, height=config.height, fx=f, fy=f,
-        cx=(config.width - 1) / 2.0, cy=(config.height - 1) / 2.0, depth_scale=config.depth_scale,
+        width=config.width,
+        height=config.height,
+        fx=f,
+        fy=f,
+        cx=(config.width - 1) / 2.0,
+        cy=(config.height - 1) / 2.0,
+        depth_scale=config.depth_scale,
     )
 
 
@@ -90,8 +96,9 @@ class Renderer:
         light = np.array([0.3, 0.2, 1.0])
         self._light = light / np.linalg.norm(light)
 
-    def render(self, T_map_cam: NDArray[np.float64], dynamic: Sequence[tuple[int, Mesh]],
-               rng: np.random.Generator) -> RenderOutput:
+    def render(
+        self, T_map_cam: NDArray[np.float64], dynamic: Sequence[tuple[int, Mesh]], rng: np.random.Generator
+    ) -> RenderOutput:
         import open3d as o3d
 
         scene = o3d.t.geometry.RaycastingScene()
@@ -102,7 +109,7 @@ class Renderer:
         total = 0
         for inst_id, mesh in items:
             gid = scene.add_triangles(
-                o3d.core.Tensor(mesh.vertices.astype(np.float32)), o3d.core.Tensor(mesh.triangles.astype(np.uint32))
+                _tensor(mesh.vertices.astype(np.float32)), _tensor(mesh.triangles.astype(np.uint32))
             )
             ids[gid] = inst_id
             offsets[gid] = total
@@ -112,7 +119,7 @@ class Renderer:
         R, t = T_map_cam[:3, :3], T_map_cam[:3, 3]
         dirs = self._dirs_cam @ R.T
         rays = np.concatenate([np.broadcast_to(t, dirs.shape), dirs], axis=1).astype(np.float32)
-        hit = scene.cast_rays(o3d.core.Tensor(rays))
+        hit = scene.cast_rays(_tensor(rays))
         t_hit = hit["t_hit"].numpy().astype(np.float64)
         gids = hit["geometry_ids"].numpy().astype(np.int64)
         prims = hit["primitive_ids"].numpy().astype(np.int64)
@@ -139,3 +146,9 @@ class Renderer:
         depth = np.where(valid, z, 0.0).astype(np.float32).reshape(shape)
         inst = np.where(valid, ids[np.where(ok, gids, len(items))], 0).astype(np.uint16).reshape(shape)
         return RenderOutput(rgb_u8, depth, inst)
+
+
+def _tensor(array: NDArray[Any]) -> Any:
+    import open3d as o3d
+
+    return o3d.core.Tensor(array)  # type: ignore[call-overload]

@@ -48,7 +48,7 @@ class Grid:
         x0, y0, x1, y1 = world.bounds
         self.origin = (x0, y0)
         self.res = res_m
-        nx, ny = int(math.ceil((x1 - x0) / res_m)), int(math.ceil((y1 - y0) / res_m))
+        nx, ny = math.ceil((x1 - x0) / res_m), math.ceil((y1 - y0) / res_m)
         xs = x0 + (np.arange(nx) + 0.5) * res_m
         ys = y0 + (np.arange(ny) + 0.5) * res_m
         X, Y = np.meshgrid(xs, ys, indexing="ij")
@@ -81,8 +81,10 @@ class Grid:
 
     def line_free(self, a: XY, b: XY) -> bool:
         n = max(2, int(math.dist(a, b) / (self.res / 2)) + 1)
-        return all(self.is_free((a[0] + (b[0] - a[0]) * k / (n - 1), a[1] + (b[1] - a[1]) * k / (n - 1)))
-                   for k in range(n))
+        return all(
+            self.is_free((a[0] + (b[0] - a[0]) * k / (n - 1), a[1] + (b[1] - a[1]) * k / (n - 1)))
+            for k in range(n)
+        )
 
     def astar(self, a: XY, b: XY) -> list[XY]:
         """Shortest 8-connected path from ``a`` to ``b`` through free cells, shortened by line of sight."""

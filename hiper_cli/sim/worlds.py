@@ -101,8 +101,15 @@ class World:
         self._next_id += 1
         return self._next_id - 1
 
-    def add(self, name: str, class_name: str, layer: str, mesh: Mesh,
-            plane: tuple[float, float, float, float] | None = None, blocks: bool = False) -> SimObject:
+    def add(
+        self,
+        name: str,
+        class_name: str,
+        layer: str,
+        mesh: Mesh,
+        plane: tuple[float, float, float, float] | None = None,
+        blocks: bool = False,
+    ) -> SimObject:
         obj = SimObject(self.new_id(), name, class_name, layer, mesh, plane)
         self.objects.append(obj)
         if blocks:
@@ -131,13 +138,25 @@ class _Builder:
     def floor_and_ceiling(self) -> None:
         x0, y0, x1, y1 = self.w.bounds
         tiles = (self.color((0.72, 0.66, 0.55)), self.color((0.6, 0.52, 0.42)))
-        self.w.add("floor_0", "floor", "background",
-                   checker_floor((x0, y0, -0.05), (x1, y1, 0.0), 0.5, tiles), plane=(0.0, 0.0, 1.0, 0.0))
+        self.w.add(
+            "floor_0",
+            "floor",
+            "background",
+            checker_floor((x0, y0, -0.05), (x1, y1, 0.0), 0.5, tiles),
+            plane=(0.0, 0.0, 1.0, 0.0),
+        )
         h = self.w.ceiling_m
-        self.w.add("ceiling_0", "ceiling", "background", box((x0, y0, h), (x1, y1, h + 0.05), (0.93, 0.93, 0.9)),
-                   plane=(0.0, 0.0, -1.0, h))
+        self.w.add(
+            "ceiling_0",
+            "ceiling",
+            "background",
+            box((x0, y0, h), (x1, y1, h + 0.05), (0.93, 0.93, 0.9)),
+            plane=(0.0, 0.0, -1.0, h),
+        )
 
-    def wall(self, a: XY, b: XY, doors: Sequence[tuple[float, float]] = (), color: Color | None = None) -> None:
+    def wall(
+        self, a: XY, b: XY, doors: Sequence[tuple[float, float]] = (), color: Color | None = None
+    ) -> None:
         """An axis-aligned wall from ``a`` to ``b`` with door gaps (offset of centre from a, width)."""
         t = WALL_THICKNESS_M / 2.0
         h = self.w.ceiling_m
@@ -147,8 +166,12 @@ class _Builder:
         s0, s1 = (a[0], b[0]) if horizontal else (a[1], b[1])
         s0, s1 = min(s0, s1) - t, max(s0, s1) + t
         fixed = a[1] if horizontal else a[0]
-        gaps = sorted((min(a[0], b[0]) + off - wd / 2, min(a[0], b[0]) + off + wd / 2) if horizontal else
-                      (min(a[1], b[1]) + off - wd / 2, min(a[1], b[1]) + off + wd / 2) for off, wd in doors)
+        gaps = sorted(
+            (min(a[0], b[0]) + off - wd / 2, min(a[0], b[0]) + off + wd / 2)
+            if horizontal
+            else (min(a[1], b[1]) + off - wd / 2, min(a[1], b[1]) + off + wd / 2)
+            for off, wd in doors
+        )
         spans, cur = [], s0
         for g0, g1 in gaps:
             spans.append((cur, g0, 0.0))
@@ -169,9 +192,18 @@ class _Builder:
         plane = (0.0, 1.0, 0.0, -fixed) if horizontal else (1.0, 0.0, 0.0, -fixed)
         self.w.add(self.name("wall"), "wall", "background", Mesh.concat(parts), plane=plane)
 
-    def place(self, class_name: str, layer: str, mesh: Mesh, x: float, y: float, yaw_deg: float = 0.0,
-              z: float = 0.0, blocks: bool = True, plane: tuple[float, float, float, float] | None = None
-              ) -> SimObject:
+    def place(
+        self,
+        class_name: str,
+        layer: str,
+        mesh: Mesh,
+        x: float,
+        y: float,
+        yaw_deg: float = 0.0,
+        z: float = 0.0,
+        blocks: bool = True,
+        plane: tuple[float, float, float, float] | None = None,
+    ) -> SimObject:
         T = rot_z(math.radians(yaw_deg), (x, y, z))
         return self.w.add(self.name(class_name), class_name, layer, mesh.transformed(T), plane, blocks)
 
@@ -181,24 +213,37 @@ class _Builder:
 
     def picture(self, x: float, y: float, facing_deg: float) -> None:
         w, h = float(self.rng.uniform(0.5, 0.7)), float(self.rng.uniform(0.7, 0.9))
-        mesh = fu.framed_person(w, h, self.color((0.35, 0.22, 0.12)), self.color((0.8, 0.8, 0.7), 0.15),
-                                0.85 * h, rng=self.rng)
+        mesh = fu.framed_person(
+            w, h, self.color((0.35, 0.22, 0.12)), self.color((0.8, 0.8, 0.7), 0.15), 0.85 * h, rng=self.rng
+        )
         self.on_wall("picture", mesh, x, y, facing_deg, 1.5 - h / 2)
 
     def door(self, x: float, y: float, facing_deg: float) -> None:
         """A closed door panel on a wall face (background ``door``)."""
-        mesh = Mesh.concat([
-            box((0.0, -0.45, 0.0), (0.02, 0.45, 2.05), self.color((0.55, 0.38, 0.2))),
-            box((0.02, 0.3, 0.95), (0.07, 0.38, 1.0), (0.8, 0.8, 0.8)),
-        ])
+        mesh = Mesh.concat(
+            [
+                box((0.0, -0.45, 0.0), (0.02, 0.45, 2.05), self.color((0.55, 0.38, 0.2))),
+                box((0.02, 0.3, 0.95), (0.07, 0.38, 1.0), (0.8, 0.8, 0.8)),
+            ]
+        )
         yaw = math.radians(facing_deg)
         nx, ny = math.cos(yaw), math.sin(yaw)
         d = -(nx * (x + 0.02 * nx) + ny * (y + 0.02 * ny))
-        self.place("door", "background", mesh, x, y, facing_deg, 0.0, blocks=False,
-                   plane=(round(nx, 12), round(ny, 12), 0.0, d))
+        self.place(
+            "door",
+            "background",
+            mesh,
+            x,
+            y,
+            facing_deg,
+            0.0,
+            blocks=False,
+            plane=(round(nx, 12), round(ny, 12), 0.0, d),
+        )
 
-    def table(self, x: float, y: float, length: float, width: float, yaw_deg: float = 0.0,
-              height: float = 0.75) -> None:
+    def table(
+        self, x: float, y: float, length: float, width: float, yaw_deg: float = 0.0, height: float = 0.75
+    ) -> None:
         mesh = fu.table(length, width, height, self.color((0.55, 0.4, 0.25)), self.color((0.3, 0.2, 0.12)))
         self.place("table", "background", mesh, x, y, yaw_deg, plane=(0.0, 0.0, 1.0, -height))
 
@@ -218,25 +263,67 @@ class _Builder:
                 continue
             placed.append(p)
             if self.rng.random() < 0.55:
-                glass = self.color([(0.1, 0.45, 0.15), (0.45, 0.25, 0.1), (0.2, 0.35, 0.7)][int(self.rng.integers(3))])
-                self.place("bottle", "foreground", fu.bottle(float(self.rng.uniform(0.22, 0.32)), glass),
-                           p[0], p[1], 0.0, z, blocks=False)
+                glass = self.color(
+                    [(0.1, 0.45, 0.15), (0.45, 0.25, 0.1), (0.2, 0.35, 0.7)][int(self.rng.integers(3))]
+                )
+                self.place(
+                    "bottle",
+                    "foreground",
+                    fu.bottle(float(self.rng.uniform(0.22, 0.32)), glass),
+                    p[0],
+                    p[1],
+                    0.0,
+                    z,
+                    blocks=False,
+                )
             else:
-                mug = self.color([(0.9, 0.9, 0.88), (0.8, 0.2, 0.15), (0.2, 0.3, 0.6)][int(self.rng.integers(3))])
-                self.place("cup", "foreground", fu.cup(mug), p[0], p[1], float(self.rng.integers(4)) * 90.0, z,
-                           blocks=False)
+                mug = self.color(
+                    [(0.9, 0.9, 0.88), (0.8, 0.2, 0.15), (0.2, 0.3, 0.6)][int(self.rng.integers(3))]
+                )
+                self.place(
+                    "cup",
+                    "foreground",
+                    fu.cup(mug),
+                    p[0],
+                    p[1],
+                    float(self.rng.integers(4)) * 90.0,
+                    z,
+                    blocks=False,
+                )
 
-    def walker(self, name: str, speed_mps: float, start: XY, goals: Sequence[XY] = (), start_goal: int = 0,
-               pause_s: tuple[float, float] = (0.0, 0.0)) -> None:
-        shirts = [(0.75, 0.1, 0.1), (0.1, 0.3, 0.7), (0.9, 0.8, 0.2), (0.2, 0.6, 0.3), (0.95, 0.95, 0.95),
-                  (0.5, 0.2, 0.6)]
-        self.w.walkers.append(WalkerSpec(
-            id=self.w.new_id(), name=name, height_m=float(self.rng.uniform(1.6, 1.9)),
-            skin=SKIN_TONES[int(self.rng.integers(len(SKIN_TONES)))],
-            shirt=self.color(shirts[int(self.rng.integers(len(shirts)))], 0.05),
-            trousers=self.color((0.15, 0.18, 0.3), 0.1), hair=self.color((0.15, 0.1, 0.05), 0.05),
-            speed_mps=speed_mps, start_xy=start, goals=tuple(goals), start_goal=start_goal, pause_s=pause_s,
-        ))
+    def walker(
+        self,
+        name: str,
+        speed_mps: float,
+        start: XY,
+        goals: Sequence[XY] = (),
+        start_goal: int = 0,
+        pause_s: tuple[float, float] = (0.0, 0.0),
+    ) -> None:
+        shirts = [
+            (0.75, 0.1, 0.1),
+            (0.1, 0.3, 0.7),
+            (0.9, 0.8, 0.2),
+            (0.2, 0.6, 0.3),
+            (0.95, 0.95, 0.95),
+            (0.5, 0.2, 0.6),
+        ]
+        self.w.walkers.append(
+            WalkerSpec(
+                id=self.w.new_id(),
+                name=name,
+                height_m=float(self.rng.uniform(1.6, 1.9)),
+                skin=SKIN_TONES[int(self.rng.integers(len(SKIN_TONES)))],
+                shirt=self.color(shirts[int(self.rng.integers(len(shirts)))], 0.05),
+                trousers=self.color((0.15, 0.18, 0.3), 0.1),
+                hair=self.color((0.15, 0.1, 0.05), 0.05),
+                speed_mps=speed_mps,
+                start_xy=start,
+                goals=tuple(goals),
+                start_goal=start_goal,
+                pause_s=pause_s,
+            )
+        )
 
 
 def _house(seed: int) -> World:
@@ -260,9 +347,17 @@ def _house(seed: int) -> World:
         B.chair(tx + dx, ty + 0.72, -90.0)
     B.small_things(tx - 0.7, ty - 0.35, tx + 0.7, ty + 0.35, 0.75, int(rng.integers(3, 6)))
     sofa_y = D - 1.2
-    B.place("couch", "foreground", fu.couch(2.0, B.color((0.3, 0.35, 0.5)), B.color((0.4, 0.45, 0.6))),
-            0.5, sofa_y, 0.0)
-    B.place("shelf", "foreground", fu.shelf(0.9, 0.5, B.color((0.45, 0.3, 0.18)), B.rng), a - 0.2, sofa_y, 180.0)
+    B.place(
+        "couch",
+        "foreground",
+        fu.couch(2.0, B.color((0.3, 0.35, 0.5)), B.color((0.4, 0.45, 0.6))),
+        0.5,
+        sofa_y,
+        0.0,
+    )
+    B.place(
+        "shelf", "foreground", fu.shelf(0.9, 0.5, B.color((0.45, 0.3, 0.18)), B.rng), a - 0.2, sofa_y, 180.0
+    )
     B.on_wall("tv", fu.tv(1.0, B.rng), a - 0.4, sofa_y, 180.0, 0.55)
     B.place("shelf", "foreground", fu.shelf(1.2, 1.8, B.color((0.45, 0.3, 0.18)), B.rng), 2.4, D - 0.2, -90.0)
     B.place("potted plant", "foreground", fu.plant(B.color((0.7, 0.35, 0.2))), 0.35, 0.35)
@@ -276,15 +371,38 @@ def _house(seed: int) -> World:
     B.place("shelf", "foreground", fu.shelf(1.0, 1.4, B.color((0.5, 0.35, 0.2)), B.rng), a + 1.4, 0.2, 90.0)
     B.place("potted plant", "foreground", fu.plant(B.color((0.3, 0.3, 0.7))), W - 0.35, b - 0.35)
     # Bedroom (x > a, y > b).
-    B.place("bed", "foreground", fu.bed(2.0, 1.4, B.color((0.4, 0.28, 0.16)), B.color((0.5, 0.6, 0.8)),
-                                         (0.95, 0.95, 0.95)), W - 1.08, (b + D) / 2, 180.0)
+    B.place(
+        "bed",
+        "foreground",
+        fu.bed(2.0, 1.4, B.color((0.4, 0.28, 0.16)), B.color((0.5, 0.6, 0.8)), (0.95, 0.95, 0.95)),
+        W - 1.08,
+        (b + D) / 2,
+        180.0,
+    )
     B.picture(W - WALL_THICKNESS_M / 2, (b + D) / 2 + 1.1, 180.0)
-    B.place("shelf", "foreground", fu.shelf(0.8, 1.2, B.color((0.6, 0.5, 0.4)), B.rng), a + 0.8, D - 0.2, -90.0)
+    B.place(
+        "shelf", "foreground", fu.shelf(0.8, 1.2, B.color((0.6, 0.5, 0.4)), B.rng), a + 0.8, D - 0.2, -90.0
+    )
     B.door(W - 0.8, D - WALL_THICKNESS_M / 2, -90.0)
-    w.waypoints = [(3.3, 3.6), (3.4, 0.9), (a + 1.0, 1.7), (W - 1.8, 2.6), (a + 0.8, 2.4), (3.2, 1.2),
-                   (3.0, 4.6), (a + 1.0, b + 0.8), (W - 2.6, D - 0.8), (a + 0.9, b + 1.2), (2.6, 5.0),
-                   (1.2, 3.6)]
-    w.walkable = [(0.6, 0.6, a - 0.6, D - 0.6), (a + 0.6, 0.6, W - 0.6, b - 0.6), (a + 0.6, b + 0.6, W - 0.6, D - 0.6)]
+    w.waypoints = [
+        (3.3, 3.6),
+        (3.4, 0.9),
+        (a + 1.0, 1.7),
+        (W - 1.8, 2.6),
+        (a + 0.8, 2.4),
+        (3.2, 1.2),
+        (3.0, 4.6),
+        (a + 1.0, b + 0.8),
+        (W - 2.6, D - 0.8),
+        (a + 0.9, b + 1.2),
+        (2.6, 5.0),
+        (1.2, 3.6),
+    ]
+    w.walkable = [
+        (0.6, 0.6, a - 0.6, D - 0.6),
+        (a + 0.6, 0.6, W - 0.6, b - 0.6),
+        (a + 0.6, b + 0.6, W - 0.6, D - 0.6),
+    ]
     B.walker("person_0", 0.9, (3.5, 3.2), pause_s=(1.0, 4.0))
     return w
 
@@ -310,8 +428,14 @@ def _hospital(seed: int) -> World:
         B.wall((end + k * room_w, cw), (end + k * room_w, cw + band))
     for k in range(4):
         x0 = end + k * room_w
-        B.place("bed", "foreground", fu.bed(2.0, 1.0, (0.8, 0.8, 0.82), B.color((0.6, 0.75, 0.85)),
-                                             (0.95, 0.95, 0.95)), x0 + room_w - 1.05, cw + band / 2, 180.0)
+        B.place(
+            "bed",
+            "foreground",
+            fu.bed(2.0, 1.0, (0.8, 0.8, 0.82), B.color((0.6, 0.75, 0.85)), (0.95, 0.95, 0.95)),
+            x0 + room_w - 1.05,
+            cw + band / 2,
+            180.0,
+        )
         B.chair(x0 + room_w - 2.6, cw + band / 2 + 1.2, -90.0)
         B.table(x0 + 0.5, cw + band - 0.5, 0.6, 0.6, 0.0, 0.8)
         B.small_things(x0 + 0.25, cw + band - 0.75, x0 + 0.75, cw + band - 0.25, 0.8, 2)
@@ -322,8 +446,17 @@ def _hospital(seed: int) -> World:
     B.place("potted plant", "foreground", fu.plant(B.color((0.6, 0.6, 0.6))), 0.4, 0.4)
     B.place("potted plant", "foreground", fu.plant(B.color((0.6, 0.6, 0.6))), L - 0.4, H - 0.4)
     cart_y = 0.4
-    w.carts.append(CartSpec(w.new_id(), "cart_0", fu.cart(B.rng), ((5.0, cart_y), (11.0, cart_y), (18.0, cart_y)),
-                            0.0, 0.5, (15.0, 30.0)))
+    w.carts.append(
+        CartSpec(
+            w.new_id(),
+            "cart_0",
+            fu.cart(B.rng),
+            ((5.0, cart_y), (11.0, cart_y), (18.0, cart_y)),
+            0.0,
+            0.5,
+            (15.0, 30.0),
+        )
+    )
     # Five people walking between predefined positions of corridor A; corridor B stays empty.
     lanes = [0.9, 1.3, 1.7, 1.1, 1.5]
     stops_x = [3.2, 8.0, 12.5, 16.5, L - 3.2]
@@ -333,9 +466,18 @@ def _hospital(seed: int) -> World:
         start = (float(stops_x[0] + (stops_x[4] - stops_x[0]) * (i + 0.5) / 5.0), y)
         B.walker(f"person_{i}", 0.6, start, goals, start_goal=(i % 2) * 2)
     mid = cw + band / 2
-    w.waypoints = [(1.2, cw / 2), (end + 1.0, cw / 2), (end + 1.6, mid - 0.6), (end + 1.0, cw / 2),
-                   (L / 2, cw / 2), (L / 2 + 1.0, mid - 0.4), (L / 2 + 0.4, cw / 2), (L - 1.2, cw / 2),
-                   (L - 1.2, H - cw / 2), (1.2, H - cw / 2)]
+    w.waypoints = [
+        (1.2, cw / 2),
+        (end + 1.0, cw / 2),
+        (end + 1.6, mid - 0.6),
+        (end + 1.0, cw / 2),
+        (L / 2, cw / 2),
+        (L / 2 + 1.0, mid - 0.4),
+        (L / 2 + 0.4, cw / 2),
+        (L - 1.2, cw / 2),
+        (L - 1.2, H - cw / 2),
+        (1.2, H - cw / 2),
+    ]
     w.walkable = [(0.6, 0.6, L - 0.6, cw - 0.6)]
     return w
 
@@ -375,8 +517,14 @@ def _office(seed: int) -> World:
     B.place("stairs", "background", fu.stairs(9, 1.3, B.color((0.7, 0.7, 0.72))), 1.0, D - 0.75, 0.0)
     B.place("potted plant", "foreground", fu.plant(B.color((0.5, 0.3, 0.2))), 6.5, D - 0.4)
     B.picture(WALL_THICKNESS_M / 2, c1 + 1.5, 0.0)
-    B.place("couch", "foreground", fu.couch(1.8, B.color((0.55, 0.15, 0.15)), B.color((0.65, 0.2, 0.2))),
-            6.45, c1 + 1.6, 180.0)
+    B.place(
+        "couch",
+        "foreground",
+        fu.couch(1.8, B.color((0.55, 0.15, 0.15)), B.color((0.65, 0.2, 0.2))),
+        6.45,
+        c1 + 1.6,
+        180.0,
+    )
     # Meeting room (x > 7, y > c1): table, chairs, a TV.
     my = (c1 + D) / 2
     B.table(11.5, my, 2.4, 1.1)
@@ -387,10 +535,28 @@ def _office(seed: int) -> World:
     B.on_wall("tv", fu.tv(1.2, B.rng), W - WALL_THICKNESS_M / 2, my, 180.0, 0.9)
     B.door(W - 1.0, c1 - WALL_THICKNESS_M / 2, -90.0)
     cy = (c0 + c1) / 2
-    w.waypoints = [(1.2, cy), (3.5, c1 + 1.0), (2.0, cy), (2.0, c0 - 0.5), (5.5, 1.9), (2.0, c0 - 0.6),
-                   (11.0, cy), (11.0, c0 - 0.6), (13.5, 2.2), (11.0, c0 - 0.7), (10.0, cy), (10.0, c1 + 0.6),
-                   (14.5, my), (10.0, c1 + 0.5), (W - 1.0, cy)]
-    w.walkable = [(0.6, c0 + 0.5, W - 0.6, c1 - 0.5), (0.6, c1 + 0.5, 5.0, D - 1.6), (0.8, 1.8, 7.2, c0 - 1.9)]
+    w.waypoints = [
+        (1.2, cy),
+        (3.5, c1 + 1.0),
+        (2.0, cy),
+        (2.0, c0 - 0.5),
+        (5.5, 1.9),
+        (2.0, c0 - 0.6),
+        (11.0, cy),
+        (11.0, c0 - 0.6),
+        (13.5, 2.2),
+        (11.0, c0 - 0.7),
+        (10.0, cy),
+        (10.0, c1 + 0.6),
+        (14.5, my),
+        (10.0, c1 + 0.5),
+        (W - 1.0, cy),
+    ]
+    w.walkable = [
+        (0.6, c0 + 0.5, W - 0.6, c1 - 0.5),
+        (0.6, c1 + 0.5, 5.0, D - 1.6),
+        (0.8, 1.8, 7.2, c0 - 1.9),
+    ]
     B.walker("person_0", 1.0, (W - 2.0, cy), pause_s=(1.0, 5.0))
     B.walker("person_1", 0.8, (4.0, c1 + 1.0), pause_s=(2.0, 6.0))
     return w
