@@ -52,12 +52,11 @@ class PlaneFrame:
         self.normal = n
         self.d = float(plane[3]) / float(np.linalg.norm(plane[:3]))
         self.origin = -self.d * n
-        if abs(n[2]) > 0.9:
-            u = np.array([1.0, 0.0, 0.0]) - n[0] * n
-        else:
-            u = np.cross(np.array([0.0, 0.0, 1.0]), n)
+        # horizontal planes: u along x; others: u = z × n (horizontal)
+        u = np.array([1.0, 0.0, 0.0]) - n[0] * n if abs(n[2]) > 0.9 else np.array([-n[1], n[0], 0.0])
         self.u = u / np.linalg.norm(u)
-        self.v = np.cross(n, self.u)
+        a, b = n, self.u
+        self.v = np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
     @property
     def R(self) -> FloatArray:

@@ -211,40 +211,38 @@ def _refine(grid: SampleGrid, planes: FloatArray, region_cells: list[NDArray[np.
     import cv2
 
     h, w = grid.shape
-    pts = grid.points_cam
-    z = pts[..., 2]
-    threshold = cfg.inlier_m * np.maximum(z, 1.0)
-    dist = np.abs(np.einsum("hwi,ki->khw", pts, planes[:, :3]) + planes[:, 3][:, None, None])
+    pts = grid.points_cam.reshape(-1, 3)
+    valid = grid.valid.reshape(-1)
+    threshold = cfg.inlier_m * np.maximum(pts[:, 2], 1.0)
+    # where each plane may take samples: its cells and their neighbours
+    near = np.zeros((len(planes), h * w), bool)
     kernel = np.ones((3, 3), np.uint8)
     for k, cells in enumerate(region_cells):
-        near = cv2.dilate(cells.astype(np.uint8), kernel).astype(bool)
-        near_px = np.zeros((h, w), bool)
-        up = np.repeat(np.repeat(near, cell, axis=0), cell, axis=1)
-        near_px[: up.shape[0], : up.shape[1]] = up[:h, :w]
-        dist[k][~near_px] = np.inf
-    dist[:, ~grid.valid] = np.inf
-    near_any = np.isfinite(dist)
+        grown = cv2.dilate(cells.astype(np.uint8), kernel)
+        up = np.zeros((h, w), np.uint8)
+        big = np.repeat(np.repeat(grown, cell, axis=0), cell, axis=1)
+        up[: big.shape[0], : big.shape[1]] = big[:h, :w]
+        near[k] = up.reshape(-1).astype(bool) & valid
     rms = np.full(len(planes), np.inf)
     out: list[PlaneSegment] = []
     for _ in range(max(cfg.refine_passes, 1)):
+        dist = np.abs(pts @ planes[:, :3].T + planes[:, 3]).T  # (K, h*w)
         # after the first pass each plane accepts samples within 2.5 of its own spreads
-        limit = np.minimum(threshold[None], np.maximum(2.5 * rms, 0.01)[:, None, None])
-        ok_dist = np.where(dist < limit, dist, np.inf)
-        best = np.argmin(ok_dist, axis=0)
-        label = np.where(np.isfinite(ok_dist.min(axis=0)), best, -1)
+        limit = np.minimum(threshold[None], np.maximum(2.5 * rms, 0.01)[:, None])
+        dist = np.where(near & (dist < limit), dist, np.inf)
+        best = np.argmin(dist, axis=0)
+        label = np.where(np.isfinite(dist.min(axis=0)), best, -1)
         out = []
         for k in range(len(planes)):
-            mask = label == k
-            count = int(mask.sum())
+            sel = np.flatnonzero(label == k)
+            count = len(sel)
             if count < 3:
                 continue
-            p = pts[mask]
+            p = pts[sel]
             normal, d, evals = _fit_from_moments(np.array(float(count)), p.sum(axis=0), p.T @ p)
             planes[k] = np.append(normal, d)
             rms[k] = float(np.sqrt(evals[0]))
-            out.append(PlaneSegment(planes[k].copy(), mask, rms[k], count))
-        fresh = np.abs(np.einsum("hwi,ki->khw", pts, planes[:, :3]) + planes[:, 3][:, None, None])
-        dist = np.where(near_any, fresh, np.inf)
+            out.append(PlaneSegment(planes[k].copy(), (label == k).reshape(h, w), rms[k], count))
     return out
 
 
