@@ -56,11 +56,11 @@ class BackgroundConfig:
     # classification in the map frame (z up)
     horizontal_deg: float = 15.0  # floor, ceiling, table normals within this of vertical
     vertical_deg: float = 10.0  # wall normals within this of horizontal
-    floor_max_height_m: float = 0.2
+    floor_max_height_m: float = 0.1  # a cart's low shelf (0.15 m) is not floor
     ceiling_min_height_m: float = 1.9
-    table_min_height_m: float = 0.4
+    table_min_height_m: float = 0.6  # above seats, beds and low shelves (0.45-0.56 m)
     table_max_height_m: float = 1.1
-    table_min_area_m2: float = 0.12
+    table_min_area_m2: float = 0.25  # larger than a chair seat (0.2 m²)
     table_max_extent_m: float = 3.5
     wall_min_height_m: float = 1.2  # a standing person is ~1.8 m tall but narrow and not flat
     wall_min_width_m: float = 1.0
