@@ -36,7 +36,7 @@ from hiper_cli.graph.ontology import (
     session_quads,
 )
 from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph, open_graph
-from hiper_cli.model import LAYERS, Analysis, Environment, Instance, Observation
+from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, Instance, Observation
 from hiper_cli.perceive.stage import FrameResult, World
 
 __all__ = ["DEFAULT_KB", "CheckReport", "KbConfig", "KnowledgeBase", "SyncReport", "open_kb"]
@@ -92,6 +92,17 @@ class CheckReport:
 
 def _aabb(lo: Any, hi: Any) -> tuple[list[float], list[float]]:
     return [float(v) for v in lo], [float(v) for v in hi]
+
+
+def _map_aabb(box: Box3D, T_map_box: Any) -> tuple[list[float], list[float]]:
+    """(min, max) of the axis-aligned map-frame box around ``box`` given in a frame mapped into
+    the map by ``T_map_box`` (None = the box is in the map frame already)."""
+    R, c = box.R, box.center_m
+    if T_map_box is not None:
+        R = T_map_box[:3, :3] @ R
+        c = T_map_box[:3, :3] @ c + T_map_box[:3, 3]
+    half = np.abs(R) @ (box.extent_m / 2.0)
+    return (c - half).tolist(), (c + half).tolist()
 
 
 class KnowledgeBase:
@@ -195,14 +206,10 @@ class KnowledgeBase:
         return seq
 
     def _put_result(self, result: FrameResult, session_id: int | None, env_uuid: str, T: Any) -> None:
-        for obs in result.observations:
-            box_map = None
-            if T is not None:
-                box_map = _aabb(*obs.box.transformed(T).aabb())
-            self.docs.put(obs.to_dict(), session_id=session_id, env_uuid=env_uuid, box_map=box_map)
-        for inst in result.instances:
-            self.docs.put(inst.to_dict(), session_id=session_id, env_uuid=env_uuid,
-                          box_map=_aabb(*inst.box.aabb()))
+        obs_items = [(o.to_dict(), None if T is None else _map_aabb(o.box, T)) for o in result.observations]
+        self.docs.put_many(obs_items, session_id=session_id, env_uuid=env_uuid)
+        inst_items = [(i.to_dict(), _map_aabb(i.box, None)) for i in result.instances]
+        self.docs.put_many(inst_items, session_id=session_id, env_uuid=env_uuid)
         for uuid in result.deleted_instances:
             self.docs.delete(uuid)
 
@@ -384,11 +391,14 @@ def open_kb(
     remote = text.startswith(("http://", "https://"))
     root = Path(docs_dir) if docs_dir is not None else (Path(DEFAULT_KB) if remote else Path(text))
     if root.exists() and not root.is_dir():
-        raise KnowledgeBaseError(f"{root}: is a file, not a knowledge-base directory; pass a directory to --kb")
+        raise KnowledgeBaseError(
+            f"{root}: is a file, not a knowledge-base directory; pass a directory to --kb"
+        )
     docs_path = root / DOCUMENTS_FILE
     if read_only and not docs_path.exists():
         raise KnowledgeBaseError(
-            f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); run 'hiper perceive LOG --kb {root}'"
+            f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); "
+            f"run 'hiper perceive LOG --kb {root}'"
         )
     root.mkdir(parents=True, exist_ok=True)
     docs = DocumentStore(docs_path, read_only=read_only)

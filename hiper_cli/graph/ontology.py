@@ -9,6 +9,7 @@ instance -> observation provenance).
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from collections.abc import Sequence
@@ -95,7 +96,7 @@ def speed_mps(doc: dict[str, Any]) -> float | None:
     if len(rows) < 2:
         return None
     dist = 0.0
-    for a, b in zip(rows[:-1], rows[1:], strict=True):
+    for a, b in itertools.pairwise(rows):
         dist += math.dist(a[1:4], b[1:4])
     dt = float(rows[-1][0]) - float(rows[0][0])
     return dist / dt if dt > 0 else None
@@ -120,12 +121,14 @@ def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[
     elif kind == "instance":
         box = doc["box"]
         t += [(RDF_TYPE, h("Instance")), (h("uuid"), ox.Literal(doc["uuid"])), (h("layer"), h(layer)),
-              (h("className"), ox.Literal(doc["class"])), (h("frame"), ox.Literal(doc.get("frame_id", "map"))),
+              (h("className"), ox.Literal(doc["class"])),
+              (h("frame"), ox.Literal(doc.get("frame_id", "map"))),
               (h("firstSeenS"), _dbl(doc["first_seen_s"])), (h("lastSeenS"), _dbl(doc["last_seen_s"])),
               (h("state"), ox.Literal(doc.get("state", "static"))),
               (h("confidence"), _dbl(doc.get("confidence", 1.0))),
               (h("boxCenterM"), _vec(box["center_m"])), (h("boxExtentM"), _vec(box["extent_m"])),
-              (h("observationCount"), _int(len(doc.get("observation_uuids", []))))]
+              (h("observationCount"),
+               _int(doc.get("observation_count", len(doc.get("observation_uuids", [])))))]
         speed = speed_mps(doc)
         if speed is not None:
             t.append((h("speedMps"), _dbl(speed)))

@@ -96,7 +96,7 @@ class LocalGraph:
 
     def synced_seq(self, kb_id: str) -> int:
         for q in self._store.quads_for_pattern(_kb_node(kb_id), _SYNCED, None, meta_graph(kb_id)):
-            return int(q.object.value)
+            return int(str(getattr(q.object, "value", 0)))
         return 0
 
     def set_synced_seq(self, kb_id: str, seq: int) -> None:
@@ -185,7 +185,9 @@ class SparqlGraph:
                 "GRAPH ?g { ?s ?p ?o } }"
             )
         if quads:
-            body = "\n".join(f"GRAPH {q.graph_name} {{ {q.subject} {q.predicate} {q.object} }}" for q in quads)
+            body = "\n".join(
+                f"GRAPH {q.graph_name} {{ {q.subject} {q.predicate} {q.object} }}" for q in quads
+            )
             ops.append("INSERT DATA {\n" + body + "\n}")
         if ops:
             self._update(" ;\n".join(ops))
