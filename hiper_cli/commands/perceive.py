@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import typer
 
 from hiper_cli.commands._render import JSON_OPTION, console, print_json
 from hiper_cli.errors import ConfigError
 
-__all__ = ["parse_stage_options", "register"]
+__all__ = ["KB_DOCS_HELP", "KB_HELP", "parse_stage_options", "register"]
+
+KB_HELP = "Knowledge base: a directory, or the http:// URL of a SPARQL endpoint holding the scene graph."
+KB_DOCS_HELP = "Documents directory when --kb is an http:// endpoint (default ./scene.hiper)."
 
 
 def parse_stage_options(items: list[str]) -> dict[str, dict[str, Any]]:
@@ -34,25 +37,34 @@ def parse_stage_options(items: list[str]) -> dict[str, dict[str, Any]]:
 
 
 def perceive_command(
-    log: Path = typer.Argument(..., help="Sensor log: TUM folder, .bag, rosbag2 folder or .mcap."),
-    kb: str = typer.Option("scene.hiper", "--kb", help="Knowledge-base directory or SPARQL endpoint URL."),
-    kb_docs: Path | None = typer.Option(
-        None, "--kb-docs", help="Documents directory when --kb is an http:// endpoint (default ./scene.hiper)."
-    ),
-    stages: str | None = typer.Option(
-        None, "--stages", help="Comma-separated stages in order (default: all available, background first)."
-    ),
-    detector: str | None = typer.Option(None, "--detector", help="Foreground detector (onnx, log, truth)."),
-    no_background_filter: bool = typer.Option(
-        False, "--no-background-filter", help="Foreground: do not drop points of background instances."
-    ),
-    mapping_hz: float | None = typer.Option(None, "--mapping-hz", help="Background keyframe rate in Hz."),
-    option: list[str] = typer.Option(  # noqa: B008
-        [], "-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable)."
-    ),
-    resume: bool = typer.Option(False, "--resume", help="Continue the unfinished session of this log."),
-    env: str | None = typer.Option(None, "--env", help="Environment name (default: the log folder's name)."),
-    poses: Path | None = typer.Option(None, "--poses", help="TUM trajectory replacing the log's poses."),
+    log: Annotated[Path, typer.Argument(help="Sensor log: TUM folder, .bag, rosbag2 folder or .mcap.")],
+    kb: Annotated[str, typer.Option("--kb", help=KB_HELP)] = "scene.hiper",
+    kb_docs: Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)] = None,
+    stages: Annotated[
+        str | None,
+        typer.Option("--stages", help="Comma-separated stages (default: all available, background first)."),
+    ] = None,
+    detector: Annotated[
+        str | None, typer.Option("--detector", help="Foreground detector (onnx, log, truth).")
+    ] = None,
+    no_background_filter: Annotated[
+        bool, typer.Option("--no-background-filter", help="Foreground: keep points of background instances.")
+    ] = False,
+    mapping_hz: Annotated[
+        float | None, typer.Option("--mapping-hz", help="Background keyframe rate in Hz.")
+    ] = None,
+    option: Annotated[
+        list[str] | None, typer.Option("-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable).")
+    ] = None,
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Continue the unfinished session of this log.")
+    ] = False,
+    env: Annotated[
+        str | None, typer.Option("--env", help="Environment name (default: the log folder's name).")
+    ] = None,
+    poses: Annotated[
+        Path | None, typer.Option("--poses", help="TUM trajectory replacing the log's poses.")
+    ] = None,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
@@ -65,7 +77,7 @@ def perceive_command(
     from hiper_cli.perceive.logs import open_log
     from hiper_cli.pipeline import build_stages, perceive
 
-    options = parse_stage_options(option)
+    options = parse_stage_options(option or [])
     if detector is not None:
         options.setdefault("foreground", {})["detector"] = detector
     if no_background_filter:

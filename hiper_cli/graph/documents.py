@@ -312,7 +312,8 @@ class DocumentStore:
             doc.pop("observation_count", None)
             doc["observation_uuids"] = [
                 str(o) for (o,) in self._db.execute(
-                    "SELECT observation_uuid FROM links WHERE instance_uuid = ? ORDER BY seq, observation_uuid",
+                    "SELECT observation_uuid FROM links WHERE instance_uuid = ? "
+                    "ORDER BY seq, observation_uuid",
                     (doc["uuid"],),
                 )
             ]
@@ -430,8 +431,9 @@ class DocumentStore:
     ) -> list[dict[str, Any]]:
         """Documents whose map-frame box intersects the axis-aligned box [lo, hi]."""
         sql = (
-            "SELECT d.body FROM docs_box b CROSS JOIN docs d ON d.id = b.id WHERE b.max_x >= ? AND b.min_x <= ? "
-            "AND b.max_y >= ? AND b.min_y <= ? AND b.max_z >= ? AND b.min_z <= ?"
+            "SELECT d.body FROM docs_box b CROSS JOIN docs d ON d.id = b.id "
+            "WHERE b.max_x >= ? AND b.min_x <= ? AND b.max_y >= ? AND b.min_y <= ? "
+            "AND b.max_z >= ? AND b.min_z <= ?"
         )
         params: list[Any] = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
         if type is not None:
