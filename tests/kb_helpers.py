@@ -47,6 +47,11 @@ class FrameList:
     def __len__(self) -> int:
         return len(self.frames)
 
+    def info(self) -> Any:
+        from types import SimpleNamespace
+
+        return SimpleNamespace(path=self.path)
+
 
 class ProbeStage:
     """Deterministic stage: one background 'floor' instance fed by one observation per frame,
