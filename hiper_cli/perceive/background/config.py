@@ -94,4 +94,19 @@ class BackgroundConfig:
             raise ConfigError(
                 f"unknown background option(s) {unknown}; expected one of {', '.join(names)}"
             )
-        return cls(**options)
+        typed: dict[str, Any] = {}
+        for f in fields(cls):
+            if f.name in options:
+                typed[f.name] = _typed(f.name, options[f.name], type(getattr(cls, f.name)))
+        return cls(**typed)
+
+
+def _typed(name: str, value: Any, kind: type) -> Any:
+    """``value`` as the field's type (numbers from ints or floats, text as text)."""
+    if kind in (int, float):
+        ok = isinstance(value, int | float) and not isinstance(value, bool)
+    else:
+        ok = isinstance(value, kind)
+    if not ok or (kind is int and float(value) != int(value)):
+        raise ConfigError(f"background option {name}={value!r}: expected {kind.__name__}")
+    return kind(value)

@@ -8,7 +8,7 @@ instances that now coincide are merged (Algorithm 2's duplicate rule).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,14 +35,24 @@ class ReanchorResult:
 def reanchor(
     instances: Iterable[Instance],
     observations: Iterable[Observation],
-    poses: Mapping[int, NDArray[np.float64]],
+    poses: Mapping[int, NDArray[np.float64]] | Callable[[Observation], NDArray[np.float64] | None],
     config: BackgroundConfig | None = None,
 ) -> ReanchorResult:
-    """Recompute every background instance from its observations with ``poses`` (pose_id → T_map_cam).
+    """Recompute every background instance from its observations with new poses.
 
-    An observation whose pose id is missing from ``poses`` raises ``DataError``; an
-    instance none of whose observations are given keeps its geometry (listed in ``unchanged``).
+    ``poses``: pose_id → T_map_cam, or a function giving an observation's T_map_cam (e.g. by
+    its stamp in an optimised trajectory; None when it has none). An observation without a
+    pose raises ``DataError``; an instance none of whose observations are given keeps its
+    geometry (listed in ``unchanged``).
     """
+    if callable(poses):
+        pose_of = poses
+    else:
+        table = poses
+
+        def pose_of(o: Observation) -> NDArray[np.float64] | None:
+            return table.get(o.pose_id)
+
     cfg = config or BackgroundConfig()
     by_uuid = {o.uuid: o for o in observations if o.layer == "background"}
     result = ReanchorResult()
@@ -55,13 +65,15 @@ def reanchor(
             result.unchanged.append(inst.uuid)
             rebuilt.append(inst)
             continue
-        missing = sorted({o.pose_id for o in obs if o.pose_id not in poses})
+        found = [(o, pose_of(o)) for o in obs]
+        missing = sorted({(o.pose_id, round(o.stamp_s, 6)) for o, T in found if T is None})
         if missing:
+            more = " ..." if len(missing) > 5 else ""
             raise DataError(
-                f"reanchor: no pose for pose id(s) {missing[:5]}{' ...' if len(missing) > 5 else ''}; "
+                f"reanchor: no pose for (pose id, stamp) {missing[:5]}{more}; "
                 "the trajectory must cover every pose the observations were anchored to"
             )
-        moved = [to_map(o, np.asarray(poses[o.pose_id], dtype=np.float64)) for o in obs]
+        moved = [to_map(o, np.asarray(T, dtype=np.float64)) for o, T in found]
         new = fold(moved, cfg, base=inst)
         new.observation_uuids = list(inst.observation_uuids)
         new.confidence = inst.confidence
