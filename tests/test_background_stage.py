@@ -107,7 +107,10 @@ def test_keyframes_at_the_mapping_rate():
     world = run_stages([], [])[0]
     results = [stage.process(make_frame(boxes, T, pose_id=i, stamp_s=0.1 * i), world) for i in range(7)]
     assert [r.skipped is None for r in results] == [True, False, False, False, False, True, False]
-    assert "background_s" in results[0].timings_s
+    assert set(results[0].timings_s) == {"background_s", "background_cpu_s"}
+    assert results[0].observations and all(
+        o.data["keyframe_s"] == results[0].timings_s["background_s"] for o in results[0].observations
+    )
 
 
 def test_ransac_method_finds_the_same_planes():
