@@ -38,7 +38,9 @@ class BackgroundConfig:
     cell_px: int = 5
     cell_noise_m: float = 0.0025  # plane RMS allowed in a cell at 1 m (grows with depth squared)
     cell_min_valid: float = 0.9  # fraction of valid samples a cell needs
-    jump_ratio: float = 0.05  # a depth step above this fraction of the depth splits surfaces
+    # a kink in inverse depth above this (1/m) separates surfaces; on a plane 1/z is linear in
+    # the image, so its second difference is ~0 even at grazing angles
+    jump_inv_m: float = 0.02
     grow_angle_deg: float = 12.0
     grow_offset_m: float = 0.04
     inlier_m: float = 0.03  # point-to-plane distance of an inlier at 1 m (grows with depth)

@@ -92,17 +92,16 @@ def _moments(points: FloatArray, weights: FloatArray) -> tuple[FloatArray, Float
     return n, s1, s2
 
 
-def _jumps(grid: SampleGrid, ratio: float) -> NDArray[np.bool_]:
-    """Samples next to a depth discontinuity (a step above ``ratio`` of the depth)."""
-    z = np.where(grid.valid, grid.points_cam[..., 2], np.nan)
-    out = np.zeros(z.shape, bool)
+def _jumps(grid: SampleGrid, limit_inv_m: float) -> NDArray[np.bool_]:
+    """Samples at a depth discontinuity: where the second difference of inverse depth along a
+    row or a column exceeds ``limit_inv_m`` (on any plane 1/z is linear in the image)."""
+    inv = np.where(grid.valid, 1.0 / np.where(grid.valid, grid.points_cam[..., 2], 1.0), np.nan)
+    out = np.zeros(inv.shape, bool)
     with np.errstate(invalid="ignore"):
-        dh = np.abs(np.diff(z, axis=1)) > ratio * np.fmin(z[:, 1:], z[:, :-1])
-        dv = np.abs(np.diff(z, axis=0)) > ratio * np.fmin(z[1:], z[:-1])
-    out[:, 1:] |= dh
-    out[:, :-1] |= dh
-    out[1:] |= dv
-    out[:-1] |= dv
+        dh = np.abs(inv[:, 2:] - 2.0 * inv[:, 1:-1] + inv[:, :-2]) > limit_inv_m
+        dv = np.abs(inv[2:] - 2.0 * inv[1:-1] + inv[:-2]) > limit_inv_m
+    out[:, 1:-1] |= dh
+    out[1:-1] |= dv
     return out
 
 
@@ -124,7 +123,7 @@ def _extract_fast(grid: SampleGrid, cfg: BackgroundConfig) -> list[PlaneSegment]
     z_mean = s1[..., 2] / np.maximum(n, 1.0)
     noise = cfg.cell_noise_m * np.maximum(z_mean, 1.0) ** 2
     planar = (n >= cfg.cell_min_valid * c * c) & (np.sqrt(evals[..., 0]) < noise)
-    planar &= ~_jumps(grid, cfg.jump_ratio)[: gh * c, : gw * c].reshape(gh, c, gw, c).any(axis=(1, 3))
+    planar &= ~_jumps(grid, cfg.jump_inv_m)[: gh * c, : gw * c].reshape(gh, c, gw, c).any(axis=(1, 3))
     mean = s1 / np.maximum(n, 1.0)[..., None]
 
     cos_grow = np.cos(np.radians(cfg.grow_angle_deg))
