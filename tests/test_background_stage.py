@@ -137,3 +137,12 @@ def test_unknown_option_names_the_choices():
     with pytest.raises(ConfigError, match="expected one of fast, ransac"):
         make_stage("background", method="magic")
     assert make_stage("background", log_path="x", stride_px=8).config.stride_px == 8
+
+
+@pytest.mark.parametrize("method", ["fast", "ransac"])
+def test_frame_without_depth_gives_nothing(method):
+    frame = make_frame(box_room(), look_at(CENTER, (6.0, 2.5, 1.2)))
+    empty = type(frame)(**{**frame.__dict__, "depth_m": np.zeros_like(frame.depth_m)})
+    nan = type(frame)(**{**frame.__dict__, "depth_m": np.full_like(frame.depth_m, np.nan)})
+    assert observe(empty, BackgroundConfig(method=method)) == []
+    assert observe(nan, BackgroundConfig(method=method)) == []
