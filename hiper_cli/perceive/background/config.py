@@ -44,7 +44,7 @@ class BackgroundConfig:
     grow_angle_deg: float = 12.0
     grow_offset_m: float = 0.04
     inlier_m: float = 0.03  # point-to-plane distance of an inlier at 1 m (grows with depth)
-    min_plane_cells: int = 6
+    min_plane_cells: int = 4
     refine_passes: int = 2  # assign samples to the closest plane and refit, this many times
     # ransac extraction (the paper's method)
     ransac_max_planes: int = 8
@@ -56,13 +56,13 @@ class BackgroundConfig:
     pixel_sample: int = 64  # inlier pixels kept per observation for evaluation
     contour_epsilon_px: float = 1.0
     # classification in the map frame (z up)
-    horizontal_deg: float = 15.0  # floor, ceiling, table normals within this of vertical
+    horizontal_deg: float = 10.0  # floor, ceiling, table normals within this of vertical
     vertical_deg: float = 10.0  # wall normals within this of horizontal
     floor_max_height_m: float = 0.1  # a cart's low shelf (0.15 m) is not floor
     ceiling_min_height_m: float = 1.9
     table_min_height_m: float = 0.6  # above seats, beds and low shelves (0.45-0.56 m)
     table_max_height_m: float = 1.1
-    table_min_area_m2: float = 0.25  # larger than a chair seat (0.2 m²)
+    table_min_area_m2: float = 0.15
     table_max_extent_m: float = 3.5
     wall_min_height_m: float = 1.2  # a standing person is ~1.8 m tall but narrow and not flat
     wall_min_width_m: float = 1.0
