@@ -1,0 +1,8 @@
+"""The knowledge base: JSON documents in SQLite (source of truth) and the RDF scene graph.
+
+One public entry: ``open_kb(location) -> KnowledgeBase``.
+"""
+
+from hiper_cli.graph.kb import DEFAULT_KB, CheckReport, KbConfig, KnowledgeBase, SyncReport, open_kb
+
+__all__ = ["DEFAULT_KB", "CheckReport", "KbConfig", "KnowledgeBase", "SyncReport", "open_kb"]

@@ -1,0 +1,308 @@
+"""Export a knowledge base to Turtle, N-Quads, JSON-LD, GraphML or JSON, and import it back.
+
+* ``turtle``: every triple of the four layer graphs (Turtle has no named graphs, so each node
+  gets its ``hiper:layer``); ``nquads``: the four named graphs as they are (both serialised by
+  pyoxigraph); ``jsonld``: the named graphs through rdflib's JSON-LD serialiser.
+* ``graphml`` (networkx): one node per graph node (attributes: ``iri``, ``type``, ``layer`` and
+  every literal property by its local name), one edge per object property (``predicate``).
+* ``json``: the documented export for other tools and LLM agents (schema in docs/kb.md):
+  environments, sessions, instances (class, layer, box centre/extent in metres, first/last seen,
+  state, observation count, speed), analyses and, with ``observations=True``, the full
+  observation documents.
+
+Import reads all five back into documents (then the graph is rebuilt from them). The RDF and
+GraphML forms carry the high-level attributes only: imported observations have no low-level
+data, and their boxes are zero unless the graph held them (``observation_detail="full"``).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import pyoxigraph as ox
+
+from hiper_cli.errors import DataError, KnowledgeBaseError
+from hiper_cli.graph.kb import KnowledgeBase
+from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, h, layer_graph, speed_mps
+from hiper_cli.model import LAYERS
+
+__all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_export"]
+
+EXPORT_FORMATS = ("turtle", "nquads", "jsonld", "graphml", "json")
+_SUFFIX = {".ttl": "turtle", ".nq": "nquads", ".jsonld": "jsonld", ".graphml": "graphml", ".json": "json"}
+JSON_FORMAT_NAME = "hiper-kb-export"
+JSON_FORMAT_VERSION = 1
+
+
+def guess_format(path: Path) -> str:
+    fmt = _SUFFIX.get(path.suffix.lower())
+    if fmt is None:
+        raise DataError(f"{path}: cannot tell the format from '{path.suffix}'; use --format "
+                        f"({', '.join(EXPORT_FORMATS)}) or a suffix {', '.join(_SUFFIX)}")
+    return fmt
+
+
+def _layer_quads(kb: KnowledgeBase) -> list[ox.Quad]:
+    kb.sync_graph() if not kb.read_only else None
+    return kb.graph.quads([layer_graph(kb.kb_id, layer) for layer in LAYERS])
+
+
+def _with_layers(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:
+    """Add ``hiper:layer`` to nodes that lack it (summary observations), from their graph."""
+    graph_layer = {layer_graph(kb.kb_id, layer).value: layer for layer in LAYERS}
+    has_layer = {q.subject for q in quads if q.predicate == h("layer")}
+    extra = {
+        ox.Quad(q.subject, h("layer"), h(graph_layer[q.graph_name.value]), q.graph_name)
+        for q in quads
+        if q.predicate == RDF_TYPE and q.subject not in has_layer and isinstance(q.graph_name, ox.NamedNode)
+    }
+    return quads + sorted(extra, key=str)
+
+
+def _to_rdflib(term: Any) -> Any:
+    import rdflib
+
+    if isinstance(term, ox.NamedNode):
+        return rdflib.URIRef(term.value)
+    if isinstance(term, ox.Literal):
+        if term.language:
+            return rdflib.Literal(term.value, lang=term.language)
+        return rdflib.Literal(term.value, datatype=rdflib.URIRef(term.datatype.value))
+    return rdflib.BNode(str(term))
+
+
+def _local(iri: str) -> str:
+    for base in (HIPER, PROV, "http://www.w3.org/1999/02/22-rdf-syntax-ns#"):
+        if iri.startswith(base):
+            return iri[len(base):]
+    return iri
+
+
+def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = False) -> dict[str, Any]:
+    """Write ``kb`` to ``out`` in ``fmt``; returns a summary (format, path, counts)."""
+    if fmt not in EXPORT_FORMATS:
+        raise DataError(f"export format {fmt!r}; expected one of {', '.join(EXPORT_FORMATS)}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    summary: dict[str, Any] = {"format": fmt, "path": str(out)}
+    if fmt == "json":
+        data = json_export(kb, observations=observations)
+        out.write_text(json.dumps(data, indent=1) + "\n")
+        keys = ("environments", "instances", "analyses", "observations")
+        summary["counts"] = {k: len(data[k]) for k in keys}
+        return summary
+    quads = _with_layers(kb, _layer_quads(kb))
+    summary["quads"] = len(quads)
+    prefixes = {"hiper": HIPER, "prov": PROV, "sosa": "http://www.w3.org/ns/sosa/"}
+    if fmt == "nquads":
+        ox.serialize(quads, str(out), ox.RdfFormat.N_QUADS)
+    elif fmt == "turtle":
+        ox.serialize([ox.Triple(q.subject, q.predicate, q.object) for q in quads], str(out),
+                     ox.RdfFormat.TURTLE, prefixes=prefixes)
+    elif fmt == "jsonld":
+        import rdflib
+
+        dataset = rdflib.Dataset()
+        for q in quads:
+            dataset.graph(_to_rdflib(q.graph_name)).add(
+                (_to_rdflib(q.subject), _to_rdflib(q.predicate), _to_rdflib(q.object))
+            )
+        for name, iri in prefixes.items():
+            dataset.bind(name, iri)
+        dataset.serialize(destination=str(out), format="json-ld")
+    else:
+        import networkx as nx
+
+        g = nx.MultiDiGraph()
+        for q in quads:
+            s = str(getattr(q.subject, "value", q.subject))
+            g.add_node(s, iri=s)
+            key = _local(q.predicate.value)
+            if isinstance(q.object, ox.Literal):
+                g.nodes[s][key] = q.object.value
+                continue
+            o = str(getattr(q.object, "value", q.object))
+            if key in ("type", "layer"):
+                g.nodes[s][key] = _local(o)
+            else:
+                g.add_node(o, iri=o)
+                g.add_edge(s, o, predicate=key)
+        nx.write_graphml(g, str(out))
+    return summary
+
+
+def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, Any]:
+    """The documented JSON form of a knowledge base (see docs/kb.md)."""
+    docs = kb.docs
+    instances = []
+    for d in docs.find(type="instance"):
+        box = d["box"]
+        instances.append({
+            "uuid": d["uuid"], "layer": d["layer"], "class": d["class"],
+            "box": {"center_m": box["center_m"], "extent_m": box["extent_m"], "R": box.get("R")},
+            "frame": d.get("frame_id", "map"),
+            "first_seen_s": d["first_seen_s"], "last_seen_s": d["last_seen_s"], "state": d.get("state"),
+            "confidence": d.get("confidence"),
+            "observation_count": len(d.get("observation_uuids", [])),
+            "speed_mps": speed_mps(d),
+            **({"observation_uuids": d["observation_uuids"]} if observations else {}),
+            "data": d.get("data", {}) if observations else None,
+        })
+    return {
+        "format": JSON_FORMAT_NAME,
+        "version": JSON_FORMAT_VERSION,
+        "kb_id": kb.kb_id,
+        "exported_s": time.time(),
+        "units": {"length": "m", "time": "s", "speed": "m/s"},
+        "environments": [{"uuid": d["uuid"], "name": d["name"]} for d in docs.find(type="environment")],
+        "sessions": [s.to_dict() for s in docs.sessions()],
+        "instances": instances,
+        "analyses": [{k: v for k, v in d.items() if k != "type"} for d in docs.find(type="analysis")],
+        "observations": docs.find(type="observation") if observations else [],
+    }
+
+
+def _docs_from_json(data: dict[str, Any], source: Path) -> list[dict[str, Any]]:
+    if data.get("format") != JSON_FORMAT_NAME:
+        raise DataError(f"{source}: not a hiper JSON export (format {data.get('format')!r}); "
+                        f"expected {JSON_FORMAT_NAME!r} written by 'hiper export --format json'")
+    out: list[dict[str, Any]] = []
+    for e in data.get("environments", []):
+        out.append({"uuid": e["uuid"], "type": "environment", "name": e["name"], "data": {},
+                    "env_uuid": e["uuid"]})
+    for i in data.get("instances", []):
+        box = dict(i["box"])
+        if box.get("R") is None:
+            box.pop("R", None)
+        out.append({
+            "uuid": i["uuid"], "type": "instance", "layer": i["layer"], "class": i["class"], "box": box,
+            "first_seen_s": i["first_seen_s"], "last_seen_s": i["last_seen_s"],
+            "state": i.get("state") or "static", "confidence": i.get("confidence") or 1.0,
+            "observation_uuids": i.get("observation_uuids", []), "frame_id": i.get("frame", "map"),
+            "data": i.get("data") or {},
+        })
+    for a in data.get("analyses", []):
+        out.append({**a, "type": "analysis"})
+    out.extend(data.get("observations", []))
+    return out
+
+
+def _vec(text: str | None) -> list[float]:
+    return [float(v) for v in text.split()] if text else [0.0, 0.0, 0.0]
+
+
+def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[dict[str, Any]]:
+    """Documents from node properties keyed by local predicate name (RDF or GraphML)."""
+    out: list[dict[str, Any]] = []
+    links: dict[str, list[str]] = defaultdict(list)
+    for iri, p in props.items():
+        for target in p.get("wasDerivedFrom", []):
+            links[iri].append(target.removeprefix("urn:uuid:"))
+
+    def one(p: dict[str, list[str]], key: str, default: Any = None) -> Any:
+        values = p.get(key)
+        return values[0] if values else default
+
+    for iri, p in props.items():
+        if not iri.startswith("urn:uuid:"):
+            continue
+        uuid = iri.removeprefix("urn:uuid:")
+        kind = one(p, "type")
+        layer = one(p, "layer")
+        if kind == "Observation":
+            out.append({
+                "uuid": uuid, "type": "observation", "layer": layer or "foreground",
+                "class": one(p, "className"),
+                "confidence": float(one(p, "confidence", 1.0)), "stamp_s": float(one(p, "stampS", 0.0)),
+                "pose_id": int(one(p, "poseId", -1)), "frame_id": one(p, "frame", "camera"),
+                "box": {"center_m": _vec(one(p, "boxCenterM")), "extent_m": _vec(one(p, "boxExtentM"))},
+                "instance_uuid": None, "data": {},
+            })
+        elif kind == "Instance":
+            env = one(p, "inEnvironment")
+            out.append({
+                "uuid": uuid, "type": "instance", "layer": layer, "class": one(p, "className"),
+                "box": {"center_m": _vec(one(p, "boxCenterM")), "extent_m": _vec(one(p, "boxExtentM"))},
+                "first_seen_s": float(one(p, "firstSeenS", 0.0)),
+                "last_seen_s": float(one(p, "lastSeenS", 0.0)),
+                "state": one(p, "state", "static"), "confidence": float(one(p, "confidence", 1.0)),
+                "observation_uuids": links.get(iri, []), "frame_id": one(p, "frame", "map"), "data": {},
+                **({"env_uuid": env.removeprefix("urn:uuid:")} if env else {}),
+            })
+        elif kind == "Analysis":
+            out.append({
+                "uuid": uuid, "type": "analysis", "kind": one(p, "kind"), "class": one(p, "className"),
+                "t_start_s": float(one(p, "tStartS", 0.0)), "t_end_s": float(one(p, "tEndS", 0.0)),
+                "values": json.loads(one(p, "valuesJson", "{}")), "created_s": float(one(p, "createdS", 0.0)),
+            })
+        elif kind == "Environment":
+            out.append({"uuid": uuid, "type": "environment", "name": one(p, "name", uuid), "data": {},
+                        "env_uuid": uuid})
+    order = {"environment": 0, "observation": 1, "instance": 2, "analysis": 3}
+    return sorted(out, key=lambda d: order[d["type"]])
+
+
+def _props_from_rdf(path: Path, fmt: str) -> dict[str, dict[str, list[str]]]:
+    formats = {"turtle": ox.RdfFormat.TURTLE, "nquads": ox.RdfFormat.N_QUADS, "jsonld": ox.RdfFormat.JSON_LD}
+    props: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+    try:
+        for q in ox.parse(path=str(path), format=formats[fmt]):
+            if not isinstance(q.subject, ox.NamedNode):
+                continue
+            key = _local(q.predicate.value)
+            value = q.object.value if isinstance(q.object, ox.NamedNode | ox.Literal) else str(q.object)
+            if key in ("type", "layer"):
+                value = _local(value)
+            props[q.subject.value][key].append(value)
+    except (SyntaxError, ValueError, OSError) as err:
+        raise DataError(f"{path}: cannot read it as {fmt} ({err}); check the file or pass --format") from err
+    return props
+
+
+def _props_from_graphml(path: Path) -> dict[str, dict[str, list[str]]]:
+    import networkx as nx
+
+    try:
+        g = nx.read_graphml(str(path))
+    except Exception as err:  # networkx raises several parser errors
+        raise DataError(f"{path}: cannot read it as GraphML ({err})") from err
+    props: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+    for n, attrs in g.nodes(data=True):
+        for k, v in attrs.items():
+            if k != "iri":
+                props[str(n)][k].append(str(v))
+    for s, o, attrs in g.edges(data=True):
+        props[str(s)][str(attrs.get("predicate", "related"))].append(str(o))
+    return props
+
+
+def import_kb(kb: KnowledgeBase, path: Path, fmt: str | None = None) -> dict[str, Any]:
+    """Read an export into ``kb`` (documents first, then the graph follows)."""
+    fmt = fmt or guess_format(path)
+    if not path.is_file():
+        raise DataError(f"{path}: no such file; pass a file written by 'hiper export'")
+    if fmt == "json":
+        try:
+            data = json.loads(path.read_text())
+        except ValueError as err:
+            raise DataError(f"{path}: not valid JSON ({err})") from err
+        docs = _docs_from_json(data, path)
+    elif fmt == "graphml":
+        docs = _docs_from_props(_props_from_graphml(path))
+    elif fmt in ("turtle", "nquads", "jsonld"):
+        docs = _docs_from_props(_props_from_rdf(path, fmt))
+    else:
+        raise DataError(f"import format {fmt!r}; expected one of {', '.join(EXPORT_FORMATS)}")
+    if kb.read_only:
+        raise KnowledgeBaseError(f"{kb.location}: opened read-only; cannot import")
+    envs = [d["uuid"] for d in docs if d["type"] == "environment"]
+    default_env = envs[0] if len(envs) == 1 else None
+    n = kb.put_documents(docs, env_uuid=default_env)
+    kb.sync_graph()
+    counts: dict[str, int] = defaultdict(int)
+    for d in docs:
+        counts[d["type"]] += 1
+    return {"path": str(path), "format": fmt, "documents": n, "counts": dict(counts), "kb": kb.location}

@@ -1,0 +1,413 @@
+"""The knowledge base: documents (source of truth) plus the RDF scene graph derived from them.
+
+Layout of a knowledge-base directory (``--kb PATH``, default ``./scene.hiper``)::
+
+    PATH/documents.sqlite   the documents (SQLite, WAL), see ``documents.py``
+    PATH/graph/             the scene graph (pyoxigraph on-disk store), unless the graph lives
+                            on a SPARQL endpoint (``open_kb("http://...", docs_dir=PATH)``)
+
+A perception frame is written with ``write_frame`` in one SQLite transaction. The graph is
+brought up to date with ``sync_graph`` (the pipeline calls it every few seconds and at the end),
+replaying every document change after the graph's high-water mark; ``open_kb`` does it too, so
+a crash at any instant leaves a knowledge base that reopens with both stores in agreement.
+"""
+
+from __future__ import annotations
+
+import time
+import uuid as _uuid
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.graph.documents import DocumentStore, Session
+from hiper_cli.graph.ontology import (
+    OBSERVATION_DETAIL,
+    doc_quads,
+    layer_graph,
+    link_quad,
+    meta_graph,
+    node,
+    session_node,
+    session_quads,
+)
+from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph, open_graph
+from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, Instance, Observation
+from hiper_cli.perceive.stage import FrameResult, World
+
+__all__ = ["DEFAULT_KB", "CheckReport", "KbConfig", "KnowledgeBase", "SyncReport", "open_kb"]
+
+DEFAULT_KB = "scene.hiper"
+DOCUMENTS_FILE = "documents.sqlite"
+GRAPH_DIR = "graph"
+
+
+@dataclass(frozen=True)
+class KbConfig:
+    """``observation_detail``: how much of each observation the graph holds ("summary": class,
+    stamp and provenance link; "full": also pose id, frame, confidence and box).
+    ``sync_batch``: documents per graph write when catching up."""
+
+    observation_detail: str = "summary"
+    sync_batch: int = 2000
+
+    def __post_init__(self) -> None:
+        if self.observation_detail not in OBSERVATION_DETAIL:
+            raise KnowledgeBaseError(
+                f"observation_detail {self.observation_detail!r}; expected one of {OBSERVATION_DETAIL}"
+            )
+
+
+@dataclass
+class SyncReport:
+    documents: int = 0
+    links: int = 0
+    deleted: int = 0
+    sessions: int = 0
+    seconds: float = 0.0
+    rebuilt: bool = False
+
+
+@dataclass
+class CheckReport:
+    ok: bool
+    problems: list[str] = field(default_factory=list)
+    repaired: bool = False
+    graph_counts: dict[str, int] = field(default_factory=dict)
+    document_counts: dict[str, int] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "ok": self.ok,
+            "problems": self.problems,
+            "repaired": self.repaired,
+            "graph_counts": self.graph_counts,
+            "document_counts": self.document_counts,
+        }
+
+
+def _aabb(lo: Any, hi: Any) -> tuple[list[float], list[float]]:
+    return [float(v) for v in lo], [float(v) for v in hi]
+
+
+def _map_aabb(box: Box3D, T_map_box: Any) -> tuple[list[float], list[float]]:
+    """(min, max) of the axis-aligned map-frame box around ``box`` given in a frame mapped into
+    the map by ``T_map_box`` (None = the box is in the map frame already)."""
+    R, c = box.R, box.center_m
+    if T_map_box is not None:
+        R = T_map_box[:3, :3] @ R
+        c = T_map_box[:3, :3] @ c + T_map_box[:3, 3]
+    half = np.abs(R) @ (box.extent_m / 2.0)
+    return (c - half).tolist(), (c + half).tolist()
+
+
+class KnowledgeBase:
+    """Open with ``open_kb``. Not thread-safe; one writer process at a time."""
+
+    def __init__(
+        self,
+        root: Path,
+        graph: LocalGraph | SparqlGraph,
+        docs: DocumentStore,
+        config: KbConfig,
+        read_only: bool = False,
+    ) -> None:
+        self.root = root
+        self.graph = graph
+        self.docs = docs
+        self.config = config
+        self.read_only = read_only
+        kb_id = docs.meta("kb_id")
+        if kb_id is None:
+            kb_id = str(_uuid.uuid4())
+            docs.set_meta("kb_id", kb_id)
+        self.kb_id = kb_id
+        detail = docs.meta("observation_detail")
+        if detail is None and not read_only:
+            docs.set_meta("observation_detail", config.observation_detail)
+        elif detail is not None and detail != config.observation_detail:
+            self.config = KbConfig(observation_detail=detail, sync_batch=config.sync_batch)
+
+    # -- lifecycle ----------------------------------------------------------------------------
+
+    @property
+    def location(self) -> str:
+        """The knowledge base as the user names it: its directory, or the endpoint URL."""
+        return self.graph.location if isinstance(self.graph, SparqlGraph) else str(self.root)
+
+    def close(self) -> None:
+        if not self.read_only:
+            self.sync_graph()
+        self.graph.close()
+        self.docs.close()
+
+    def __enter__(self) -> KnowledgeBase:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def graphs(self) -> list[Any]:
+        """The named graphs of this knowledge base: four layers and the meta graph."""
+        return [layer_graph(self.kb_id, layer) for layer in LAYERS] + [meta_graph(self.kb_id)]
+
+    # -- writes -------------------------------------------------------------------------------
+
+    def environment(self, name: str) -> Environment:
+        """The environment called ``name``, created on first use."""
+        for doc in self.docs.find(type="environment"):
+            if doc["name"] == name:
+                return Environment.from_dict(doc)
+        env = Environment(name=name)
+        with self.docs.transaction():
+            self.docs.put(env.to_dict(), env_uuid=env.uuid)
+        return env
+
+    def environments(self) -> list[Environment]:
+        return [Environment.from_dict(d) for d in self.docs.find(type="environment")]
+
+    def start_session(self, env: Environment, log_path: str, stages: Sequence[str]) -> Session:
+        with self.docs.transaction():
+            return self.docs.start_session(env.uuid, log_path, stages)
+
+    def resumable_session(self, env: Environment, log_path: str) -> Session | None:
+        """The newest unfinished session of ``log_path`` in ``env``, if any."""
+        found = [s for s in self.docs.sessions() if s.env_uuid == env.uuid and s.log_path == log_path]
+        return found[-1] if found and not found[-1].finished else None
+
+    def end_session(self, session: Session) -> None:
+        with self.docs.transaction():
+            self.docs.end_session(session.id)
+
+    def write_frame(
+        self,
+        session: Session,
+        result: FrameResult,
+        *,
+        pose_id: int | None = None,
+        stamp_s: float | None = None,
+        T_map_cam: Any = None,
+    ) -> int:
+        """Write one frame's merged result atomically; ``pose_id`` None = the end-of-log flush.
+
+        Observations get their map-frame box indexed through ``T_map_cam``. Returns the change
+        sequence number of the write.
+        """
+        T = None if T_map_cam is None else np.asarray(T_map_cam, dtype=np.float64)
+        with self.docs.transaction() as seq:
+            self._put_result(result, session.id, session.env_uuid, T)
+            if pose_id is not None:
+                self.docs.record_frame(session.id, pose_id, float(stamp_s or 0.0),
+                                       T if T is not None else np.eye(4))
+        return seq
+
+    def _put_result(self, result: FrameResult, session_id: int | None, env_uuid: str, T: Any) -> None:
+        obs_items = [(o.to_dict(), None if T is None else _map_aabb(o.box, T)) for o in result.observations]
+        self.docs.put_many(obs_items, session_id=session_id, env_uuid=env_uuid)
+        inst_items = [(i.to_dict(), _map_aabb(i.box, None)) for i in result.instances]
+        self.docs.put_many(inst_items, session_id=session_id, env_uuid=env_uuid)
+        for uuid in result.deleted_instances:
+            self.docs.delete(uuid)
+
+    def put_documents(self, docs: Iterable[dict[str, Any]], env_uuid: str | None = None) -> int:
+        """Write documents (``to_dict`` forms) in one transaction, e.g. from an import."""
+        n = 0
+        with self.docs.transaction():
+            for doc in docs:
+                box_map = None
+                if doc["type"] == "instance":
+                    inst = Instance.from_dict(doc)
+                    box_map = _aabb(*inst.box.aabb())
+                self.docs.put(doc, env_uuid=doc.get("env_uuid", env_uuid), box_map=box_map)
+                n += 1
+        return n
+
+    def put_analyses(self, analyses: Sequence[Analysis], env_uuid: str | None = None) -> None:
+        self.put_documents((a.to_dict() for a in analyses), env_uuid=env_uuid)
+
+    # -- graph synchronisation ----------------------------------------------------------------
+
+    def sync_graph(self, *, rebuild: bool = False) -> SyncReport:
+        """Bring the scene graph up to date with the documents (everything after its high-water
+        mark, or everything when ``rebuild``). Idempotent; safe to interrupt."""
+        start = time.perf_counter()
+        report = SyncReport(rebuilt=rebuild)
+        upto = self.docs.seq
+        after = 0 if rebuild else self.graph.synced_seq(self.kb_id)
+        if after > upto:  # the graph is ahead of the documents (restored backup): rebuild
+            after, report.rebuilt = 0, True
+        if after == upto and not rebuild:
+            return report
+        if after == 0:
+            self.graph.clear(self.graphs())
+        kb_id, detail = self.kb_id, self.config.observation_detail
+        for batch in self.docs.changed_docs(after, upto, self.config.sync_batch):
+            quads = [q for d in batch for q in doc_quads(kb_id, d, detail)]
+            refresh = [] if after == 0 else [node(d["uuid"]).value for d in batch]
+            self.graph.write(kb_id, refresh, [], quads)
+            report.documents += len(batch)
+        links = [link_quad(kb_id, i, o, layer) for i, o, layer in self.docs.changed_links(after, upto)]
+        for k in range(0, len(links), self.config.sync_batch * 4):
+            self.graph.write(kb_id, [], [], links[k : k + self.config.sync_batch * 4])
+        report.links = len(links)
+        dead = [node(u).value for u, _, _ in self.docs.tombstones(after, upto)]
+        if dead and after > 0:
+            self.graph.write(kb_id, [], dead, [])
+        report.deleted = len(dead)
+        sessions = self.docs.sessions(after_seq=after, upto_seq=upto)
+        if sessions:
+            self.graph.write(kb_id, [session_node(kb_id, s.id).value for s in sessions], [],
+                             [q for s in sessions for q in session_quads(kb_id, s.to_dict())])
+        report.sessions = len(sessions)
+        self.graph.set_synced_seq(kb_id, upto)
+        report.seconds = time.perf_counter() - start
+        return report
+
+    def graph_counts(self) -> dict[str, int]:
+        """Nodes per type in the graph ("layer/Type") plus provenance links and sessions."""
+        out: dict[str, int] = {}
+        for layer in LAYERS:
+            g = layer_graph(self.kb_id, layer)
+            rows = self.graph.query(
+                f"SELECT ?t (COUNT(?s) AS ?n) WHERE {{ GRAPH {g} {{ ?s a ?t }} }} GROUP BY ?t"
+            )
+            for r in rows:
+                name = r["t"].value.rsplit("#", 1)[-1]
+                out[f"{layer}/{name}"] = int(r["n"].value)
+            links = self.graph.query(
+                f"SELECT (COUNT(*) AS ?n) WHERE {{ GRAPH {g} {{ ?i prov:wasDerivedFrom ?o }} }}"
+            )
+            n = int(links[0]["n"].value) if links else 0
+            if n:
+                out[f"{layer}/wasDerivedFrom"] = n
+        return out
+
+    def document_counts(self) -> dict[str, int]:
+        """The same keys as ``graph_counts``, computed from the documents."""
+        out: dict[str, int] = {}
+        type_layer = {"environment": "environment", "analysis": "map"}
+        for kind, layer, _cls, n in self.docs.counts():
+            key = f"{layer or type_layer.get(kind, 'map')}/{kind.capitalize()}"
+            out[key] = out.get(key, 0) + n
+        sessions = len(self.docs.sessions())
+        if sessions:
+            out["environment/Session"] = sessions
+        for layer, n in self.docs.link_counts_by_layer().items():
+            out[f"{layer}/wasDerivedFrom"] = n
+        return out
+
+    def check(self, *, repair: bool = True) -> CheckReport:
+        """Verify the documents and that the graph agrees with them; rebuild the graph from the
+        documents when it does not (``repair``)."""
+        problems = self.docs.integrity_problems()
+        synced = self.graph.synced_seq(self.kb_id)
+        if synced != self.docs.seq:
+            problems.append(f"graph high-water mark {synced} != document sequence {self.docs.seq}")
+        graph_counts, doc_counts = self.graph_counts(), self.document_counts()
+        if graph_counts != doc_counts:
+            keys = sorted(set(graph_counts) | set(doc_counts))
+            diff = [f"{k}: graph {graph_counts.get(k, 0)} vs documents {doc_counts.get(k, 0)}"
+                    for k in keys if graph_counts.get(k, 0) != doc_counts.get(k, 0)]
+            problems.append("graph and documents disagree: " + "; ".join(diff))
+        report = CheckReport(ok=not problems, problems=problems, graph_counts=graph_counts,
+                             document_counts=doc_counts)
+        if problems and repair and not self.read_only:
+            self.sync_graph(rebuild=True)
+            report.repaired = True
+            report.graph_counts = self.graph_counts()
+            report.ok = report.graph_counts == doc_counts and not self.docs.integrity_problems()
+        return report
+
+    # -- reads --------------------------------------------------------------------------------
+
+    def load_world(self, env: Environment) -> World:
+        """The live instances and the analyses of ``env``, for resuming perception."""
+        world = World()
+        for doc in self.docs.find(type="instance", env_uuid=env.uuid):
+            inst = Instance.from_dict(doc)
+            world.layer(inst.layer)[inst.uuid] = inst
+        world.analyses = [Analysis.from_dict(d) for d in self.docs.find(type="analysis")]
+        return world
+
+    def observation(self, uuid: str) -> Observation | None:
+        doc = self.docs.get(uuid)
+        return Observation.from_dict(doc) if doc and doc["type"] == "observation" else None
+
+    def instance(self, uuid: str) -> Instance | None:
+        doc = self.docs.get(uuid)
+        return Instance.from_dict(doc) if doc and doc["type"] == "instance" else None
+
+    def instances(self, *, layer: str | None = None, class_name: str | None = None) -> list[Instance]:
+        return [Instance.from_dict(d) for d in self.docs.find(type="instance", layer=layer,
+                                                              class_name=class_name)]
+
+    def query(self, sparql: str) -> list[dict[str, Any]]:
+        """SPARQL SELECT over the scene graph (prefixes hiper:, prov:, sosa: predeclared)."""
+        return self.graph.query(sparql)
+
+    def info(self) -> dict[str, Any]:
+        """Counts per type, layer and class, sessions, environments and size on disk."""
+        counts = [
+            {"type": t, "layer": layer, "class": cls, "count": n} for t, layer, cls, n in self.docs.counts()
+        ]
+        size = sum(p.stat().st_size for p in self.root.rglob("*") if p.is_file()) if self.root.exists() else 0
+        return {
+            "kb": self.location,
+            "documents_path": str(self.docs.path),
+            "kb_id": self.kb_id,
+            "observation_detail": self.config.observation_detail,
+            "environments": [e.to_dict() | {"data": None} for e in self.environments()],
+            "sessions": [s.to_dict() for s in self.docs.sessions()],
+            "counts": counts,
+            "totals": {
+                kind: sum(c["count"] for c in counts if c["type"] == kind)
+                for kind in ("observation", "instance", "analysis", "environment")
+            },
+            "change_seq": self.docs.seq,
+            "graph_synced_seq": self.graph.synced_seq(self.kb_id),
+            "size_bytes": size,
+        }
+
+
+def open_kb(
+    location: str | Path = DEFAULT_KB,
+    *,
+    docs_dir: str | Path | None = None,
+    read_only: bool = False,
+    config: KbConfig | None = None,
+    sync: bool = True,
+) -> KnowledgeBase:
+    """Open (creating on first use) the knowledge base at ``location``.
+
+    ``location`` is a directory, or the URL of a SPARQL 1.1 endpoint holding the scene graph; in
+    that case the documents live in ``docs_dir`` (default ``./scene.hiper``). On open the graph is
+    brought up to date with the documents (``sync``), which repairs an interrupted write.
+    """
+    text = str(location)
+    remote = text.startswith(("http://", "https://"))
+    root = Path(docs_dir) if docs_dir is not None else (Path(DEFAULT_KB) if remote else Path(text))
+    if root.exists() and not root.is_dir():
+        raise KnowledgeBaseError(
+            f"{root}: is a file, not a knowledge-base directory; pass a directory to --kb"
+        )
+    docs_path = root / DOCUMENTS_FILE
+    if read_only and not docs_path.exists():
+        raise KnowledgeBaseError(
+            f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); "
+            f"run 'hiper perceive LOG --kb {root}'"
+        )
+    root.mkdir(parents=True, exist_ok=True)
+    docs = DocumentStore(docs_path, read_only=read_only)
+    try:
+        graph = open_graph(text if remote else root / GRAPH_DIR, read_only=read_only)
+    except BaseException:
+        docs.close()
+        raise
+    kb = KnowledgeBase(root, graph, docs, config or KbConfig(), read_only=read_only)
+    if sync and not read_only:
+        kb.sync_graph()
+    return kb

@@ -1,0 +1,166 @@
+"""How documents become RDF: IRIs, the four layer graphs of a knowledge base, and node triples.
+
+Nodes are ``<urn:uuid:UUID>``. Each knowledge base (id ``KB``) writes four named graphs
+``<urn:hiper:kb:KB:LAYER>`` (environment, background, foreground, map) plus a meta graph
+holding the high-water mark, so several robots' knowledge bases can share one SPARQL endpoint.
+The vocabulary is ``hiper.ttl`` beside this file (SOSA/SSN for observations, PROV-O for the
+instance -> observation provenance).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from collections.abc import Sequence
+from importlib import resources
+from typing import Any
+
+import pyoxigraph as ox
+
+__all__ = [
+    "HIPER",
+    "LAYER_OF_TYPE",
+    "OBSERVATION_DETAIL",
+    "PROV",
+    "SOSA",
+    "doc_quads",
+    "layer_graph",
+    "link_quad",
+    "meta_graph",
+    "node",
+    "ontology_turtle",
+    "session_node",
+    "session_quads",
+]
+
+HIPER = "https://w3id.org/hiper#"
+SOSA = "http://www.w3.org/ns/sosa/"
+PROV = "http://www.w3.org/ns/prov#"
+RDF_TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
+XSD = "http://www.w3.org/2001/XMLSchema#"
+_DOUBLE = ox.NamedNode(XSD + "double")
+_INTEGER = ox.NamedNode(XSD + "integer")
+
+# Observation nodes in the graph: "summary" = class, stamp, provenance link (fast, ~2x more
+# observations/s); "full" = also pose id, frame, confidence and the camera-frame box.
+OBSERVATION_DETAIL = ("summary", "full")
+
+# Which layer graph holds which document type when the document has no layer of its own.
+LAYER_OF_TYPE = {"environment": "environment", "session": "environment", "analysis": "map"}
+
+WAS_DERIVED_FROM = ox.NamedNode(PROV + "wasDerivedFrom")
+
+
+def h(name: str) -> ox.NamedNode:
+    return ox.NamedNode(HIPER + name)
+
+
+def node(uuid: str) -> ox.NamedNode:
+    return ox.NamedNode(f"urn:uuid:{uuid}")
+
+
+def layer_graph(kb_id: str, layer: str) -> ox.NamedNode:
+    return ox.NamedNode(f"urn:hiper:kb:{kb_id}:{layer}")
+
+
+def meta_graph(kb_id: str) -> ox.NamedNode:
+    return ox.NamedNode(f"urn:hiper:kb:{kb_id}:meta")
+
+
+def session_node(kb_id: str, session_id: int) -> ox.NamedNode:
+    return ox.NamedNode(f"urn:hiper:kb:{kb_id}:session:{session_id}")
+
+
+def ontology_turtle() -> str:
+    """The ontology shipped with the package (``hiper_cli/graph/hiper.ttl``)."""
+    return resources.files("hiper_cli.graph").joinpath("hiper.ttl").read_text(encoding="utf-8")
+
+
+def _dbl(value: Any) -> ox.Literal:
+    v = float(value)
+    return ox.Literal(repr(v) if math.isfinite(v) else "NaN", datatype=_DOUBLE)
+
+
+def _int(value: Any) -> ox.Literal:
+    return ox.Literal(str(int(value)), datatype=_INTEGER)
+
+
+def _vec(values: Sequence[float]) -> ox.Literal:
+    return ox.Literal(" ".join(f"{float(v):.6g}" for v in values))
+
+
+def speed_mps(doc: dict[str, Any]) -> float | None:
+    """Mean speed of an instance along ``data.trajectory`` rows [t, x, y, z, ...], if it has one."""
+    rows = (doc.get("data") or {}).get("trajectory") or []
+    if len(rows) < 2:
+        return None
+    dist = 0.0
+    for a, b in itertools.pairwise(rows):
+        dist += math.dist(a[1:4], b[1:4])
+    dt = float(rows[-1][0]) - float(rows[0][0])
+    return dist / dt if dt > 0 else None
+
+
+def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[ox.Quad]:
+    """The graph node of one document (without its provenance links, see ``link_quad``)."""
+    kind = doc["type"]
+    layer = doc.get("layer") or LAYER_OF_TYPE.get(kind, "map")
+    g = layer_graph(kb_id, layer)
+    s = node(doc["uuid"])
+    t: list[tuple[ox.NamedNode, ox.NamedNode | ox.Literal]] = []
+    if kind == "observation":
+        t += [(RDF_TYPE, h("Observation")), (h("className"), ox.Literal(doc["class"])),
+              (h("stampS"), _dbl(doc["stamp_s"]))]
+        if detail == "full":
+            box = doc["box"]
+            t += [(h("layer"), h(layer)), (h("poseId"), _int(doc["pose_id"])),
+                  (h("frame"), ox.Literal(doc.get("frame_id", "camera"))),
+                  (h("confidence"), _dbl(doc["confidence"])),
+                  (h("boxCenterM"), _vec(box["center_m"])), (h("boxExtentM"), _vec(box["extent_m"]))]
+    elif kind == "instance":
+        box = doc["box"]
+        t += [(RDF_TYPE, h("Instance")), (h("uuid"), ox.Literal(doc["uuid"])), (h("layer"), h(layer)),
+              (h("className"), ox.Literal(doc["class"])),
+              (h("frame"), ox.Literal(doc.get("frame_id", "map"))),
+              (h("firstSeenS"), _dbl(doc["first_seen_s"])), (h("lastSeenS"), _dbl(doc["last_seen_s"])),
+              (h("state"), ox.Literal(doc.get("state", "static"))),
+              (h("confidence"), _dbl(doc.get("confidence", 1.0))),
+              (h("boxCenterM"), _vec(box["center_m"])), (h("boxExtentM"), _vec(box["extent_m"])),
+              (h("observationCount"),
+               _int(doc.get("observation_count", len(doc.get("observation_uuids", [])))))]
+        speed = speed_mps(doc)
+        if speed is not None:
+            t.append((h("speedMps"), _dbl(speed)))
+        if doc.get("env_uuid"):
+            t.append((h("inEnvironment"), node(doc["env_uuid"])))
+    elif kind == "analysis":
+        t += [(RDF_TYPE, h("Analysis")), (h("uuid"), ox.Literal(doc["uuid"])), (h("layer"), h(layer)),
+              (h("kind"), ox.Literal(doc["kind"])), (h("className"), ox.Literal(doc["class"])),
+              (h("tStartS"), _dbl(doc["t_start_s"])), (h("tEndS"), _dbl(doc["t_end_s"])),
+              (h("createdS"), _dbl(doc["created_s"])),
+              (h("valuesJson"), ox.Literal(json.dumps(doc["values"], sort_keys=True, default=str)))]
+    elif kind == "environment":
+        t += [(RDF_TYPE, h("Environment")), (h("uuid"), ox.Literal(doc["uuid"])), (h("layer"), h(layer)),
+              (h("name"), ox.Literal(doc["name"]))]
+    else:
+        t += [(RDF_TYPE, h(kind.capitalize())), (h("uuid"), ox.Literal(doc["uuid"]))]
+    return [ox.Quad(s, p, o, g) for p, o in t]
+
+
+def link_quad(kb_id: str, instance_uuid: str, observation_uuid: str, layer: str) -> ox.Quad:
+    """``instance prov:wasDerivedFrom observation`` in the instance's layer graph."""
+    return ox.Quad(node(instance_uuid), WAS_DERIVED_FROM, node(observation_uuid), layer_graph(kb_id, layer))
+
+
+def session_quads(kb_id: str, session: dict[str, Any]) -> list[ox.Quad]:
+    g = layer_graph(kb_id, "environment")
+    s = session_node(kb_id, int(session["id"]))
+    t: list[tuple[ox.NamedNode, ox.NamedNode | ox.Literal]] = [
+        (RDF_TYPE, h("Session")), (h("logPath"), ox.Literal(session["log_path"])),
+        (h("startedS"), _dbl(session["started_s"])), (h("frames"), _int(session["frames"])),
+        (h("inEnvironment"), node(session["env_uuid"])),
+    ]
+    if session.get("ended_s") is not None:
+        t.append((h("endedS"), _dbl(session["ended_s"])))
+    return [ox.Quad(s, p, o, g) for p, o in t]

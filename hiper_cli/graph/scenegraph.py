@@ -1,0 +1,236 @@
+"""Where the RDF scene graph lives: an on-disk pyoxigraph store, or a SPARQL 1.1 endpoint.
+
+Both backends offer the same small interface (``GraphBackend``) so the knowledge base and its
+tests do not care which one they talk to. Writes are idempotent replacements of whole nodes:
+replaying a batch after a crash gives the same graph, which is what lets the knowledge base
+bring the graph up to date from its documents with a high-water mark.
+"""
+
+from __future__ import annotations
+
+import urllib.error
+import urllib.parse
+import urllib.request
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any, Protocol
+
+import pyoxigraph as ox
+
+from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
+
+__all__ = ["GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
+
+_SYNCED = ox.NamedNode(HIPER + "syncedSeq")
+_INTEGER = ox.NamedNode("http://www.w3.org/2001/XMLSchema#integer")
+_PREFIXES = f"PREFIX hiper: <{HIPER}>\nPREFIX prov: <{PROV}>\nPREFIX sosa: <http://www.w3.org/ns/sosa/>\n"
+
+
+def _kb_node(kb_id: str) -> ox.NamedNode:
+    return ox.NamedNode(f"urn:hiper:kb:{kb_id}")
+
+
+class GraphBackend(Protocol):
+    """The scene graph of one knowledge base (``kb_id``) in some quad store."""
+
+    location: str
+
+    def write(
+        self, kb_id: str, refresh: Sequence[str], drop: Sequence[str], quads: Sequence[ox.Quad]
+    ) -> None:
+        """Remove the triples of the subjects in ``refresh`` (except their provenance links) and
+        all triples of the subjects in ``drop``, then add ``quads``. Subjects are IRIs."""
+        ...
+
+    def synced_seq(self, kb_id: str) -> int:
+        """The high-water mark: the last document change the graph reflects (0 if none)."""
+        ...
+
+    def set_synced_seq(self, kb_id: str, seq: int) -> None: ...
+
+    def clear(self, graphs: Sequence[ox.NamedNode]) -> None: ...
+
+    def query(self, sparql: str) -> list[dict[str, Any]]:
+        """SELECT results as rows of {variable: pyoxigraph term}. The hiper, prov and sosa
+        prefixes are predeclared."""
+        ...
+
+    def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]: ...
+
+    def close(self) -> None: ...
+
+
+def _solutions(result: Any) -> list[dict[str, Any]]:
+    names = [v.value for v in result.variables]
+    return [{n: sol[n] for n in names if sol[n] is not None} for sol in result]
+
+
+class LocalGraph:
+    """The scene graph in an on-disk pyoxigraph (RocksDB) store, one process at a time."""
+
+    def __init__(self, path: Path, *, read_only: bool = False) -> None:
+        self.location = str(path)
+        try:
+            self._store = ox.Store.read_only(str(path)) if read_only else ox.Store(str(path))
+        except OSError as err:
+            raise KnowledgeBaseError(
+                f"{path}: cannot open the scene graph ({err}); is another hiper process writing "
+                "this knowledge base? wait for it or use another --kb"
+            ) from err
+        self._link = ox.NamedNode(PROV + "wasDerivedFrom")
+
+    def write(
+        self, kb_id: str, refresh: Sequence[str], drop: Sequence[str], quads: Sequence[ox.Quad]
+    ) -> None:
+        store = self._store
+        old: list[ox.Quad] = []
+        for iri in refresh:
+            old.extend(q for q in store.quads_for_pattern(ox.NamedNode(iri), None, None)
+                       if q.predicate != self._link)
+        for iri in drop:
+            old.extend(store.quads_for_pattern(ox.NamedNode(iri), None, None))
+        for q in old:
+            store.remove(q)
+        store.extend(quads)
+
+    def synced_seq(self, kb_id: str) -> int:
+        for q in self._store.quads_for_pattern(_kb_node(kb_id), _SYNCED, None, meta_graph(kb_id)):
+            return int(str(getattr(q.object, "value", 0)))
+        return 0
+
+    def set_synced_seq(self, kb_id: str, seq: int) -> None:
+        s, g = _kb_node(kb_id), meta_graph(kb_id)
+        for q in list(self._store.quads_for_pattern(s, _SYNCED, None, g)):
+            self._store.remove(q)
+        self._store.add(ox.Quad(s, _SYNCED, ox.Literal(str(seq), datatype=_INTEGER), g))
+
+    def clear(self, graphs: Sequence[ox.NamedNode]) -> None:
+        for g in graphs:
+            self._store.clear_graph(g)
+
+    def query(self, sparql: str) -> list[dict[str, Any]]:
+        try:
+            return _solutions(self._store.query(_PREFIXES + sparql))
+        except SyntaxError as err:
+            raise KnowledgeBaseError(f"SPARQL query does not parse: {err}") from err
+
+    def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
+        out: list[ox.Quad] = []
+        for g in graphs:
+            out.extend(self._store.quads_for_pattern(None, None, None, g))
+        return out
+
+    def flush(self) -> None:
+        self._store.flush()
+
+    def close(self) -> None:
+        self._store.flush()
+        del self._store
+
+
+class SparqlGraph:
+    """The scene graph on a SPARQL 1.1 endpoint (query at ``BASE/query``, update at
+    ``BASE/update``, as the ``oxigraph serve`` server lays them out). One update request per
+    write, so each write is atomic on the server."""
+
+    def __init__(self, base_url: str, timeout_s: float = 60.0) -> None:
+        base = base_url.rstrip("/")
+        for suffix in ("/query", "/sparql"):
+            if base.endswith(suffix):
+                base = base[: -len(suffix)]
+        self.location = base
+        self._timeout_s = timeout_s
+        try:
+            self._post("query", "ASK { }", "application/sparql-query")
+        except KnowledgeBaseError as err:
+            raise KnowledgeBaseError(
+                f"{base}: no SPARQL endpoint answers there ({err}); start one with "
+                "'oxigraph serve --location DIR --bind 127.0.0.1:7878' or fix --kb"
+            ) from err
+
+    def _post(self, path: str, body: str, content_type: str, accept: str | None = None) -> bytes:
+        request = urllib.request.Request(
+            f"{self.location}/{path}", data=body.encode("utf-8"), method="POST",
+            headers={"Content-Type": content_type, **({"Accept": accept} if accept else {})},
+        )
+        try:
+            with urllib.request.urlopen(request, timeout=self._timeout_s) as response:
+                return bytes(response.read())
+        except urllib.error.HTTPError as err:
+            detail = err.read().decode("utf-8", "replace")[:300]
+            raise KnowledgeBaseError(f"{self.location}/{path}: HTTP {err.code}: {detail}") from err
+        except (urllib.error.URLError, OSError) as err:
+            raise KnowledgeBaseError(f"{self.location}/{path}: {err}") from err
+
+    def _update(self, text: str) -> None:
+        self._post("update", _PREFIXES + text, "application/sparql-update")
+
+    @staticmethod
+    def _values(iris: Iterable[str]) -> str:
+        return " ".join(f"<{i}>" for i in iris)
+
+    def write(
+        self, kb_id: str, refresh: Sequence[str], drop: Sequence[str], quads: Sequence[ox.Quad]
+    ) -> None:
+        ops: list[str] = []
+        if refresh:
+            ops.append(
+                "DELETE { GRAPH ?g { ?s ?p ?o } } WHERE { VALUES ?s { " + self._values(refresh) + " } "
+                "GRAPH ?g { ?s ?p ?o } FILTER(?p != prov:wasDerivedFrom) }"
+            )
+        if drop:
+            ops.append(
+                "DELETE { GRAPH ?g { ?s ?p ?o } } WHERE { VALUES ?s { " + self._values(drop) + " } "
+                "GRAPH ?g { ?s ?p ?o } }"
+            )
+        if quads:
+            body = "\n".join(
+                f"GRAPH {q.graph_name} {{ {q.subject} {q.predicate} {q.object} }}" for q in quads
+            )
+            ops.append("INSERT DATA {\n" + body + "\n}")
+        if ops:
+            self._update(" ;\n".join(ops))
+
+    def synced_seq(self, kb_id: str) -> int:
+        rows = self.query(
+            f"SELECT ?n WHERE {{ GRAPH {meta_graph(kb_id)} {{ {_kb_node(kb_id)} hiper:syncedSeq ?n }} }}"
+        )
+        return int(rows[0]["n"].value) if rows else 0
+
+    def set_synced_seq(self, kb_id: str, seq: int) -> None:
+        s, g = _kb_node(kb_id), meta_graph(kb_id)
+        self._update(
+            f"DELETE WHERE {{ GRAPH {g} {{ {s} hiper:syncedSeq ?n }} }} ;\n"
+            f"INSERT DATA {{ GRAPH {g} {{ {s} hiper:syncedSeq {seq} }} }}"
+        )
+
+    def clear(self, graphs: Sequence[ox.NamedNode]) -> None:
+        if graphs:
+            self._update(" ;\n".join(f"CLEAR SILENT GRAPH {g}" for g in graphs))
+
+    def query(self, sparql: str) -> list[dict[str, Any]]:
+        raw = self._post("query", _PREFIXES + sparql, "application/sparql-query",
+                         accept="application/sparql-results+json")
+        return _solutions(ox.parse_query_results(raw, format=ox.QueryResultsFormat.JSON))
+
+    def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
+        out: list[ox.Quad] = []
+        for g in graphs:
+            for row in self.query(f"SELECT ?s ?p ?o WHERE {{ GRAPH {g} {{ ?s ?p ?o }} }}"):
+                out.append(ox.Quad(row["s"], row["p"], row["o"], g))
+        return out
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def open_graph(location: str | Path, *, read_only: bool = False) -> LocalGraph | SparqlGraph:
+    """A ``SparqlGraph`` for ``http(s)://`` locations, else a ``LocalGraph`` directory."""
+    text = str(location)
+    if text.startswith(("http://", "https://")):
+        return SparqlGraph(text)
+    return LocalGraph(Path(text), read_only=read_only)

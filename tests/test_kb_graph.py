@@ -1,0 +1,228 @@
+"""The knowledge base, run against both graph backends: the on-disk pyoxigraph store and a
+SPARQL 1.1 endpoint (an ``oxigraph serve`` process on loopback)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.graph import KbConfig, open_kb
+from hiper_cli.graph.ontology import layer_graph, ontology_turtle
+from hiper_cli.model import Analysis, Box3D, Observation
+from hiper_cli.perceive.runner import run_stages
+from hiper_cli.perceive.stage import FrameResult
+from tests.kb_helpers import ProbeStage, make_frame, oxigraph_binary, start_oxigraph
+
+
+@pytest.fixture(scope="module")
+def sparql_url(tmp_path_factory):
+    if oxigraph_binary() is None:
+        pytest.skip("the oxigraph server (pip install oxigraph, in the dev extra) is not installed")
+    proc, url = start_oxigraph(tmp_path_factory.mktemp("oxigraph"))
+    yield url
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+@pytest.fixture(params=["local", "sparql"])
+def kb_location(request, tmp_path):
+    """(location, docs_dir) for open_kb: a directory, or the server URL plus a documents dir."""
+    if request.param == "local":
+        return str(tmp_path / "scene.hiper"), None
+    return request.getfixturevalue("sparql_url"), tmp_path / "docs.hiper"
+
+
+def _fill(kb, n_frames=12):
+    env = kb.environment("lab")
+    session = kb.start_session(env, "/logs/lab", ["probe"])
+    stage = ProbeStage()
+
+    def on_frame(frame, result):
+        if frame is None:
+            kb.write_frame(session, result)
+        else:
+            kb.write_frame(session, result, pose_id=frame.pose_id, stamp_s=frame.stamp_s,
+                           T_map_cam=frame.T_map_cam)
+
+    world, _ = run_stages([make_frame(i, x_m=0.5 * i) for i in range(n_frames)], [stage], None, on_frame)
+    kb.end_session(session)
+    return env, session, world
+
+
+def test_frames_become_documents_and_graph_nodes(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _env, session, world = _fill(kb)
+        kb.sync_graph()
+        assert kb.docs.count(type="observation") == 24
+        # 12 frames, tracks of 4 frames -> 3 tracks; frames 5 and 11 each merge the previous away
+        assert {i.uuid for i in kb.instances()} == set(world.background) | set(world.foreground)
+        assert kb.docs.count(type="instance", layer="foreground") == 1
+        counts = kb.graph_counts()
+        assert counts == kb.document_counts()
+        assert counts["foreground/Observation"] == 12
+        assert counts["background/wasDerivedFrom"] == 12
+        report = kb.check(repair=False)
+        assert report.ok, report.problems
+        assert kb.docs.session(session.id).frames == 12
+
+
+def test_graph_nodes_carry_high_level_attributes(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _, _, world = _fill(kb)
+        kb.sync_graph()
+        floor = next(iter(world.background.values()))
+        rows = kb.query(
+            f"SELECT ?cls ?last ?state ?n ?center WHERE {{ GRAPH {layer_graph(kb.kb_id, 'background')} {{ "
+            f"<urn:uuid:{floor.uuid}> hiper:className ?cls ; hiper:lastSeenS ?last ; hiper:state ?state ; "
+            "hiper:observationCount ?n ; hiper:boxCenterM ?center } }"
+        )
+        assert len(rows) == 1
+        assert rows[0]["cls"].value == "floor"
+        assert float(rows[0]["last"].value) == pytest.approx(floor.last_seen_s)
+        assert int(rows[0]["n"].value) == 12
+        derived = kb.query(f"SELECT (COUNT(?o) AS ?n) WHERE {{ GRAPH ?g {{ <urn:uuid:{floor.uuid}> "
+                           "prov:wasDerivedFrom ?o . ?o a hiper:Observation } }")
+        assert int(derived[0]["n"].value) == 12
+
+
+def test_reopen_keeps_everything_and_world_reloads(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _env, _, world = _fill(kb)
+    with open_kb(location, docs_dir=docs) as kb:
+        assert kb.check(repair=False).ok
+        loaded = kb.load_world(kb.environment("lab"))
+        assert set(loaded.background) == set(world.background)
+        assert set(loaded.foreground) == set(world.foreground)
+        floor = next(iter(loaded.background.values()))
+        assert len(floor.observation_uuids) == 12
+        assert floor.observation_uuids == next(iter(world.background.values())).observation_uuids
+
+
+def test_document_queries(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _, _, world = _fill(kb)
+        cups = kb.docs.find(type="observation", class_name="cup", t_start_s=10.2, t_end_s=10.5)
+        assert [round(d["stamp_s"], 3) for d in cups] == [10.2, 10.3, 10.4, 10.5]
+        track = next(iter(world.foreground.values()))
+        obs = kb.docs.observations_of(track.uuid)
+        assert [o["uuid"] for o in obs] == track.observation_uuids
+        # frame 3: camera at x=1.5, cup 0.3 m right of it -> map x = 1.8; the spatial index
+        # holds the map-frame box of each observation
+        hits = kb.docs.in_box([1.75, -0.1, 0.9], [1.85, 0.1, 1.1], type="observation")
+        assert [h["pose_id"] for h in hits] == [3]
+        assert kb.docs.get(hits[0]["uuid"])["class"] == "cup"
+        assert kb.docs.get("no-such-uuid") is None
+
+
+def test_deleted_instances_leave_the_graph(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _fill(kb)
+        kb.sync_graph()
+        dead = [u for u, _, _ in kb.docs.tombstones(0, kb.docs.seq)]
+        assert len(dead) == 2
+        for uuid in dead:
+            assert kb.query(f"SELECT ?p WHERE {{ GRAPH ?g {{ <urn:uuid:{uuid}> ?p ?o }} }}") == []
+
+
+def test_check_repairs_a_damaged_graph(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _fill(kb)
+        kb.sync_graph()
+        kb.graph.clear([layer_graph(kb.kb_id, "foreground")])  # lose a layer behind the KB's back
+        report = kb.check(repair=False)
+        assert not report.ok
+        assert any("foreground/Observation: graph 0 vs documents 12" in p for p in report.problems)
+        report = kb.check(repair=True)
+        assert report.repaired and report.ok
+        assert kb.check(repair=False).ok
+
+
+def test_graph_catches_up_from_the_high_water_mark(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _fill(kb)
+        kb.sync_graph()
+        synced = kb.graph.synced_seq(kb.kb_id)
+        assert synced == kb.docs.seq
+        env = kb.environment("lab")
+        session = kb.start_session(env, "/logs/lab2", ["probe"])
+        obs = Observation("foreground", "book", 0.7, 20.0, 0, Box3D(np.zeros(3), np.ones(3)))
+        kb.write_frame(session, FrameResult([obs]), pose_id=0, stamp_s=20.0, T_map_cam=np.eye(4))
+        assert kb.graph.synced_seq(kb.kb_id) == synced  # the graph lags until the next sync
+        assert not kb.check(repair=False).ok
+        report = kb.sync_graph()
+        assert report.documents == 1 and report.sessions == 1
+        assert kb.check(repair=False).ok
+
+
+def test_analyses_and_multi_session_environment(kb_location):
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _fill(kb)
+        kb.put_analyses([Analysis("ods", "cup", 0.0, 10.0, {"mean_mps": 0.4}, 1.0)])
+        env = kb.environment("lab")
+        assert kb.environment("lab").uuid == env.uuid
+        assert len(kb.environments()) == 1
+        kb.sync_graph()
+        rows = kb.query('SELECT ?v WHERE { GRAPH ?g { ?a a hiper:Analysis ; hiper:kind "ods" ; '
+                        "hiper:valuesJson ?v } }")
+        assert rows and '"mean_mps": 0.4' in rows[0]["v"].value
+        assert kb.load_world(env).analysis("ods", "cup") is not None
+
+
+def test_two_knowledge_bases_share_one_endpoint(sparql_url, tmp_path):
+    with open_kb(sparql_url, docs_dir=tmp_path / "robot1") as kb1, \
+            open_kb(sparql_url, docs_dir=tmp_path / "robot2") as kb2:
+        _fill(kb1, 6)
+        _fill(kb2, 3)
+        kb1.sync_graph()
+        kb2.sync_graph()
+        assert kb1.kb_id != kb2.kb_id
+        assert kb1.check(repair=False).ok and kb2.check(repair=False).ok
+        rows = kb1.query("SELECT (COUNT(?o) AS ?n) WHERE { GRAPH ?g { ?o a hiper:Observation } }")
+        assert int(rows[0]["n"].value) >= 18  # both robots' observations on one endpoint
+
+
+def test_errors_name_the_problem(tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(KnowledgeBaseError, match="is a file, not a knowledge-base directory"):
+        open_kb(tmp_path / "file")
+    with pytest.raises(KnowledgeBaseError, match="no knowledge base there"):
+        open_kb(tmp_path / "missing", read_only=True)
+    with pytest.raises(KnowledgeBaseError, match="no SPARQL endpoint answers"):
+        open_kb("http://127.0.0.1:9", docs_dir=tmp_path / "d")
+    with pytest.raises(KnowledgeBaseError, match="observation_detail"):
+        KbConfig(observation_detail="everything")
+    (tmp_path / "bad.hiper").mkdir()
+    (tmp_path / "bad.hiper" / "documents.sqlite").write_bytes(b"not a database at all" * 100)
+    with pytest.raises(KnowledgeBaseError, match="not a hiper document store"):
+        open_kb(tmp_path / "bad.hiper")
+
+
+def test_full_observation_detail(tmp_path):
+    with open_kb(tmp_path / "kb", config=KbConfig(observation_detail="full")) as kb:
+        _fill(kb, 3)
+        kb.sync_graph()
+        rows = kb.query("SELECT ?pose WHERE { GRAPH ?g { ?o a hiper:Observation ; hiper:poseId ?pose } }")
+        assert sorted(int(r["pose"].value) for r in rows) == [0, 0, 1, 1, 2, 2]
+    with open_kb(tmp_path / "kb") as kb:  # the detail is a property of the knowledge base
+        assert kb.config.observation_detail == "full"
+
+
+def test_ontology_parses_and_declares_the_classes():
+    import pyoxigraph as ox
+
+    triples = list(ox.parse(ontology_turtle(), format=ox.RdfFormat.TURTLE))
+    classes = {t.subject.value.rsplit("#", 1)[-1] for t in triples
+               if t.object == ox.NamedNode("http://www.w3.org/2002/07/owl#Class")}
+    assert {"Observation", "Instance", "Analysis", "Environment", "Session", "Layer"} <= classes
+    supers = {(t.subject.value.rsplit("#", 1)[-1], t.object.value) for t in triples
+              if t.predicate.value.endswith("subClassOf")}
+    assert ("Observation", "http://www.w3.org/ns/sosa/Observation") in supers

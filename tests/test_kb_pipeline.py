@@ -1,0 +1,175 @@
+"""``hiper perceive``: the pipeline writes every frame, resumes after the last committed one."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from hiper_cli.cli import app
+from hiper_cli.errors import ConfigError, KnowledgeBaseError
+from hiper_cli.graph import open_kb
+from hiper_cli.perceive import stage as stage_module
+from hiper_cli.perceive.logs import TumWriter
+from hiper_cli.pipeline import available_stages, build_stages, perceive
+from tests.kb_helpers import CAMERA, FrameList, ProbeStage, make_frame
+
+runner = CliRunner()
+
+
+def _text(result) -> str:
+    """The output with rich's line wrapping undone."""
+    return " ".join(result.output.split())
+
+
+@pytest.fixture
+def probe_registry(monkeypatch):
+    registry = {"probe": "tests.kb_helpers:ProbeStage", "ghost": "hiper_cli.perceive.ghost_stage:Ghost"}
+    monkeypatch.setattr(stage_module, "STAGES", registry)
+    import hiper_cli.pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "STAGES", registry)
+    return registry
+
+
+class Crash(Exception):
+    pass
+
+
+class CrashingStage(ProbeStage):
+    """A probe stage that dies on one frame, as an interrupted run would."""
+
+    def __init__(self, crash_at: int) -> None:
+        super().__init__()
+        self.crash_at = crash_at
+
+    def process(self, frame, world):
+        if frame.pose_id == self.crash_at:
+            raise Crash(f"frame {frame.pose_id}")
+        return super().process(frame, world)
+
+
+def _log(n=12):
+    return FrameList([make_frame(i, x_m=0.5 * i) for i in range(n)])
+
+
+def test_perceive_writes_every_frame_and_summarises(tmp_path):
+    done = []
+    with open_kb(tmp_path / "kb") as kb:
+        summary = perceive(_log(), kb, [ProbeStage()], env_name="lab",
+                           progress=lambda d, t: done.append((d, t)))
+        assert kb.check(repair=False).ok
+        (session,) = kb.docs.sessions()
+        assert session.finished and session.frames == 12
+    data = summary.to_dict()
+    assert data["frames_read"] == 12 and data["frames_total"] == 12
+    assert data["observations"] == {"background": {"floor": 12}, "foreground": {"cup": 12}}
+    assert data["instances"] == {"background": {"floor": 1}, "foreground": {"cup": 1}}
+    assert data["deleted_instances"] == 2
+    assert data["skipped"] == [{"source": "frame-x", "reason": "unreadable png (test)"}]
+    assert data["frames_skipped"] == 1
+    assert data["environment"] == "lab" and data["frames_per_s"] > 0
+    assert done[-1] == (12, 12)
+
+
+def test_resume_continues_after_the_last_committed_frame(tmp_path):
+    with open_kb(tmp_path / "kb") as kb:
+        with pytest.raises(Crash):
+            perceive(_log(), kb, [CrashingStage(crash_at=7)])
+        (session,) = kb.docs.sessions()
+        assert not session.finished and session.last_pose_id == 6 and session.frames == 7
+    with open_kb(tmp_path / "kb") as kb:
+        summary = perceive(_log(), kb, [ProbeStage()], resume=True)
+        assert summary.resumed_after_pose_id == 6
+        assert summary.frames_already_done == 7 and summary.frames_read == 5
+        (session,) = kb.docs.sessions()
+        assert session.finished and session.frames == 12
+        assert kb.docs.count(type="observation") == 24
+        # the floor instance from before the crash was reloaded into the world and kept growing
+        (floor,) = kb.instances(layer="background")
+        assert len(floor.observation_uuids) == 12
+        with pytest.raises(KnowledgeBaseError, match="nothing to resume"):
+            perceive(_log(), kb, [ProbeStage()], resume=True)
+
+
+def test_sessions_of_several_logs_accumulate_in_one_environment(tmp_path):
+    with open_kb(tmp_path / "kb") as kb:
+        for name, n in (("/logs/a", 4), ("/logs/b", 3)):
+            perceive(FrameList([make_frame(i) for i in range(n)], name), kb, [ProbeStage()], env_name="house")
+        assert [e.name for e in kb.environments()] == ["house"]
+        assert [s.frames for s in kb.docs.sessions()] == [4, 3]
+        (floor,) = kb.instances(layer="background")
+        assert len(floor.observation_uuids) == 7
+
+
+def test_stage_factories_get_the_log_path_and_options(tmp_path, probe_registry):
+    stages, unavailable = build_stages(["probe"], tmp_path / "log", {"probe": {"track_frames": 3}})
+    assert stages[0].log_path == tmp_path / "log" and stages[0].track_frames == 3
+    assert unavailable == {}
+    ok, missing = available_stages()
+    assert ok == ["probe"] and "ghost" in missing
+    stages, unavailable = build_stages(None, tmp_path / "log")
+    assert [s.name for s in stages] == ["probe"] and "not available" in unavailable["ghost"]
+    with pytest.raises(ConfigError, match="not available in this version"):
+        build_stages(["ghost"], tmp_path / "log")
+    with pytest.raises(ConfigError, match="unknown stage"):
+        build_stages(["nope"], tmp_path / "log")
+    with pytest.raises(ConfigError, match="options given for stage"):
+        build_stages(["probe"], tmp_path / "log", {"ghost": {"x": 1}})
+
+
+def _tum_log(root: Path, n=6) -> Path:
+    with TumWriter(root, CAMERA) as writer:
+        for i in range(n):
+            writer.write(make_frame(i, x_m=0.2 * i))
+    return root
+
+
+def test_cli_perceive_info_check(tmp_path, probe_registry):
+    log = _tum_log(tmp_path / "kitchen")
+    kb = tmp_path / "scene.hiper"
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(kb), "--stages", "probe",
+                                 "-o", "probe.track_frames=2", "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["frames_read"] == 6 and data["environment"] == "kitchen"
+    assert data["observations"]["foreground"]["cup"] == 6
+    assert data["kb"] == str(kb)
+
+    result = runner.invoke(app, ["kb", "info", "--kb", str(kb), "--json"])
+    assert result.exit_code == 0, result.output
+    info = json.loads(result.output)
+    assert info["totals"]["observation"] == 12 and info["totals"]["environment"] == 1
+    assert info["sessions"][0]["frames"] == 6 and info["size_bytes"] > 0
+    assert info["graph_synced_seq"] == info["change_seq"]
+
+    result = runner.invoke(app, ["kb", "check", "--kb", str(kb), "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["ok"] is True
+
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(kb), "--stages", "probe", "--resume"])
+    assert result.exit_code != 0 and "nothing to resume" in _text(result)
+
+    result = runner.invoke(app, ["kb", "info", "--kb", str(kb)])
+    assert result.exit_code == 0 and "12 observations" in _text(result)
+
+
+def test_cli_perceive_errors(tmp_path, probe_registry):
+    log = _tum_log(tmp_path / "log")
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "k"), "--stages", "ghost"])
+    assert result.exit_code == 2 and "not available" in _text(result)
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "k"), "-o", "probe.x"])
+    assert result.exit_code == 2 and "STAGE.KEY=VALUE" in _text(result)
+    result = runner.invoke(app, ["perceive", str(tmp_path / "none"), "--kb", str(tmp_path / "k")])
+    assert result.exit_code == 1 and "no such file" in _text(result)
+    result = runner.invoke(app, ["kb", "info", "--kb", str(tmp_path / "empty")])
+    assert result.exit_code == 0  # created on first use, empty
+
+
+def test_cli_perceive_progress_bar_and_table(tmp_path, probe_registry):
+    log = _tum_log(tmp_path / "hall", 3)
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "kb"), "--stages", "probe"])
+    assert result.exit_code == 0, result.output
+    assert "3 frames read" in _text(result) and "floor" in result.output
