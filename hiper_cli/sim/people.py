@@ -36,7 +36,8 @@ class SocialForceConfig:
     lambda_: float = 0.35  # field-of-view anisotropy: behind counts this much
     body_radius_m: float = 0.25  # hard clearance from walls
     robot_radius_m: float = 0.35
-    goal_tolerance_m: float = 0.3
+    goal_tolerance_m: float = 0.5
+    max_turn_rps: float = 3.0  # people turn their walking direction at most this fast
     dt_s: float = 0.05  # integration step
 
 
@@ -143,8 +144,11 @@ class Crowd:
                     continue
                 force += cfg.wall_A_mps2 * math.exp((cfg.body_radius_m - d) / cfg.wall_B_m) * d_vec / d
             v = self.vel[i] + h * force
-            speed = float(np.linalg.norm(v))
-            new_vel[i] = spec.speed_mps * (v / speed if speed > 1e-9 else e)
+            want = math.atan2(v[1], v[0]) if np.linalg.norm(v) > 1e-9 else math.atan2(e[1], e[0])
+            turn = (want - self.heading[i] + math.pi) % (2 * math.pi) - math.pi
+            limit = cfg.max_turn_rps * h
+            direction = self.heading[i] + max(-limit, min(limit, turn))
+            new_vel[i] = spec.speed_mps * np.array([math.cos(direction), math.sin(direction)])
         for i in range(n):
             moved = self._move(self.pos[i], new_vel[i] * h, obstacles)
             self.walked_m[i] += float(np.linalg.norm(moved - self.pos[i]))

@@ -484,7 +484,7 @@ def _hospital(seed: int) -> World:
 
 def _office(seed: int) -> World:
     rng = np.random.default_rng(seed)
-    W, D = 16.0, 10.0
+    W, D = 16.0, 10.6
     c0 = 4.0 + float(rng.uniform(-0.2, 0.2))
     c1 = c0 + 2.2
     w = World("office", seed, (0.0, 0.0, W, D), 2.7)
@@ -527,10 +527,10 @@ def _office(seed: int) -> World:
     )
     # Meeting room (x > 7, y > c1): table, chairs, a TV.
     my = (c1 + D) / 2
-    B.table(11.5, my, 2.4, 1.1)
+    B.table(11.5, my, 2.4, 1.0)
     for dx in (-0.7, 0.0, 0.7):
-        B.chair(11.5 + dx, my - 0.85, 90.0)
-        B.chair(11.5 + dx, my + 0.85, -90.0)
+        B.chair(11.5 + dx, my - 0.78, 90.0)
+        B.chair(11.5 + dx, my + 0.78, -90.0)
     B.small_things(10.5, my - 0.4, 12.5, my + 0.4, 0.75, int(rng.integers(2, 5)))
     B.on_wall("tv", fu.tv(1.2, B.rng), W - WALL_THICKNESS_M / 2, my, 180.0, 0.9)
     B.door(W - 1.0, c1 - WALL_THICKNESS_M / 2, -90.0)
