@@ -35,6 +35,7 @@ class RouteConfig:
     camera_height_m: float = 1.2
     camera_pitch_deg: float = 12.0  # tilted down
     grid_m: float = 0.1
+    stop_distance_m: float = 1.2  # the robot waits while a person is this close in front of it
 
     def __post_init__(self) -> None:
         if not 0.0 < self.speed_mps <= 0.9:

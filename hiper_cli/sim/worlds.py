@@ -137,7 +137,8 @@ class _Builder:
 
     def floor_and_ceiling(self) -> None:
         x0, y0, x1, y1 = self.w.bounds
-        tiles = (self.color((0.72, 0.66, 0.55)), self.color((0.6, 0.52, 0.42)))
+        r, g, b = self.color((0.66, 0.6, 0.5))
+        tiles = ((r * 1.06, g * 1.06, b * 1.06), (r * 0.94, g * 0.94, b * 0.94))
         self.w.add(
             "floor_0",
             "floor",

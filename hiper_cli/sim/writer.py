@@ -26,7 +26,7 @@ from hiper_cli.sim.meshes import Mesh, human, rot_z
 from hiper_cli.sim.noise import NoiseModel, detect
 from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
 from hiper_cli.sim.render import RenderConfig, Renderer
-from hiper_cli.sim.route import RouteConfig, plan_route
+from hiper_cli.sim.route import Route, RouteConfig, plan_route
 from hiper_cli.sim.worlds import World, make_world
 
 __all__ = ["SimConfig", "SimResult", "simulate"]
@@ -81,6 +81,17 @@ class SimResult:
             "elapsed_s": round(self.elapsed_s, 3),
             "frames_per_s": round(self.frames_per_s, 2),
         }
+
+
+def _blocked(route: Route, route_t: float, people_xy: np.ndarray) -> bool:
+    """True when a person stands within the stop distance in front of the robot (±60°)."""
+    if len(people_xy) == 0:
+        return False
+    x, y, yaw = route.state_at(route_t)
+    d = people_xy - np.array([x, y])
+    dist = np.linalg.norm(d, axis=1)
+    ahead = d @ np.array([math.cos(yaw), math.sin(yaw)]) > 0.5 * dist
+    return bool(np.any((dist < route.config.stop_distance_m) & ahead))
 
 
 def _person_box(height_m: float, radius_m: float, x: float, y: float) -> Box3D:
@@ -151,11 +162,14 @@ def simulate(
     with ThreadPoolExecutor(max_workers=1) as pool, writer, (gt / "detections.jsonl").open("w") as det_fh:
         pending: Future[None] | None = None
         prev_t = 0.0
+        route_t = 0.0  # how far along its route the robot is; it waits while someone is in its way
         for k, t in enumerate(stamps):
             operating = k >= op_start
             dt = float(t - prev_t)
             prev_t = float(t)
-            x, y, _ = route.state_at(float(t))
+            if k > 0 and not _blocked(route, route_t, crowd.pos if operating else np.zeros((0, 2))):
+                route_t += dt
+            x, y, _ = route.state_at(route_t)
             if operating and k > op_start:
                 crowd.step(dt, (x, y), carts.footprints())
             carts.step(dt, operating and k > op_start)
@@ -184,7 +198,7 @@ def simulate(
                 tracks_rows.append(
                     [f"{t:.6f}", cspec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
                 )
-            T = route.pose_at(float(t))
+            T = route.pose_at(route_t)
             rng = np.random.default_rng([seed, k])
             image = renderer.render(T, dynamic, rng)
             detections = detect(image.ids, classes, cfg.noise, rng, picture_ids)
