@@ -20,7 +20,7 @@ def hospital_log(tmp_path_factory):
     """Hospital, 4 s at 5 Hz, 160×120, exact depth: mapping 1.6 s, then five people in corridor A."""
     out = tmp_path_factory.mktemp("sim") / "hospital"
     cfg = SimConfig(rate_hz=5.0, mapping_s=1.6, render=RenderConfig(width=160, height=120,
-                                                                    noise=DepthNoise(0.0, 0.0)))
+                                                                    noise=DepthNoise.off()))
     result = simulate("hospital", 4.0, 3, out, cfg)
     return out, result
 

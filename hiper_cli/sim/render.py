@@ -4,9 +4,10 @@ One ray per pixel of a pinhole camera: pixel (u, v) (integers) looks along
 ``((u - cx) / fx, (v - cy) / fy, 1)`` in the optical frame, so the hit distance along that
 unnormalised ray is the depth z. Depth gets the axial noise of a structured-light sensor,
 sigma(z) = a + b·(z - z0)² (Nguyen, Izadi and Lovell 2012, Kinect: a = 1.2 mm, b = 1.9 mm/m²,
-z0 = 0.4 m), is quantised to the TUM depth unit and is 0 (no return) below the minimum and
-beyond the maximum range; instance ids are 0 wherever depth is 0. RGB is the triangle colour
-with Lambert shading from a head light and a ceiling light.
+z0 = 0.4 m), is quantised in disparity (1/8 pixel, like a Kinect) and to the TUM depth
+unit, and is 0 (no return) below the minimum and beyond the maximum range; instance ids
+are 0 wherever depth is 0. RGB is the triangle colour with Lambert shading from a head
+light and a ceiling light.
 """
 
 from __future__ import annotations
@@ -27,11 +28,22 @@ __all__ = ["DepthNoise", "RenderConfig", "RenderOutput", "Renderer", "camera_for
 
 @dataclass(frozen=True)
 class DepthNoise:
-    """Axial depth noise sigma(z) = a_m + b_per_m · (z - z0_m)² (metres); zero a and b turn it off."""
+    """Axial depth noise sigma(z) = a_m + b_per_m · (z - z0_m)² (metres), then disparity quantisation.
+
+    A structured-light sensor measures disparity d = fb / z in steps of ``disparity_step_px``
+    (Kinect: 1/8 pixel, fb = 580 px × 0.075 m = 43.5 px·m), so depth comes in steps that
+    grow as z² (1.1 cm at 2 m, 4.6 cm at 4 m). ``DepthNoise.off()`` gives exact depth.
+    """
 
     a_m: float = 0.0012
     b_per_m: float = 0.0019
     z0_m: float = 0.4
+    disparity_step_px: float = 0.125
+    focal_baseline_px_m: float = 43.5
+
+    @classmethod
+    def off(cls) -> DepthNoise:
+        return cls(0.0, 0.0, 0.4, 0.0)
 
     def sigma_m(self, z_m: NDArray[Any]) -> NDArray[Any]:
         return self.a_m + self.b_per_m * (z_m - self.z0_m) ** 2
@@ -39,6 +51,15 @@ class DepthNoise:
     @property
     def enabled(self) -> bool:
         return self.a_m > 0.0 or self.b_per_m > 0.0
+
+    def quantise(self, z_m: NDArray[np.float32]) -> NDArray[np.float32]:
+        """Depth rounded to the nearest disparity step (unchanged when the step is 0)."""
+        if self.disparity_step_px <= 0:
+            return z_m
+        fb = self.focal_baseline_px_m
+        with np.errstate(divide="ignore"):
+            d = np.round(fb / z_m / self.disparity_step_px) * self.disparity_step_px
+            return np.where((z_m > 0) & (d > 0), fb / np.maximum(d, 1e-9), 0.0).astype(np.float32)
 
 
 @dataclass(frozen=True)
@@ -149,6 +170,7 @@ class Renderer:
         if self.cfg.noise.enabled:
             sigma = self.cfg.noise.sigma_m(z).astype(np.float32)
             z = (z + rng.standard_normal(z.shape, dtype=np.float32) * sigma).astype(np.float32)
+        z = self.cfg.noise.quantise(z)
         z = (np.round(z * self.cfg.depth_scale) / self.cfg.depth_scale).astype(np.float32)
         valid &= z > 0
         depth = np.where(valid, z, np.float32(0.0)).astype(np.float32).reshape(shape)

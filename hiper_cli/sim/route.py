@@ -33,7 +33,7 @@ class RouteConfig:
     turn_rate_rps: float = 0.7
     robot_radius_m: float = 0.35
     camera_height_m: float = 1.2
-    camera_pitch_deg: float = 12.0  # tilted down
+    camera_pitch_deg: float = 6.0  # tilted slightly down
     grid_m: float = 0.1
     stop_distance_m: float = 1.2  # the robot waits while a person is this close in front of it
 

@@ -146,8 +146,9 @@ def simulate(
     writer = TumWriter(root, renderer.camera, overwrite=overwrite)
     gt = root / "gt"
     (gt / "instance_ids").mkdir(parents=True, exist_ok=True)
-    for stale in (gt / "instance_ids").glob("*.png"):
-        stale.unlink()
+    for folder in ("rgb", "depth", "gt/instance_ids"):  # with overwrite: drop images of an older log
+        for stale in (root / folder).glob("*.png"):
+            stale.unlink()
     first_box: dict[int, Box3D] = {}
     tracks_rows: list[list[Any]] = []
     png = [cv2.IMWRITE_PNG_COMPRESSION, int(cfg.png_compression)]
