@@ -57,7 +57,10 @@ _register_commands()
 def main() -> None:
     """Entry point of the ``hiper`` script: one red line and a non-zero exit on HiperError."""
     try:
-        app(standalone_mode=False)
+        # In non-standalone mode click returns the code of a typer.Exit instead of raising it.
+        code = app(standalone_mode=False)
+        if isinstance(code, int) and code != 0:
+            sys.exit(code)
     except HiperError as err:
         from hiper_cli.commands._render import print_error
 

@@ -84,8 +84,8 @@ def test_associations_file_and_preset_camera(tmp_path):
     frames = make_frames(n=3, detections=False)
     root = write_tum(tmp_path / "rgbd_dataset_freiburg3_tiny", frames)
     (root / "camera.json").unlink()
-    with pytest.raises(LogError, match="image is 32×24 but the camera intrinsics are for 640×480"):
-        list(open_log(root))
+    with pytest.raises(LogError, match=r"is 32×24 but the camera intrinsics \(preset fr3\) are for 640×480"):
+        open_log(root)
     (root / "camera.json").write_text(json.dumps(CAMERA.to_dict()))
     rgb = [ln.split() for ln in (root / "rgb.txt").read_text().splitlines() if not ln.startswith("#")]
     (root / "rgb.txt").unlink()
@@ -100,7 +100,9 @@ def test_associations_file_and_preset_camera(tmp_path):
 def test_preset_chosen_from_folder_name(tmp_path):
     from hiper_cli.perceive.logs import TUM_PRESETS
 
-    root = write_tum(tmp_path / "rgbd_dataset_freiburg1_xyz", make_frames(n=2, detections=False))
+    fr1 = TUM_PRESETS["fr1"]
+    frames = make_frames(n=2, detections=False, camera=fr1)
+    root = write_tum(tmp_path / "rgbd_dataset_freiburg1_xyz", frames, camera=fr1)
     (root / "camera.json").unlink()
     info = open_log(root).info()
     assert info.camera == TUM_PRESETS["fr1"]
@@ -136,3 +138,14 @@ def test_writer_refuses_non_increasing_stamps(tmp_path):
             writer.write(frames[0])
     with pytest.raises(LogError, match="folder exists and is not empty"):
         TumWriter(tmp_path / "log", CAMERA)
+
+
+def test_depth_scale_flag_applies_to_a_tum_folder(tmp_path):
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+
+    root = write_tum(tmp_path / "log", make_frames(n=2, detections=False))
+    result = CliRunner().invoke(app, ["info", str(root), "--depth-scale", "1000", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["camera"]["depth_scale"] == 1000.0

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 from hiper_cli.errors import LogError
+from hiper_cli.perceive.logs.bag_writer import BAG_KINDS, BagLayout, BagWriter
 from hiper_cli.perceive.logs.base import LogInfo, StampGap
 from hiper_cli.perceive.logs.topics import BagTopics
 from hiper_cli.perceive.logs.trajectory import Trajectory, read_tum_trajectory, write_tum_trajectory
@@ -27,14 +28,18 @@ from hiper_cli.perceive.logs.tum_writer import TumWriter
 from hiper_cli.types import CameraIntrinsics, Frame
 
 __all__ = [
+    "BAG_KINDS",
     "TUM_PRESETS",
+    "BagLayout",
     "BagTopics",
+    "BagWriter",
     "LogInfo",
     "LogReader",
     "StampGap",
     "Trajectory",
     "TumWriter",
     "detect_format",
+    "load_camera_json",
     "open_log",
     "read_tum_trajectory",
     "write_tum_trajectory",

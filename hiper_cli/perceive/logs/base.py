@@ -102,8 +102,8 @@ class LogInfo:
             "path": self.path,
             "format": self.format,
             "frames": self.frames,
-            "first_stamp_s": float(self.stamps_s[0]) if self.frames else None,
-            "last_stamp_s": float(self.stamps_s[-1]) if self.frames else None,
+            "first_stamp_s": round(float(self.stamps_s[0]), 6) if self.frames else None,
+            "last_stamp_s": round(float(self.stamps_s[-1]), 6) if self.frames else None,
             "duration_s": round(self.duration_s, 6),
             "rate_hz": round(self.rate_hz, 4),
             "resolution": list(self.resolution),
@@ -129,7 +129,7 @@ class LogInfo:
         return out
 
 
-@dataclass
+@dataclass(eq=False)
 class IndexedLog:
     """Base of the readers: subclasses fill ``entries`` and implement ``_read_images``."""
 
@@ -167,10 +167,23 @@ class IndexedLog:
             skipped=tuple(self.index_skipped),
         )
 
+    def _decoded(self) -> Iterator[tuple[int, tuple[NDArray[np.uint8], NDArray[np.float32]] | LogError]]:
+        """Every frame's images in order, or the error that kept them from being read."""
+        for pose_id, entry in enumerate(self.entries):
+            try:
+                yield pose_id, self._read_images(entry)
+            except LogError as err:
+                yield pose_id, err
+
     def read_frame(self, pose_id: int) -> Frame:
         """Decode frame ``pose_id`` (raises ``LogError`` when its images cannot be read)."""
+        if not 0 <= pose_id < len(self.entries):
+            raise LogError(f"{self.path}: frame {pose_id} does not exist; the log has {len(self.entries)} "
+                           "frames")
+        return self._make_frame(pose_id, *self._read_images(self.entries[pose_id]))
+
+    def _make_frame(self, pose_id: int, rgb: NDArray[np.uint8], depth_m: NDArray[np.float32]) -> Frame:
         entry = self.entries[pose_id]
-        rgb, depth_m = self._read_images(entry)
         if rgb.shape[:2] != depth_m.shape:
             raise LogError(f"{entry.source}: rgb is {rgb.shape[1]}×{rgb.shape[0]} but depth is "
                            f"{depth_m.shape[1]}×{depth_m.shape[0]}; register depth to the colour camera")
@@ -193,9 +206,12 @@ class IndexedLog:
         self.skipped = list(self.index_skipped)
         yielded = 0
         first_reason = ""
-        for pose_id, entry in enumerate(self.entries):
+        for pose_id, result in self._decoded():
+            entry = self.entries[pose_id]
             try:
-                frame = self.read_frame(pose_id)
+                if isinstance(result, LogError):
+                    raise result
+                frame = self._make_frame(pose_id, *result)
             except LogError as err:
                 self.skipped.append((entry.source, str(err)))
                 first_reason = first_reason or str(err)

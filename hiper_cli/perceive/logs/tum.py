@@ -26,7 +26,8 @@ from hiper_cli.perceive.logs.images import read_depth_png, read_rgb_file
 from hiper_cli.perceive.logs.trajectory import Trajectory, read_tum_trajectory
 from hiper_cli.types import CameraIntrinsics, Detections
 
-__all__ = ["TUM_PRESETS", "TumReader", "associate", "is_tum_folder", "load_camera_json", "open_tum"]
+__all__ = ["TUM_PRESETS", "TumReader", "associate", "is_tum_folder", "load_camera_json", "open_tum",
+           "tum_camera"]
 
 # Freiburg calibrations published with the TUM RGB-D benchmark (depth factor 5000).
 TUM_PRESETS: dict[str, CameraIntrinsics] = {
@@ -130,7 +131,8 @@ def associate(a_s: NDArray[np.float64], b_s: NDArray[np.float64], max_dt_s: floa
     return sorted(pairs)
 
 
-def _camera_for(root: Path, camera: CameraIntrinsics | None) -> tuple[CameraIntrinsics, str]:
+def tum_camera(root: Path, camera: CameraIntrinsics | None = None) -> tuple[CameraIntrinsics, str]:
+    """The intrinsics of a TUM folder and where they came from (see the module docstring)."""
     if camera is not None:
         return camera, "flags"
     if (root / "camera.json").is_file():
@@ -169,10 +171,23 @@ class TumReader(IndexedLog):
         return read_rgb_file(rgb_path), read_depth_png(depth_path, self.camera.depth_scale)
 
 
+def _check_size(entry: FrameEntry, camera: CameraIntrinsics, camera_source: str) -> None:
+    """Refuse intrinsics of another size than the first readable colour image, before iterating."""
+    try:
+        rgb = read_rgb_file(entry.locator[0])
+    except LogError:
+        return  # counted as a skipped frame while iterating
+    height, width = rgb.shape[:2]
+    if (width, height) != (camera.width, camera.height):
+        raise LogError(f"{entry.locator[0]}: image is {width}×{height} but the camera intrinsics "
+                       f"({camera_source}) are for {camera.width}×{camera.height}; pass the right "
+                       "camera.json or camera flags")
+
+
 def open_tum(root: Path, *, poses: Trajectory | None = None, camera: CameraIntrinsics | None = None,
              max_dt_s: float = 0.02) -> TumReader:
     """Index a TUM folder; ``poses`` replaces ``groundtruth.txt``, ``camera`` the folder's intrinsics."""
-    cam, camera_source = _camera_for(root, camera)
+    cam, camera_source = tum_camera(root, camera)
     assoc = next((root / n for n in ASSOCIATION_FILES if (root / n).is_file()), None)
     if assoc is not None:
         rows = _read_associations(assoc)
@@ -229,6 +244,7 @@ def open_tum(root: Path, *, poses: Trajectory | None = None, camera: CameraIntri
         raise LogError(f"{root}: no image stamp lies within the poses' time span "
                        f"{trajectory.stamps_s[0]:.6f}..{trajectory.stamps_s[-1]:.6f}; "
                        "check that --poses belongs to this log")
+    _check_size(entries[0], cam, camera_source)
     return TumReader(
         path=str(root), format="tum", camera=cam, entries=entries, pose_source=pose_source,
         sources=sources, has_detections=det_stamps is not None, index_skipped=index_skipped,

@@ -1,0 +1,130 @@
+"""``hiper info LOG``: what a sensor log holds (frames, rate, camera, poses, detections, gaps)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from hiper_cli.commands._log_options import (
+    CAMERA_FRAME_OPTION,
+    CAMERA_OPTION,
+    CX_OPTION,
+    CY_OPTION,
+    DEPTH_SCALE_OPTION,
+    DEPTH_TOPIC_OPTION,
+    DETECTIONS_TOPIC_OPTION,
+    FX_OPTION,
+    FY_OPTION,
+    HEIGHT_OPTION,
+    INFO_TOPIC_OPTION,
+    LOG_ARGUMENT,
+    MAP_FRAME_OPTION,
+    MAX_DT_OPTION,
+    POSE_TOPIC_OPTION,
+    POSES_OPTION,
+    PRESET_OPTION,
+    RGB_TOPIC_OPTION,
+    WIDTH_OPTION,
+    open_log_from_flags,
+)
+from hiper_cli.commands._render import JSON_OPTION, console, print_json
+
+HELP = (
+    "Show what a sensor log holds: frames, rate, duration, resolution, intrinsics, pose source, "
+    "detections and stamp gaps.\n\n"
+    "Example: hiper info rgbd_dataset_freiburg1_xyz --poses slam.txt --json"
+)
+
+
+def info(
+    log: Path = LOG_ARGUMENT,
+    json_out: bool = JSON_OPTION,
+    frames: bool = typer.Option(False, "--frames", help="Also list every frame's stamp and pose."),
+    check: bool = typer.Option(
+        False, "--check", help="Decode every image and report the frames that cannot be read."
+    ),
+    poses: Path | None = POSES_OPTION,
+    camera: Path | None = CAMERA_OPTION,
+    preset: str | None = PRESET_OPTION,
+    fx: float | None = FX_OPTION,
+    fy: float | None = FY_OPTION,
+    cx: float | None = CX_OPTION,
+    cy: float | None = CY_OPTION,
+    width: int | None = WIDTH_OPTION,
+    height: int | None = HEIGHT_OPTION,
+    depth_scale: float | None = DEPTH_SCALE_OPTION,
+    max_dt: float = MAX_DT_OPTION,
+    rgb_topic: str | None = RGB_TOPIC_OPTION,
+    depth_topic: str | None = DEPTH_TOPIC_OPTION,
+    info_topic: str | None = INFO_TOPIC_OPTION,
+    pose_topic: str | None = POSE_TOPIC_OPTION,
+    detections_topic: str | None = DETECTIONS_TOPIC_OPTION,
+    map_frame: str = MAP_FRAME_OPTION,
+    camera_frame: str | None = CAMERA_FRAME_OPTION,
+) -> None:
+    reader = open_log_from_flags(
+        log, poses=poses, camera=camera, preset=preset, fx=fx, fy=fy, cx=cx, cy=cy, width=width,
+        height=height, depth_scale=depth_scale, max_dt=max_dt, rgb_topic=rgb_topic,
+        depth_topic=depth_topic, info_topic=info_topic, pose_topic=pose_topic,
+        detections_topic=detections_topic, map_frame=map_frame, camera_frame=camera_frame,
+    )
+    summary = reader.info()
+    data = summary.to_dict(frames=frames)
+    if check:
+        readable = sum(1 for _ in reader)
+        data["readable_frames"] = readable
+        data["skipped"] = [{"source": s, "reason": r} for s, r in reader.skipped]
+    if json_out:
+        print_json(data)
+        return
+    _render(data)
+
+
+def _render(data: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    cam = data["camera"]
+    table = Table(title=f"{data['path']} ({data['format']})", show_header=False)
+    table.add_column("what", style="bold")
+    table.add_column("value")
+    rows = [
+        ("frames", str(data["frames"])),
+        ("rate", f"{data['rate_hz']:.3f} Hz"),
+        ("duration", f"{data['duration_s']:.3f} s"),
+        ("stamps", f"{data['first_stamp_s']:.6f} .. {data['last_stamp_s']:.6f}"),
+        ("resolution", f"{cam['width']}×{cam['height']}"),
+        ("intrinsics", f"fx {cam['fx']:.2f} fy {cam['fy']:.2f} cx {cam['cx']:.2f} cy {cam['cy']:.2f} "
+                       f"depth scale {cam['depth_scale']:g}"
+                       + (f" distortion {cam['distortion']}" if cam.get("distortion") else "")),
+        ("pose source", data["pose_source"]),
+        ("detections", "yes" if data["has_detections"] else "no"),
+        ("stamp gaps", ", ".join(f"{g['gap_s']:.3f} s after {g['after_stamp_s']:.3f}"
+                                 for g in data["stamp_gaps"][:5])
+         + (f" (+{len(data['stamp_gaps']) - 5} more)" if len(data["stamp_gaps"]) > 5 else "") or "none"),
+    ]
+    rows += [(f"source: {role}", where) for role, where in data["sources"].items()]
+    if "readable_frames" in data:
+        rows.append(("readable", f"{data['readable_frames']} of {data['frames']}"))
+    rows.append(("skipped", str(len(data["skipped"]))))
+    for name, value in rows:
+        table.add_row(name, value)
+    out = console()
+    out.print(table)
+    for item in data["skipped"][:10]:
+        out.print(f"[yellow]skipped[/] {item['source']}: {item['reason']}")
+    if len(data["skipped"]) > 10:
+        out.print(f"[yellow]... {len(data['skipped']) - 10} more skipped[/]")
+    if data.get("frame_list"):
+        frames = Table(title="frames")
+        for column in ("pose_id", "stamp_s", "x y z qx qy qz qw"):
+            frames.add_column(column)
+        for item in data["frame_list"]:
+            frames.add_row(str(item["pose_id"]), f"{item['stamp_s']:.6f}",
+                           " ".join(f"{v:.4f}" for v in item["pose_xyz_qxyzw"]))
+        out.print(frames)
+
+
+def register(app: typer.Typer) -> None:
+    app.command(name="info", help=HELP)(info)

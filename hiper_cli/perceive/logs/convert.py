@@ -1,0 +1,52 @@
+"""Copy a sensor log into another format: TUM folder, rosbag1, rosbag2 (sqlite3) or MCAP."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.logs import LogReader
+from hiper_cli.perceive.logs.bag_writer import BAG_KINDS, BagLayout, BagWriter
+from hiper_cli.perceive.logs.tum_writer import TumWriter
+from hiper_cli.types import Frame
+
+__all__ = ["CONVERT_TARGETS", "ConvertResult", "convert_log"]
+
+CONVERT_TARGETS = ("tum", *BAG_KINDS)
+TUM_DEPTH_SCALE = 5000.0  # TUM RGB-D convention: depth PNG units per metre
+
+
+@dataclass(frozen=True)
+class ConvertResult:
+    output: str
+    to: str
+    frames_written: int
+    skipped: list[tuple[str, str]] = field(default_factory=list)
+
+
+def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayout | None = None,
+                overwrite: bool = False, on_frame: Callable[[Frame], None] | None = None) -> ConvertResult:
+    """Write every readable frame of ``reader`` (a ``LogReader``) to ``out`` in format ``to``.
+
+    ``layout`` sets the bag topics, frames and encodings; ``overwrite`` lets a TUM output
+    reuse a non-empty folder (bags are never overwritten). TUM output stores depth at
+    5000 units per metre (the TUM convention; depths beyond 13.1 m become invalid).
+    """
+    if to not in CONVERT_TARGETS:
+        raise ConfigError(f"--to {to}: unknown format; expected one of {', '.join(CONVERT_TARGETS)}")
+    camera = reader.info().camera
+    writer: TumWriter | BagWriter
+    if to == "tum":
+        writer = TumWriter(out, replace(camera, depth_scale=TUM_DEPTH_SCALE), overwrite=overwrite)
+    else:
+        writer = BagWriter(out, to, camera, layout or BagLayout())
+    written = 0
+    with writer:
+        for frame in reader:
+            writer.write(frame)
+            written += 1
+            if on_frame is not None:
+                on_frame(frame)
+    return ConvertResult(str(out), to, written, list(reader.skipped))
