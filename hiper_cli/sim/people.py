@@ -160,16 +160,14 @@ class Crowd:
             direction = self.heading[i] + max(-limit, min(limit, turn))
             new_vel[i] = spec.speed_mps * np.array([math.cos(direction), math.sin(direction)])
         for i in range(n):
-            moved = self._move(self.pos[i], new_vel[i] * h, obstacles)
+            moved = self._move(self.pos[i], new_vel[i] * h)
             self.walked_m[i] += float(np.linalg.norm(moved - self.pos[i]))
             self.pos[i] = moved
             self.vel[i] = new_vel[i]
             if np.linalg.norm(new_vel[i]) > 1e-6:
                 self.heading[i] = math.atan2(new_vel[i][1], new_vel[i][0])
 
-    def _move(
-        self, p: NDArray[np.float64], step: NDArray[np.float64], obstacles: list[Rect]
-    ) -> NDArray[np.float64]:
+    def _move(self, p: NDArray[np.float64], step: NDArray[np.float64]) -> NDArray[np.float64]:
         """Move by ``step`` but keep ``body_radius_m`` clear of every wall.
 
         A step into a wall turns along the wall at the same length (people slide past walls
@@ -200,9 +198,6 @@ class Crowd:
                     return p.copy()
                 q = near + d_vec / d * self.cfg.body_radius_m
         return q
-
-    def active(self) -> list[int]:
-        return list(range(len(self.specs)))
 
     def stride(self, i: int) -> float:
         """Leg swing in [-1, 1] from the distance walked (a 1.4 m gait cycle)."""

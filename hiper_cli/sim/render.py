@@ -147,7 +147,7 @@ class Renderer:
         # one black colour row at the end for rays that hit nothing
         all_colors = np.concatenate([*(m.colors for _, m in items), np.zeros((1, 3))]).astype(np.float32)
         R = T_map_cam[:3, :3].astype(np.float32)
-        dirs = self._dirs_cam @ R.T
+        dirs = _matmul3(self._dirs_cam, R.T)
         rays = np.empty((len(dirs), 6), dtype=np.float32)
         rays[:, :3] = T_map_cam[:3, 3]
         rays[:, 3:] = dirs
@@ -156,7 +156,7 @@ class Renderer:
         ok = np.isfinite(t_hit)
         gids = np.where(ok, hit["geometry_ids"].numpy(), len(items)).astype(np.int64)
         prims = np.where(ok, hit["primitive_ids"].numpy(), 0).astype(np.int64)
-        n_cam = hit["primitive_normals"].numpy() @ R  # normals in the camera frame
+        n_cam = _matmul3(hit["primitive_normals"].numpy(), R)  # normals in the camera frame
         shape = (self.camera.height, self.camera.width)
 
         base = all_colors[offsets[gids] + prims]
@@ -182,3 +182,8 @@ def _tensor(array: NDArray[Any]) -> Any:
     import open3d as o3d
 
     return o3d.core.Tensor(array)  # type: ignore[call-overload]
+
+
+def _matmul3(a: NDArray[np.float32], M: NDArray[np.float32]) -> NDArray[np.float32]:
+    """``a @ M`` for (N, 3) × (3, 3); numpy's matmul is slow for such thin matrices."""
+    return (a[:, 0:1] * M[0] + a[:, 1:2] * M[1] + a[:, 2:3] * M[2]).astype(np.float32, copy=False)
