@@ -37,8 +37,8 @@ class SocialForceConfig:
     lambda_: float = 0.35  # field-of-view anisotropy: behind counts this much
     body_radius_m: float = 0.25  # hard clearance from walls
     robot_radius_m: float = 0.35
-    robot_A_mps2: float = 4.0  # people give the robot a wider berth than each other
-    robot_B_m: float = 0.4
+    robot_A_mps2: float = 2.1  # people give way to the robot like to another person
+    robot_B_m: float = 0.3
     replan_s: float = 1.0  # re-plan the path when its next point is out of sight, this often
     goal_tolerance_m: float = 0.5
     max_turn_rps: float = 3.0  # people turn their walking direction at most this fast

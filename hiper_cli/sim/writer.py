@@ -84,13 +84,13 @@ class SimResult:
 
 
 def _blocked(route: Route, route_t: float, people_xy: np.ndarray) -> bool:
-    """True when a person stands within the stop distance in front of the robot (±60°)."""
+    """True when a person stands within the stop distance in front of the robot (±30°)."""
     if len(people_xy) == 0:
         return False
     x, y, yaw = route.state_at(route_t)
     d = people_xy - np.array([x, y])
     dist = np.linalg.norm(d, axis=1)
-    ahead = d @ np.array([math.cos(yaw), math.sin(yaw)]) > 0.5 * dist
+    ahead = d @ np.array([math.cos(yaw), math.sin(yaw)]) > math.cos(math.radians(30.0)) * dist
     return bool(np.any((dist < route.config.stop_distance_m) & ahead))
 
 
@@ -164,12 +164,18 @@ def simulate(
         pending: Future[None] | None = None
         prev_t = 0.0
         route_t = 0.0  # how far along its route the robot is; it waits while someone is in its way
+        waited_s = 0.0
         for k, t in enumerate(stamps):
             operating = k >= op_start
             dt = float(t - prev_t)
             prev_t = float(t)
-            if k > 0 and not _blocked(route, route_t, crowd.pos if operating else np.zeros((0, 2))):
-                route_t += dt
+            if k > 0:
+                in_way = _blocked(route, route_t, crowd.pos if operating else np.zeros((0, 2)))
+                if in_way and waited_s < cfg.route.max_wait_s:
+                    waited_s += dt
+                else:
+                    route_t += dt
+                    waited_s = 0.0 if not in_way else waited_s
             x, y, _ = route.state_at(route_t)
             if operating and k > op_start:
                 crowd.step(dt, (x, y), carts.footprints())
