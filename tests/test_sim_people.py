@@ -31,16 +31,15 @@ def _walk(world_name, seed, seconds, dt=0.1):
     return world, np.array(stamps), np.array(positions)  # (T,), (T, N, 2)
 
 
-@pytest.mark.parametrize("seed", [1, 2])
-def test_hospital_corridor_people_walk_at_0_6_mps(seed):
-    world, stamps, pos = _walk("hospital", seed, 90.0)
+def test_hospital_corridor_people_walk_at_0_6_mps():
+    world, stamps, pos = _walk("hospital", 2, 75.0)
     assert pos.shape[1] == 5
     speed = np.linalg.norm(np.diff(pos, axis=0), axis=2) / np.diff(stamps)[:, None]
     assert np.all(np.abs(speed - 0.6) <= 0.05), f"speeds from {speed.min():.3f} to {speed.max():.3f} m/s"
     # all five stay in corridor A (south of the rooms); corridor B (the parallel one) stays empty
     assert pos[:, :, 1].max() < world.bounds[3] / 2 - 1.5
-    # they cover the corridor: each walks more than 30 m in 90 s
-    assert np.all(np.linalg.norm(np.diff(pos, axis=0), axis=2).sum(axis=0) > 30.0)
+    # they cover the corridor: each walks more than 40 m in 75 s
+    assert np.all(np.linalg.norm(np.diff(pos, axis=0), axis=2).sum(axis=0) > 40.0)
 
 
 def test_truth_tracks_speed_matches_the_walk(tmp_path):
@@ -60,7 +59,7 @@ def test_truth_tracks_speed_matches_the_walk(tmp_path):
 
 @pytest.mark.parametrize("world_name", ["house", "hospital", "office"])
 def test_nobody_walks_through_a_wall(world_name):
-    world, _, pos = _walk(world_name, 4, 80.0)
+    world, _, pos = _walk(world_name, 4, 60.0)
     n = pos.shape[1]
     assert n >= 1
     for i in range(n):
