@@ -61,7 +61,7 @@ def register(app: HiperTyper) -> None:
                 width=width,
                 height=height,
                 max_range_m=max_range_m,
-                noise=DepthNoise() if depth_noise else DepthNoise(0.0, 0.0),
+                noise=DepthNoise() if depth_noise else DepthNoise.off(),
             ),
             route=RouteConfig(speed_mps=speed_mps),
             noise=NoiseModel(

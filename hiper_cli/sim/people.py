@@ -3,7 +3,8 @@
 Each person feels (1) attraction to the next point of an A* path to their goal, relaxing
 to the preferred velocity in ``tau_s``; (2) exponential repulsion from every other person
 and from the robot, weighted by the field of view (anisotropy ``lambda_``); (3) exponential
-repulsion from walls and furniture footprints. The forces set the walking direction; the
+repulsion from walls and furniture footprints. The forces set the walking direction (toward the
+velocity the model relaxes to, v0·e + tau·F, turning at most ``max_turn_rps``); the
 speed stays the preferred speed (the paper's hospital people walk at a constant 0.6 m/s),
 so people steer around each other instead of slowing down. A hard constraint keeps the
 body centre at least ``body_radius_m`` from any wall.
@@ -36,7 +37,11 @@ class SocialForceConfig:
     lambda_: float = 0.35  # field-of-view anisotropy: behind counts this much
     body_radius_m: float = 0.25  # hard clearance from walls
     robot_radius_m: float = 0.35
-    goal_tolerance_m: float = 0.3
+    robot_A_mps2: float = 2.1  # people give way to the robot like to another person
+    robot_B_m: float = 0.3
+    replan_s: float = 1.0  # re-plan the path when its next point is out of sight, this often
+    goal_tolerance_m: float = 0.5
+    max_turn_rps: float = 3.0  # people turn their walking direction at most this fast
     dt_s: float = 0.05  # integration step
 
 
@@ -61,6 +66,7 @@ class Crowd:
         self.walked_m = np.zeros(n)
         self.goal_index = [s.start_goal for s in self.specs]
         self.pause_until = np.zeros(n)
+        self.next_check = np.zeros(n)
         self.paths: list[list[XY]] = [[] for _ in self.specs]
         self.t_s = 0.0
         for i in range(n):
@@ -107,6 +113,10 @@ class Crowd:
             path = self.paths[i]
             while path and math.dist(tuple(self.pos[i]), path[0]) < cfg.goal_tolerance_m:
                 path.pop(0)
+            if path and self.t_s >= self.next_check[i]:
+                self.next_check[i] = self.t_s + cfg.replan_s
+                if not self.grid.line_free(tuple(self.pos[i]), path[0]):
+                    self.paths[i] = path = self.grid.astar(tuple(self.pos[i]), path[-1])[1:]
             if not path:
                 if spec.goals:
                     self.goal_index[i] += 1
@@ -120,13 +130,13 @@ class Crowd:
                 path = self.paths[i]
             to_goal = np.asarray(path[0]) - self.pos[i]
             e = to_goal / max(np.linalg.norm(to_goal), 1e-9)
-            force = (spec.speed_mps * e - self.vel[i]) / cfg.tau_s
+            force = np.zeros(2)  # the social (repulsive) forces
             others = [self.pos[j] for j in range(n) if j != i]
-            radii = [cfg.agent_radius_m * 2] * len(others)
+            params = [(cfg.agent_radius_m * 2, cfg.agent_A_mps2, cfg.agent_B_m)] * len(others)
             if robot_xy is not None:
                 others.append(np.asarray(robot_xy))
-                radii.append(cfg.agent_radius_m + cfg.robot_radius_m)
-            for q, r_ab in zip(others, radii, strict=True):
+                params.append((cfg.agent_radius_m + cfg.robot_radius_m, cfg.robot_A_mps2, cfg.robot_B_m))
+            for q, (r_ab, A, B) in zip(others, params, strict=True):
                 d_vec = self.pos[i] - q
                 d = float(np.linalg.norm(d_vec))
                 if d > 3.0 or d < 1e-9:
@@ -134,7 +144,7 @@ class Crowd:
                 n_ab = d_vec / d
                 cos_phi = float(-n_ab @ e)
                 w = cfg.lambda_ + (1 - cfg.lambda_) * (1 + cos_phi) / 2
-                force += w * cfg.agent_A_mps2 * math.exp((r_ab - d) / cfg.agent_B_m) * n_ab
+                force += w * A * math.exp((r_ab - d) / B) * n_ab
             for r in obstacles:
                 near = _nearest_on_rect(self.pos[i], r)
                 d_vec = self.pos[i] - near
@@ -142,34 +152,52 @@ class Crowd:
                 if d > 1.5 or d < 1e-9:
                     continue
                 force += cfg.wall_A_mps2 * math.exp((cfg.body_radius_m - d) / cfg.wall_B_m) * d_vec / d
-            v = self.vel[i] + h * force
-            speed = float(np.linalg.norm(v))
-            new_vel[i] = spec.speed_mps * (v / speed if speed > 1e-9 else e)
+            # The velocity the model relaxes to: preferred velocity plus tau times the social forces.
+            v = spec.speed_mps * e + cfg.tau_s * force
+            want = math.atan2(v[1], v[0]) if np.linalg.norm(v) > 1e-9 else math.atan2(e[1], e[0])
+            turn = (want - self.heading[i] + math.pi) % (2 * math.pi) - math.pi
+            limit = cfg.max_turn_rps * h
+            direction = self.heading[i] + max(-limit, min(limit, turn))
+            new_vel[i] = spec.speed_mps * np.array([math.cos(direction), math.sin(direction)])
         for i in range(n):
-            moved = self._move(self.pos[i], new_vel[i] * h, obstacles)
+            moved = self._move(self.pos[i], new_vel[i] * h)
             self.walked_m[i] += float(np.linalg.norm(moved - self.pos[i]))
             self.pos[i] = moved
             self.vel[i] = new_vel[i]
             if np.linalg.norm(new_vel[i]) > 1e-6:
                 self.heading[i] = math.atan2(new_vel[i][1], new_vel[i][0])
 
-    def _move(
-        self, p: NDArray[np.float64], step: NDArray[np.float64], obstacles: list[Rect]
-    ) -> NDArray[np.float64]:
-        """Move by ``step`` but keep ``body_radius_m`` clear of every wall (slide along it)."""
+    def _move(self, p: NDArray[np.float64], step: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Move by ``step`` but keep ``body_radius_m`` clear of every wall.
+
+        A step into a wall turns along the wall at the same length (people slide past walls
+        without slowing down); what still breaks the clearance is pushed back out.
+        """
+        length = float(np.linalg.norm(step))
         q = p + step
         for r in self.world.walls:
             near = _nearest_on_rect(q, r)
             d_vec = q - near
             d = float(np.linalg.norm(d_vec))
+            if d >= self.cfg.body_radius_m:
+                continue
+            n_vec = p - _nearest_on_rect(p, r)
+            n_len = float(np.linalg.norm(n_vec))
+            if n_len > 1e-9 and length > 1e-9:
+                n = n_vec / n_len
+                tangent = step - min(float(step @ n), 0.0) * n
+                t_len = float(np.linalg.norm(tangent))
+                if t_len > 1e-9:
+                    step = tangent / t_len * length
+                    q = p + step
+                    near = _nearest_on_rect(q, r)
+                    d_vec = q - near
+                    d = float(np.linalg.norm(d_vec))
             if d < self.cfg.body_radius_m:
                 if d < 1e-9:
                     return p.copy()
                 q = near + d_vec / d * self.cfg.body_radius_m
         return q
-
-    def active(self) -> list[int]:
-        return list(range(len(self.specs)))
 
     def stride(self, i: int) -> float:
         """Leg swing in [-1, 1] from the distance walked (a 1.4 m gait cycle)."""

@@ -33,8 +33,10 @@ class RouteConfig:
     turn_rate_rps: float = 0.7
     robot_radius_m: float = 0.35
     camera_height_m: float = 1.2
-    camera_pitch_deg: float = 12.0  # tilted down
+    camera_pitch_deg: float = 6.0  # tilted slightly down
     grid_m: float = 0.1
+    stop_distance_m: float = 1.0  # the robot waits while a person is this close in front of it (±30°)
+    max_wait_s: float = 2.0  # ... but for at most this long, then it drives on
 
     def __post_init__(self) -> None:
         if not 0.0 < self.speed_mps <= 0.9:

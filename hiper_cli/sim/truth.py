@@ -4,6 +4,9 @@ The layout, beside the TUM RGB-D files of the log (``rgb.txt``, ``depth.txt``,
 ``groundtruth.txt`` = T_map_cam per stamp, ``camera.json``)::
 
     gt/world.json           {"world", "seed", "rate_hz", "instances": [...], "phases": [...]}
+                            plus, from hiper sim: "bounds_m" [x0, y0, x1, y1], "ceiling_m",
+                            "walls_xy" (wall footprints [x0, y0, x1, y1]), "robot" (speed, camera
+                            height and pitch); the loader ignores them
     gt/tracks.csv           stamp_s,id,x,y,z,vx,vy,vz  (box centre of every dynamic instance,
                             map frame, at every image stamp while it exists)
     gt/instance_ids/*.png   uint16 per-pixel instance id, same file stem as the rgb image,

@@ -137,7 +137,8 @@ class _Builder:
 
     def floor_and_ceiling(self) -> None:
         x0, y0, x1, y1 = self.w.bounds
-        tiles = (self.color((0.72, 0.66, 0.55)), self.color((0.6, 0.52, 0.42)))
+        r, g, b = self.color((0.66, 0.6, 0.5))
+        tiles = ((r * 1.06, g * 1.06, b * 1.06), (r * 0.94, g * 0.94, b * 0.94))
         self.w.add(
             "floor_0",
             "floor",
@@ -384,19 +385,20 @@ def _house(seed: int) -> World:
         "shelf", "foreground", fu.shelf(0.8, 1.2, B.color((0.6, 0.5, 0.4)), B.rng), a + 0.8, D - 0.2, -90.0
     )
     B.door(W - 0.8, D - WALL_THICKNESS_M / 2, -90.0)
+    # Diagonal legs look across the rooms at the furniture.
     w.waypoints = [
-        (3.3, 3.6),
-        (3.4, 0.9),
-        (a + 1.0, 1.7),
-        (W - 1.8, 2.6),
-        (a + 0.8, 2.4),
-        (3.2, 1.2),
-        (3.0, 4.6),
+        (3.9, D - 0.8),
+        (2.7, 3.6),
+        (3.9, 1.0),
+        (a + 1.2, 1.7),
+        (W - 1.6, b - 0.9),
+        (a - 1.0, 1.7),
+        (2.4, 4.6),
+        (3.6, b + 0.8),
         (a + 1.0, b + 0.8),
-        (W - 2.6, D - 0.8),
-        (a + 0.9, b + 1.2),
-        (2.6, 5.0),
-        (1.2, 3.6),
+        (a + 1.4, D - 0.9),
+        (a - 0.6, b + 0.8),
+        (1.6, 4.4),
     ]
     w.walkable = [
         (0.6, 0.6, a - 0.6, D - 0.6),
@@ -484,7 +486,7 @@ def _hospital(seed: int) -> World:
 
 def _office(seed: int) -> World:
     rng = np.random.default_rng(seed)
-    W, D = 16.0, 10.0
+    W, D = 16.0, 10.6
     c0 = 4.0 + float(rng.uniform(-0.2, 0.2))
     c1 = c0 + 2.2
     w = World("office", seed, (0.0, 0.0, W, D), 2.7)
@@ -527,10 +529,10 @@ def _office(seed: int) -> World:
     )
     # Meeting room (x > 7, y > c1): table, chairs, a TV.
     my = (c1 + D) / 2
-    B.table(11.5, my, 2.4, 1.1)
+    B.table(11.5, my, 2.4, 1.0)
     for dx in (-0.7, 0.0, 0.7):
-        B.chair(11.5 + dx, my - 0.85, 90.0)
-        B.chair(11.5 + dx, my + 0.85, -90.0)
+        B.chair(11.5 + dx, my - 0.78, 90.0)
+        B.chair(11.5 + dx, my + 0.78, -90.0)
     B.small_things(10.5, my - 0.4, 12.5, my + 0.4, 0.75, int(rng.integers(2, 5)))
     B.on_wall("tv", fu.tv(1.2, B.rng), W - WALL_THICKNESS_M / 2, my, 180.0, 0.9)
     B.door(W - 1.0, c1 - WALL_THICKNESS_M / 2, -90.0)

@@ -26,7 +26,7 @@ from hiper_cli.sim.meshes import Mesh, human, rot_z
 from hiper_cli.sim.noise import NoiseModel, detect
 from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
 from hiper_cli.sim.render import RenderConfig, Renderer
-from hiper_cli.sim.route import RouteConfig, plan_route
+from hiper_cli.sim.route import Route, RouteConfig, plan_route
 from hiper_cli.sim.worlds import World, make_world
 
 __all__ = ["SimConfig", "SimResult", "simulate"]
@@ -83,6 +83,17 @@ class SimResult:
         }
 
 
+def _blocked(route: Route, route_t: float, people_xy: np.ndarray) -> bool:
+    """True when a person stands within the stop distance in front of the robot (±30°)."""
+    if len(people_xy) == 0:
+        return False
+    x, y, yaw = route.state_at(route_t)
+    d = people_xy - np.array([x, y])
+    dist = np.linalg.norm(d, axis=1)
+    ahead = d @ np.array([math.cos(yaw), math.sin(yaw)]) > math.cos(math.radians(30.0)) * dist
+    return bool(np.any((dist < route.config.stop_distance_m) & ahead))
+
+
 def _person_box(height_m: float, radius_m: float, x: float, y: float) -> Box3D:
     return Box3D(np.array([x, y, height_m / 2.0]), np.array([2 * radius_m, 2 * radius_m, height_m]))
 
@@ -135,8 +146,9 @@ def simulate(
     writer = TumWriter(root, renderer.camera, overwrite=overwrite)
     gt = root / "gt"
     (gt / "instance_ids").mkdir(parents=True, exist_ok=True)
-    for stale in (gt / "instance_ids").glob("*.png"):
-        stale.unlink()
+    for folder in ("rgb", "depth", "gt/instance_ids"):  # with overwrite: drop images of an older log
+        for stale in (root / folder).glob("*.png"):
+            stale.unlink()
     first_box: dict[int, Box3D] = {}
     tracks_rows: list[list[Any]] = []
     png = [cv2.IMWRITE_PNG_COMPRESSION, int(cfg.png_compression)]
@@ -151,11 +163,20 @@ def simulate(
     with ThreadPoolExecutor(max_workers=1) as pool, writer, (gt / "detections.jsonl").open("w") as det_fh:
         pending: Future[None] | None = None
         prev_t = 0.0
+        route_t = 0.0  # how far along its route the robot is; it waits while someone is in its way
+        waited_s = 0.0
         for k, t in enumerate(stamps):
             operating = k >= op_start
             dt = float(t - prev_t)
             prev_t = float(t)
-            x, y, _ = route.state_at(float(t))
+            if k > 0:
+                in_way = _blocked(route, route_t, crowd.pos if operating else np.zeros((0, 2)))
+                if in_way and waited_s < cfg.route.max_wait_s:
+                    waited_s += dt
+                else:
+                    route_t += dt
+                    waited_s = 0.0 if not in_way else waited_s
+            x, y, _ = route.state_at(route_t)
             if operating and k > op_start:
                 crowd.step(dt, (x, y), carts.footprints())
             carts.step(dt, operating and k > op_start)
@@ -184,7 +205,7 @@ def simulate(
                 tracks_rows.append(
                     [f"{t:.6f}", cspec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
                 )
-            T = route.pose_at(float(t))
+            T = route.pose_at(route_t)
             rng = np.random.default_rng([seed, k])
             image = renderer.render(T, dynamic, rng)
             detections = detect(image.ids, classes, cfg.noise, rng, picture_ids)
