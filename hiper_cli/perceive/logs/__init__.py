@@ -1,0 +1,110 @@
+"""Sensor logs in, one interface: ``open_log(path)`` -> a ``LogReader`` of ``Frame``s.
+
+Formats: TUM RGB-D folders, rosbag1 (``.bag``), rosbag2 folders (sqlite3 or MCAP storage)
+and bare ``.mcap`` files. ``poses`` (a TUM trajectory file or a ``Trajectory``) replaces the
+log's own poses for any format; ``camera`` (``CameraIntrinsics`` or a ``camera.json`` path)
+replaces its intrinsics.
+
+    reader = open_log("rgbd_dataset_freiburg1_xyz")
+    print(reader.info().rate_hz)
+    for frame in reader:          # Frames in time order, pose_id = index in the log
+        ...
+    print(reader.skipped)         # [(source, reason)] of frames that could not be read
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from hiper_cli.errors import LogError
+from hiper_cli.perceive.logs.base import LogInfo, StampGap
+from hiper_cli.perceive.logs.topics import BagTopics
+from hiper_cli.perceive.logs.trajectory import Trajectory, read_tum_trajectory, write_tum_trajectory
+from hiper_cli.perceive.logs.tum import TUM_PRESETS, load_camera_json
+from hiper_cli.perceive.logs.tum_writer import TumWriter
+from hiper_cli.types import CameraIntrinsics, Frame
+
+__all__ = [
+    "TUM_PRESETS",
+    "BagTopics",
+    "LogInfo",
+    "LogReader",
+    "StampGap",
+    "Trajectory",
+    "TumWriter",
+    "detect_format",
+    "open_log",
+    "read_tum_trajectory",
+    "write_tum_trajectory",
+]
+
+
+@runtime_checkable
+class LogReader(Protocol):
+    """A sensor log: ``Frame``s in time order, its length and a summary."""
+
+    skipped: list[tuple[str, str]]
+
+    def __iter__(self) -> Iterator[Frame]: ...
+
+    def __len__(self) -> int: ...
+
+    def info(self) -> LogInfo: ...
+
+    def read_frame(self, pose_id: int) -> Frame: ...
+
+
+def detect_format(path: Path) -> str:
+    """``tum``, ``rosbag1``, ``rosbag2`` or ``mcap``; ``LogError`` when it is none of them."""
+    from hiper_cli.perceive.logs.tum import is_tum_folder
+
+    if not path.exists():
+        raise LogError(f"{path}: no such file or folder; pass a TUM folder, a .bag, a rosbag2 folder "
+                       "or an .mcap file")
+    if path.is_dir():
+        if is_tum_folder(path):
+            return "tum"
+        if (path / "metadata.yaml").is_file():
+            return "rosbag2"
+        raise LogError(f"{path}: not a log folder (no rgb.txt or associations.txt, no metadata.yaml); "
+                       "expected a TUM RGB-D folder or a rosbag2 folder")
+    suffix = path.suffix.lower()
+    if suffix == ".bag":
+        return "rosbag1"
+    if suffix == ".mcap":
+        return "mcap"
+    if suffix == ".db3" and (path.parent / "metadata.yaml").is_file():
+        return "rosbag2"
+    raise LogError(f"{path}: unknown log type '{suffix or path.name}'; expected a TUM folder, .bag, "
+                   "a rosbag2 folder or .mcap")
+
+
+def open_log(
+    path: str | Path,
+    *,
+    poses: str | Path | Trajectory | None = None,
+    camera: str | Path | CameraIntrinsics | None = None,
+    max_dt_s: float = 0.02,
+    topics: BagTopics | None = None,
+) -> LogReader:
+    """Open a sensor log for reading (see the module docstring).
+
+    ``max_dt_s``: tolerance when associating colour, depth, camera info, detections and
+    poses by timestamp. ``topics``: bag topic and tf frame choices (ignored for TUM).
+    """
+    path = Path(path)
+    kind = detect_format(path)
+    trajectory = read_tum_trajectory(poses) if isinstance(poses, str | Path) else poses
+    intrinsics = load_camera_json(Path(camera)) if isinstance(camera, str | Path) else camera
+    if max_dt_s <= 0:
+        raise LogError(f"max_dt_s must be positive, got {max_dt_s}")
+    if kind == "tum":
+        from hiper_cli.perceive.logs.tum import open_tum
+
+        return open_tum(path, poses=trajectory, camera=intrinsics, max_dt_s=max_dt_s)
+    from hiper_cli.perceive.logs.rosbag import open_bag
+
+    return open_bag(path, kind, poses=trajectory, camera=intrinsics, max_dt_s=max_dt_s,
+                    topics=topics or BagTopics())
