@@ -13,6 +13,7 @@ left on a 114 canvas; output [1, 3549, 85] = grids of strides 8, 16, 32, columns
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -31,16 +32,23 @@ _MODEL_RELPATH = Path("yolox_nano") / "yolox_nano.onnx"
 _STRIDES = (8, 16, 32)
 
 
-def find_yolox_model(model_path: str | Path | None = None) -> Path:
-    """Where the YOLOX-Nano model is; ``ConfigError`` with download instructions when absent."""
+def find_yolox_model(
+    model_path: str | Path | None = None, search_roots: Sequence[Path] | None = None
+) -> Path:
+    """Where the YOLOX-Nano model is; ``ConfigError`` with download instructions when absent.
+
+    ``search_roots`` (default: the repository and the working directory) are searched, with
+    all their parents, for ``shared/models/yolox_nano/yolox_nano.onnx``.
+    """
     tried: list[Path] = []
     if model_path is not None:
         tried.append(Path(model_path))
     env = os.environ.get("HIPER_MODELS")
     if env:
         tried.append(Path(env) / _MODEL_RELPATH)
-    repo = Path(__file__).resolve().parents[3]
-    for base in (repo, Path.cwd().resolve()):
+    if search_roots is None:
+        search_roots = (Path(__file__).resolve().parents[3], Path.cwd().resolve())
+    for base in search_roots:
         for parent in (base, *base.parents):
             tried.append(parent / "shared" / "models" / _MODEL_RELPATH)
     for path in tried:

@@ -38,7 +38,9 @@ class ForegroundConfig:
     background_margin_m: float = 0.05
     """Background boxes are grown by this much on every side before filtering."""
     cluster_tolerance_m: float = 0.1
-    """Euclidean clustering: neighbouring points closer than this join one cluster."""
+    """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
+    cluster_tolerance_per_m: float = 0.04
+    """... plus this much per metre of depth (grazing surfaces, depth noise)."""
     cluster_neighbour_cells: int = 2
     """How far (in subsampled grid cells) a neighbour may be; bridges small depth holes."""
     min_cluster_points: int = 15

@@ -6,8 +6,9 @@
    grown by a margin); the points are moved into the map frame once and tested box by box.
 3. Euclidean cluster extraction: two points join one cluster when they are at most
    ``cluster_neighbour_cells`` apart on the subsampled grid and closer than
-   ``cluster_tolerance_m`` in 3D; clusters are the connected components of that graph, kept when
-   their size lies in [``min_cluster_points``, ``max_cluster_points``] and their extent is below
+   ``cluster_tolerance_m + cluster_tolerance_per_m · depth`` in 3D (surfaces seen at a
+   grazing angle and the sensor's depth noise spread points further apart with range);
+   clusters are the connected components of that graph, kept when their size lies in [``min_cluster_points``, ``max_cluster_points``] and their extent is below
    ``max_cluster_extent_m``.
 
 Each kept cluster is a ``Blob``: its points in the camera and map frames, the full-resolution
@@ -95,7 +96,7 @@ def inside_boxes(points: FloatArray, boxes: Sequence[Box3D], margin_m: float) ->
 
 
 def _cluster_labels(
-    P: FloatArray, valid: NDArray[np.bool_], tolerance_m: float, cells: int
+    P: FloatArray, valid: NDArray[np.bool_], tolerance_m: float, per_m: float, cells: int
 ) -> NDArray[np.int64]:
     """Connected components of the organised neighbour graph; -1 for invalid points."""
     from scipy.sparse import coo_matrix
@@ -103,7 +104,6 @@ def _cluster_labels(
 
     h, w = valid.shape
     index = np.arange(h * w).reshape(h, w)
-    tol2 = tolerance_m * tolerance_m
     rows: list[NDArray[np.int64]] = []
     cols: list[NDArray[np.int64]] = []
     offsets = [(dy, dx) for dy in range(0, cells + 1) for dx in range(-cells, cells + 1) if (dy, dx) > (0, 0)]
@@ -115,8 +115,10 @@ def _cluster_labels(
         both = valid[a] & valid[b]
         if not both.any():
             continue
-        diff = P[a][both] - P[b][both]
-        close = np.einsum("ij,ij->i", diff, diff) <= tol2
+        pa = P[a][both]
+        diff = pa - P[b][both]
+        tol = tolerance_m + per_m * pa[:, 2]
+        close = np.einsum("ij,ij->i", diff, diff) <= tol * tol
         rows.append(index[a][both][close])
         cols.append(index[b][both][close])
     n = h * w
@@ -162,7 +164,9 @@ def segment(
     t2 = time.perf_counter()
     map_full = np.zeros_like(P_flat)
     map_full[idx] = pts_map
-    labels = _cluster_labels(P, valid, config.cluster_tolerance_m, config.cluster_neighbour_cells)
+    labels = _cluster_labels(
+        P, valid, config.cluster_tolerance_m, config.cluster_tolerance_per_m, config.cluster_neighbour_cells
+    )
     member = np.flatnonzero(labels >= 0)
     blobs: list[Blob] = []
     if len(member):
