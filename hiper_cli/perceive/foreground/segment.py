@@ -8,7 +8,8 @@
    ``cluster_neighbour_cells`` apart on the subsampled grid and closer than
    ``cluster_tolerance_m + cluster_tolerance_per_m · depth`` in 3D (surfaces seen at a
    grazing angle and the sensor's depth noise spread points further apart with range);
-   clusters are the connected components of that graph, kept when their size lies in [``min_cluster_points``, ``max_cluster_points``] and their extent is below
+   clusters are the connected components of that graph, kept when their size lies in
+   [``min_cluster_points``, ``max_cluster_points``] and their extent is below
    ``max_cluster_extent_m``.
 
 Each kept cluster is a ``Blob``: its points in the camera and map frames, the full-resolution
