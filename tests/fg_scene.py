@@ -95,3 +95,63 @@ def background_instances(boxes: list[SceneBox]) -> dict[str, Instance]:
             inst = Instance("background", b.class_name, Box3D(b.center, b.extent), 0.0, 0.0)
             out[inst.uuid] = inst
     return out
+
+
+def chair(id_: int, x: float, y: float) -> SceneBox:
+    return SceneBox(id_, np.array([x, y, 0.45]), np.array([0.5, 0.5, 0.9]), "chair")
+
+
+def write_sim_log(root, seconds: float = 3.0, rate_hz: float = 30.0, speed_mps: float = 0.6,
+                  fp_every: int = 0) -> None:
+    """A ``hiper sim``-shaped log: a person walking past a chair in a room, static camera.
+
+    ``fp_every``: add a false-positive detection (instance_id null) every n-th frame.
+    """
+    import json
+
+    import cv2
+
+    from hiper_cli.perceive.logs import TumWriter
+
+    root.mkdir(parents=True, exist_ok=True)
+    (root / "gt" / "instance_ids").mkdir(parents=True)
+    statics = [*room(), chair(11, 4.0, 1.0)]
+    T = pose_looking_x()
+    tracks, det_lines = [], []
+    n = int(seconds * rate_hz)
+    with TumWriter(root, CAMERA, overwrite=True) as writer:
+        for k in range(n):
+            t = 100.0 + k / rate_hz
+            y = -1.2 + speed_mps * (t - 100.0)
+            walker = person(10, 3.0, y)
+            boxes = [*statics, walker]
+            depth, ids = render(boxes, T)
+            frame = Frame(t, np.zeros((CAMERA.height, CAMERA.width, 3), np.uint8), depth, CAMERA, T, k)
+            stem = writer.write(frame)
+            cv2.imwrite(str(root / "gt" / "instance_ids" / f"{stem}.png"), ids)
+            tracks.append(f"{t:.6f},10,3.0,{y:.6f},0.85,0.0,{speed_mps},0.0")
+            records = []
+            for b in (walker, statics[-1]):
+                ys, xs = np.nonzero(ids == b.id)
+                if len(xs):
+                    records.append({"xyxy": [float(xs.min()), float(ys.min()), float(xs.max() + 1),
+                                             float(ys.max() + 1)], "class": b.class_name, "score": 0.9,
+                                    "instance_id": b.id})
+            if fp_every and k % fp_every == 0:
+                records.append({"xyxy": [10.0, 10.0, 30.0, 40.0], "class": "tv", "score": 0.5, "instance_id": None})
+            det_lines.append(json.dumps({"stamp_s": round(t, 6), "detections": records}))
+    instances = [
+        {"id": b.id, "name": b.class_name, "class": b.class_name,
+         "layer": "background" if b.background else "foreground", "state": "static",
+         "box": Box3D(b.center, b.extent).to_dict(), "plane": None, "speed_mps": None}
+        for b in statics
+    ]
+    instances.append({"id": 10, "name": "person_0", "class": "person", "layer": "foreground",
+                      "state": "dynamic", "box": Box3D(person(10, 3.0, -1.2).center, person(10, 3, 0).extent).to_dict(),
+                      "plane": None, "speed_mps": speed_mps})
+    world = {"world": "fg_test", "seed": 5, "rate_hz": rate_hz, "instances": instances,
+             "phases": [{"name": "operation", "t_start_s": 100.0, "t_end_s": 100.0 + seconds}]}
+    (root / "gt" / "world.json").write_text(json.dumps(world))
+    (root / "gt" / "tracks.csv").write_text("stamp_s,id,x,y,z,vx,vy,vz\n" + "\n".join(tracks) + "\n")
+    (root / "gt" / "detections.jsonl").write_text("\n".join(det_lines) + "\n")
+    (root / "gt" / "noise.json").write_text("{}")

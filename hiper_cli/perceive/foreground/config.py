@@ -43,6 +43,10 @@ class ForegroundConfig:
     """... plus this much per metre of depth (grazing surfaces, depth noise)."""
     cluster_neighbour_cells: int = 2
     """How far (in subsampled grid cells) a neighbour may be; bridges small depth holes."""
+    fragment_ratio: float = 0.25
+    """A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
+    fragment_distance_m: float = 0.5
+    """... when their centres are closer than this (grazing surfaces break off objects)."""
     min_cluster_points: int = 15
     max_cluster_points: int = 8000
     max_cluster_extent_m: float = 3.0

@@ -132,6 +132,46 @@ def _cluster_labels(
     return labels
 
 
+def _merge_fragments(
+    groups: list[NDArray[np.int64]], map_full: FloatArray, grid_w: int, config: ForegroundConfig
+) -> list[NDArray[np.int64]]:
+    """Fold small fragments into a much larger neighbouring cluster.
+
+    Surfaces seen at a grazing angle (the side of a body at the silhouette) break away from
+    the object they belong to: consecutive samples are far apart in depth. A fragment smaller
+    than ``fragment_ratio`` of a cluster whose grid box touches its own and whose centre is
+    within ``fragment_distance_m`` joins that cluster.
+    """
+    if len(groups) < 2:
+        return groups
+    groups = sorted(groups, key=len, reverse=True)
+    pad = config.cluster_neighbour_cells + 1
+    boxes = []
+    for g in groups:
+        gy, gx = g // grid_w, g % grid_w
+        boxes.append((gy.min() - pad, gx.min() - pad, gy.max() + pad, gx.max() + pad))
+    centres = [map_full[g].mean(axis=0) for g in groups]
+    kept: list[int] = []
+    members: dict[int, list[NDArray[np.int64]]] = {}
+    for i, g in enumerate(groups):
+        target = None
+        for j in kept:
+            if len(g) > config.fragment_ratio * len(groups[j]):
+                continue
+            a, b = boxes[i], boxes[j]
+            if a[0] > b[2] or b[0] > a[2] or a[1] > b[3] or b[1] > a[3]:
+                continue
+            if np.linalg.norm(centres[i] - centres[j]) <= config.fragment_distance_m:
+                target = j
+                break
+        if target is None:
+            kept.append(i)
+            members[i] = [g]
+        else:
+            members[target].append(g)
+    return [np.concatenate(members[i]) if len(members[i]) > 1 else members[i][0] for i in kept]
+
+
 def segment(
     depth_m: NDArray[np.float32],
     camera: CameraIntrinsics,
@@ -179,10 +219,12 @@ def segment(
         sizes = ends - starts
         U_flat, V_flat = U.ravel(), V.ravel()
         half = step / 2.0
-        for s, e, size in zip(starts, ends, sizes, strict=True):
+        groups = [member[s:e] for s, e, size in zip(starts, ends, sizes, strict=True) if size >= 3]
+        groups = _merge_fragments(groups, map_full, valid.shape[1], config)
+        for sel in groups:
+            size = len(sel)
             if size < config.min_cluster_points:
                 continue
-            sel = member[s:e]
             if size > config.max_cluster_points:
                 stats.rejected_clusters += 1
                 continue

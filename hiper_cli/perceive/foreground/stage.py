@@ -44,6 +44,11 @@ class ForegroundStage:
     ) -> None:
         self.config = ForegroundConfig.from_options(**options)
         cfg = self.config
+        # Import the heavy modules now, not inside the first frame's timing.
+        import filterpy.kalman  # noqa: F401
+        import scipy.optimize  # noqa: F401
+        import scipy.sparse.csgraph  # noqa: F401
+
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
         self._pool: ThreadPoolExecutor | None = None
         self._priors: dict[tuple[str, str], dict[str, Any]] = {}
