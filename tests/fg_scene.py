@@ -138,7 +138,8 @@ def write_sim_log(root, seconds: float = 3.0, rate_hz: float = 30.0, speed_mps: 
                                              float(ys.max() + 1)], "class": b.class_name, "score": 0.9,
                                     "instance_id": b.id})
             if fp_every and k % fp_every == 0:
-                records.append({"xyxy": [10.0, 10.0, 30.0, 40.0], "class": "tv", "score": 0.5, "instance_id": None})
+                fp = {"xyxy": [10.0, 10.0, 30.0, 40.0], "class": "tv", "score": 0.5, "instance_id": None}
+                records.append(fp)
             det_lines.append(json.dumps({"stamp_s": round(t, 6), "detections": records}))
     instances = [
         {"id": b.id, "name": b.class_name, "class": b.class_name,
@@ -147,7 +148,8 @@ def write_sim_log(root, seconds: float = 3.0, rate_hz: float = 30.0, speed_mps: 
         for b in statics
     ]
     instances.append({"id": 10, "name": "person_0", "class": "person", "layer": "foreground",
-                      "state": "dynamic", "box": Box3D(person(10, 3.0, -1.2).center, person(10, 3, 0).extent).to_dict(),
+                      "state": "dynamic",
+                      "box": Box3D(person(10, 3.0, -1.2).center, person(10, 3, 0).extent).to_dict(),
                       "plane": None, "speed_mps": speed_mps})
     world = {"world": "fg_test", "seed": 5, "rate_hz": rate_hz, "instances": instances,
              "phases": [{"name": "operation", "t_start_s": 100.0, "t_end_s": 100.0 + seconds}]}

@@ -46,7 +46,7 @@ class ForegroundStage:
         cfg = self.config
         # Import the heavy modules now, not inside the first frame's timing.
         import filterpy.kalman  # noqa: F401
-        import scipy.optimize  # noqa: F401
+        import scipy.optimize
         import scipy.sparse.csgraph  # noqa: F401
 
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
