@@ -23,6 +23,13 @@ def foreground(
         True, "--ablation/--no-ablation", help="Also run without background filter."
     ),
     max_frames: int = typer.Option(0, "--max-frames", help="Stop after this many frames (0: all)."),
+    background: str = typer.Option(
+        "auto", "--background", help="stage (hiper's background recognition), truth (ground-truth "
+        "boxes) or auto (the stage when available)."
+    ),
+    settings: list[str] = typer.Option(  # noqa: B008
+        [], "--set", help="A foreground option KEY=VALUE (e.g. --set pixel_step=2); repeatable."
+    ),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Foreground recognition and tracking against the ground truth (paper Table III).
@@ -33,12 +40,29 @@ def foreground(
 
     report = evaluate_foreground(
         log, detector=detector, background_filter=background_filter, ablation=ablation,
-        max_frames=max_frames or None,
+        max_frames=max_frames or None, background=background, **_parse_settings(settings),
     )
     if json_out:
         print_json(report)
         return
     _render(report)
+
+
+def _parse_settings(settings: list[str]) -> dict[str, Any]:
+    import json
+
+    from hiper_cli.errors import ConfigError
+
+    out: dict[str, Any] = {}
+    for item in settings:
+        key, sep, raw = item.partition("=")
+        if not sep or not key:
+            raise ConfigError(f"--set {item!r}: expected KEY=VALUE, e.g. --set pixel_step=2")
+        try:
+            out[key.strip()] = json.loads(raw)
+        except json.JSONDecodeError:
+            out[key.strip()] = raw
+    return out
 
 
 def _fmt(value: Any, digits: int = 3) -> str:

@@ -92,6 +92,8 @@ class ForegroundConfig:
     """With a learned speed spread sigma, the acceleration noise is sigma / this time."""
     measurement_noise_m: float = 0.03
     """Measurement noise: standard deviation of an observed centre."""
+    smooth_closed_tracks: bool = True
+    """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
     """A track moving faster than this is ``dynamic``; slower is ``static``."""
     speed_window_s: float = 0.5

@@ -15,6 +15,8 @@
   detection does not bias a moving track. A track only ages while its predicted centre is
   visible to the camera (in the image, not hidden behind nearer depth): a person who walks out
   of view keeps the identity for ``lost_max_s``.
+- Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother (every row
+  then uses all observations of the track, so the first rows are no longer noisy).
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations → closed after
   ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
 """
@@ -31,7 +33,7 @@ from numpy.typing import NDArray
 from hiper_cli.model import new_uuid
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 
-__all__ = ["ClassPrior", "Measurement", "Track", "Tracker"]
+__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
 
 FloatArray = NDArray[np.float64]
 UNKNOWN = "unknown"
@@ -76,6 +78,9 @@ class Track:
     score_sum: float = 0.0
     observation_uuids: list[str] = field(default_factory=list)
     trajectory: list[list[float]] = field(default_factory=list)
+    # per trajectory row: posterior covariance and the process noise (q, q_vertical) used
+    covariances: list[FloatArray] = field(default_factory=list)
+    noises: list[tuple[float, float]] = field(default_factory=list)
 
     @property
     def position(self) -> FloatArray:
@@ -95,6 +100,49 @@ class Track:
     @property
     def confidence(self) -> float:
         return self.score_sum / max(self.hits, 1)
+
+
+def _process_noise(dt: float, q: float, q_vertical: float) -> FloatArray:
+    """Q of the constant-velocity model with white acceleration of variance q (z: q_vertical)."""
+    Q = np.zeros((6, 6))
+    for axis in range(3):
+        var = q_vertical if axis == 2 else q
+        Q[axis, axis] = var * dt**4 / 4.0
+        Q[axis, axis + 3] = Q[axis + 3, axis] = var * dt**3 / 2.0
+        Q[axis + 3, axis + 3] = var * dt**2
+    return Q
+
+
+def smooth_trajectory(track: Track) -> None:
+    """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place).
+
+    The filter's estimates at the start of a track rest on few observations; once the track is
+    closed every row can use all of them. Rows keep their stamps; positions and velocities
+    become the smoothed ones.
+    """
+    rows = track.trajectory
+    n = len(rows)
+    if n < 3 or len(track.covariances) != n:
+        return
+    xs = [np.asarray(r[1:7], dtype=np.float64) for r in rows]
+    Ps = [np.asarray(P, dtype=np.float64) for P in track.covariances]
+    for k in range(n - 2, -1, -1):
+        dt = rows[k + 1][0] - rows[k][0]
+        if dt <= 0:
+            continue
+        F = np.eye(6)
+        F[:3, 3:] = np.eye(3) * dt
+        x_k, P_k = np.asarray(rows[k][1:7], dtype=np.float64), track.covariances[k]
+        x_pred = F @ x_k
+        P_pred = F @ P_k @ F.T + _process_noise(dt, *track.noises[k + 1])
+        try:
+            C = P_k @ F.T @ np.linalg.inv(P_pred)
+        except np.linalg.LinAlgError:
+            continue
+        xs[k] = x_k + C @ (xs[k + 1] - x_pred)
+        Ps[k] = P_k + C @ (Ps[k + 1] - P_pred) @ C.T
+    for row, x in zip(rows, xs, strict=True):
+        row[1:7] = x.tolist()
 
 
 def _compatible(track_class: str, meas_class: str) -> bool:
@@ -140,14 +188,7 @@ class Tracker:
         F = np.eye(6)
         F[:3, 3:] = np.eye(3) * dt
         q = self._accel_noise(track.class_name) ** 2
-        qv = q * self.config.vertical_noise_ratio**2
-        Q = np.zeros((6, 6))
-        for axis in range(3):
-            var = qv if axis == 2 else q
-            Q[axis, axis] = var * dt**4 / 4.0
-            Q[axis, axis + 3] = Q[axis + 3, axis] = var * dt**3 / 2.0
-            Q[axis + 3, axis + 3] = var * dt**2
-        kf.predict(F=F, Q=Q)  # type: ignore[attr-defined]
+        kf.predict(F=F, Q=_process_noise(dt, q, q * self.config.vertical_noise_ratio**2))  # type: ignore[attr-defined]
         track.last_time_s = stamp_s
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
@@ -171,6 +212,7 @@ class Tracker:
                 track.velocity_initialised = True
                 if track.trajectory:  # the first row gets the velocity it could not know yet
                     track.trajectory[0][4:7] = v.tolist()
+                    track.covariances[0] = np.array(kf.P, dtype=np.float64)  # type: ignore[attr-defined]
             else:
                 kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
         else:
@@ -188,6 +230,9 @@ class Tracker:
         track.score_sum += m.score
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
+        q = self._accel_noise(track.class_name) ** 2
+        track.covariances.append(np.array(track.kf.P, dtype=np.float64))  # type: ignore[attr-defined]
+        track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
     def _gate(self, track: Track, stamp_s: float) -> float:
@@ -264,12 +309,18 @@ class Tracker:
                 if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > self.config.lost_max_s:
                     track.closed = True
                     if track.confirmed:
+                        self._close(track)
                         changed.append(track)
         self.tracks = [t for t in self.tracks if not t.closed]
         for j, m in enumerate(measurements):
             if joined[j] is None:
                 self.tracks.append(self._birth(m, stamp_s))
         return changed, joined
+
+    def _close(self, track: Track) -> None:
+        if self.config.smooth_closed_tracks:
+            smooth_trajectory(track)
+        track.covariances, track.noises = [], []
 
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
         track = Track(
@@ -291,6 +342,7 @@ class Tracker:
         for t in self.tracks:
             t.closed = True
             if t.confirmed:
+                self._close(t)
                 out.append(t)
         self.tracks = []
         return out
