@@ -114,3 +114,19 @@ def test_learned_speed_bound_gates_association():
     plain.step(0.0, [meas([1, 0, 0.9])])
     _, joined = plain.step(1 / RATE_HZ, [meas([1.5, 0, 0.9])])
     assert joined[0] is not None
+
+
+def test_closing_a_track_smooths_its_first_rows():
+    rng = np.random.default_rng(5)
+    tracker = Tracker(ForegroundConfig())
+    for k in range(60):
+        pos = np.array([1.0 + 0.6 * k / RATE_HZ, 0.0, 0.9]) + rng.normal(0, 0.01, 3)
+        tracker.step(k / RATE_HZ, [meas(pos, k=k)])
+    (track,) = tracker.tracks
+    raw = np.array(track.trajectory)
+    (closed,) = tracker.close_all()
+    smooth = np.array(closed.trajectory)
+    assert closed.closed and smooth.shape == raw.shape and np.allclose(smooth[:, 0], raw[:, 0])
+    err_raw = np.abs(np.hypot(raw[:10, 4], raw[:10, 5]) - 0.6).mean()
+    err_smooth = np.abs(np.hypot(smooth[:10, 4], smooth[:10, 5]) - 0.6).mean()
+    assert err_smooth < err_raw / 2 and err_smooth < 0.05

@@ -259,13 +259,20 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         moving_truth.extend(true_sp[inside].tolist())
     sp_arr = np.asarray(speeds)
 
-    # identity switches
-    by_truth: dict[int, list[tuple[int, str]]] = {}
+    # identity switches: per frame and truth instance, the instance of its largest observation
+    best: dict[tuple[int, int], tuple[int, str]] = {}
     for inst in instances:
         for u in inst.observation_uuids:
             gid = run.obs_truth_id.get(u)
-            if gid is not None:
-                by_truth.setdefault(gid, []).append((run.obs_frame.get(u, 0), inst.uuid))
+            if gid is None:
+                continue
+            key = (gid, run.obs_frame.get(u, 0))
+            size = int(run.observations[u].data.get("num_points", 0)) if u in run.observations else 0
+            if key not in best or size > best[key][0]:
+                best[key] = (size, inst.uuid)
+    by_truth: dict[int, list[tuple[int, str]]] = {}
+    for (gid, k), (_, inst_uuid) in best.items():
+        by_truth.setdefault(gid, []).append((k, inst_uuid))
     switches = 0
     for seq in by_truth.values():
         seq.sort()
