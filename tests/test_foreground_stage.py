@@ -115,7 +115,7 @@ def test_eval_foreground_command_on_a_small_sim_log(tmp_path):
     assert ours["classification"] == {"chair": {"tp": 1, "fp": 0}, "person": {"tp": 1, "fp": 0}}
     assert ours["identity_switches"] == 0
     assert ours["moving_people_speed_error_mps"] == pytest.approx(0.0, abs=0.05)
-    assert ours["localisation_visible_m"][0] < 0.03
+    assert ours["localisation_visible_m"][0] < 0.06  # a 160x120 camera: 4 cm pixels at 4 m
     assert ours["frames"] == 60 and "ablation" not in report
 
 

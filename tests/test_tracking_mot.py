@@ -97,11 +97,13 @@ def test_kalman_speed_of_a_constant_velocity_walker(speed):
     assert speeds[-30:].mean() == pytest.approx(speed, abs=0.03)
 
 
-def test_different_known_classes_never_associate():
-    tracker = Tracker(ForegroundConfig())
+def test_different_known_classes_pay_a_penalty():
+    tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5, gate_m=1.0))
     tracker.step(0.0, [meas([1, 0, 0.5], "chair")])
-    _, joined = tracker.step(1 / RATE_HZ, [meas([1, 0, 0.5], "person")])
-    assert joined == [None] and len(tracker.tracks) == 2
+    _, joined = tracker.step(1 / RATE_HZ, [meas([1.6, 0, 0.5], "person")])
+    assert joined == [None] and len(tracker.tracks) == 2  # 0.6 m + 0.5 m > 1 m gate
+    _, joined = tracker.step(2 / RATE_HZ, [meas([1.02, 0, 0.5], "couch")])  # a confused detection
+    assert joined[0] == tracker.tracks[0].uuid
 
 
 def test_learned_speed_bound_gates_association():

@@ -147,7 +147,9 @@ def _frame_truth(
                 u, v = us * step + off, vs * step + off
                 p = np.stack([(u - cam.cx) * z / cam.fx, (v - cam.cy) * z / cam.fy, z], axis=1)
                 p_map = p @ frame.T_map_cam[:3, :3].T + frame.T_map_cam[:3, 3]
-                visible_centres[gid] = (p_map.min(axis=0) + p_map.max(axis=0)) / 2.0
+                centre = p_map.mean(axis=0)  # the same centre the stage computes for a blob
+                centre[2] = (p_map[:, 2].min() + p_map[:, 2].max()) / 2.0
+                visible_centres[gid] = centre
         centre = visible_centres[gid]
         if centre is not None and "center_map" in obs.data:
             errors[obs.uuid] = float(np.linalg.norm(np.asarray(obs.data["center_map"]) - centre))

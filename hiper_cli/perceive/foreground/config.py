@@ -36,7 +36,9 @@ class ForegroundConfig:
     max_depth_m: float = 5.0
     """The paper's point cloud range of 5 m."""
     background_margin_m: float = 0.05
-    """Background boxes are grown by this much on every side before filtering."""
+    """Background boxes are grown by this much on every side before filtering ..."""
+    background_margin_per_m2: float = 0.005
+    """... plus this times the squared depth (structured-light depth noise grows with z²)."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04
@@ -45,8 +47,8 @@ class ForegroundConfig:
     """How far (in subsampled grid cells) a neighbour may be; bridges small depth holes."""
     fragment_ratio: float = 0.25
     """A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
-    fragment_distance_m: float = 0.5
-    """... when their centres are closer than this (grazing surfaces break off objects)."""
+    fragment_distance_m: float = 0.3
+    """... when its centre is this close to that cluster's box (grazing sides, heads)."""
     min_cluster_points: int = 15
     max_cluster_points: int = 8000
     max_cluster_extent_m: float = 3.0
@@ -62,10 +64,16 @@ class ForegroundConfig:
     unknown_class: str = "unknown"
     keep_unknown: bool = True
     """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
+    unknown_vote_weight: float = 0.5
+    """A track's class is the score-weighted vote of its observations; ``unknown`` ones weigh
+    this much each, so a few confused detections cannot name a mostly unmatched track."""
 
     # --- tracking ---------------------------------------------------------------------------
     gate_m: float = 1.0
     """Hungarian assignment: an observation farther than this from a track cannot join it."""
+    class_mismatch_m: float = 0.5
+    """Association cost added when a track and an observation have different known classes
+    (a confused detection still joins its track when it is close)."""
     gate_margin_m: float = 0.15
     """Added to the learned c_u·dt gate (position noise of two measurements)."""
     confirm_hits: int = 3

@@ -3,7 +3,8 @@
 1. Downscale: take every ``pixel_step``-th pixel of the depth image (an organised subsample:
    no voxel grid, no sorting) and deproject it with cached pixel rays.
 2. Filter the background: drop the points inside the background instances' boxes (map frame,
-   grown by a margin); the points are moved into the map frame once and tested box by box.
+   grown by a margin that grows with the squared depth like the sensor noise); the points
+   are moved into the map frame once and tested box by box.
 3. Euclidean cluster extraction: two points join one cluster when they are at most
    ``cluster_neighbour_cells`` apart on the subsampled grid and closer than
    ``cluster_tolerance_m + cluster_tolerance_per_m · depth`` in 3D (surfaces seen at a
@@ -46,9 +47,13 @@ class Blob:
 
     @property
     def center_map(self) -> FloatArray:
-        """Centre of the blob's axis-aligned box in the map frame."""
+        """Where the blob is, map frame: the centroid of its points horizontally (robust to
+        depth noise, which moves the box's extreme points) and the middle of its vertical
+        extent (the box centre height, independent of how densely each part was sampled)."""
         lo, hi = self.points_map.min(axis=0), self.points_map.max(axis=0)
-        return np.asarray((lo + hi) / 2.0, dtype=np.float64)
+        centre = self.points_map.mean(axis=0)
+        centre[2] = (lo[2] + hi[2]) / 2.0
+        return np.asarray(centre, dtype=np.float64)
 
     @property
     def extent_map(self) -> FloatArray:
@@ -80,19 +85,24 @@ def _rays(
     return rx, ry, U, V
 
 
-def inside_boxes(points: FloatArray, boxes: Sequence[Box3D], margin_m: float) -> NDArray[np.bool_]:
-    """Which of ``points`` (N, 3) lie inside any of ``boxes`` (same frame) grown by ``margin_m``."""
+def inside_boxes(
+    points: FloatArray, boxes: Sequence[Box3D], margin_m: float | FloatArray
+) -> NDArray[np.bool_]:
+    """Which of ``points`` (N, 3) lie inside any of ``boxes`` (same frame) grown by ``margin_m``
+    (one value, or one per point)."""
     inside = np.zeros(len(points), dtype=bool)
     if len(points) == 0 or not boxes:
         return inside
+    margin = np.asarray(margin_m, dtype=np.float64)
+    max_margin = float(margin.max())
+    per_point = margin.reshape(-1, 1) if margin.ndim else margin
     plo, phi = points.min(axis=0), points.max(axis=0)
     for box in boxes:
         lo, hi = box.aabb()
-        if np.any(lo - margin_m > phi) or np.any(hi + margin_m < plo):
+        if np.any(lo - max_margin > phi) or np.any(hi + max_margin < plo):
             continue  # no point can be inside
-        half = box.extent_m / 2.0 + margin_m
-        local = (points - box.center_m) @ box.R
-        inside |= np.all(np.abs(local) <= half, axis=1)
+        local = np.abs((points - box.center_m) @ box.R) - box.extent_m / 2.0
+        inside |= np.all(local <= per_point, axis=1)
     return inside
 
 
@@ -138,9 +148,10 @@ def _merge_fragments(
     """Fold small fragments into a much larger neighbouring cluster.
 
     Surfaces seen at a grazing angle (the side of a body at the silhouette) break away from
-    the object they belong to: consecutive samples are far apart in depth. A fragment smaller
-    than ``fragment_ratio`` of a cluster whose grid box touches its own and whose centre is
-    within ``fragment_distance_m`` joins that cluster.
+    the object they belong to: consecutive samples are far apart in depth; so does a head
+    above a thin neck. A fragment smaller than ``fragment_ratio`` of a cluster whose grid box
+    touches its own and whose centre is within ``fragment_distance_m`` of that cluster's box
+    (map frame) joins that cluster.
     """
     if len(groups) < 2:
         return groups
@@ -151,6 +162,8 @@ def _merge_fragments(
         gy, gx = g // grid_w, g % grid_w
         boxes.append((gy.min() - pad, gx.min() - pad, gy.max() + pad, gx.max() + pad))
     centres = [map_full[g].mean(axis=0) for g in groups]
+    lows = [map_full[g].min(axis=0) for g in groups]
+    highs = [map_full[g].max(axis=0) for g in groups]
     kept: list[int] = []
     members: dict[int, list[NDArray[np.int64]]] = {}
     for i, g in enumerate(groups):
@@ -161,7 +174,8 @@ def _merge_fragments(
             a, b = boxes[i], boxes[j]
             if a[0] > b[2] or b[0] > a[2] or a[1] > b[3] or b[1] > a[3]:
                 continue
-            if np.linalg.norm(centres[i] - centres[j]) <= config.fragment_distance_m:
+            gap = np.maximum(np.maximum(lows[j] - centres[i], centres[i] - highs[j]), 0.0)
+            if np.linalg.norm(gap) <= config.fragment_distance_m:
                 target = j
                 break
         if target is None:
@@ -197,7 +211,9 @@ def segment(
     pts_map = P_flat[idx] @ R.T + t
     t1 = time.perf_counter()
     if config.background_filter and background_boxes_map:
-        bg = inside_boxes(pts_map, background_boxes_map, config.background_margin_m)
+        depth = P_flat[idx, 2]
+        margin = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+        bg = inside_boxes(pts_map, background_boxes_map, margin)
         flat_valid = valid.ravel().copy()
         flat_valid[idx[bg]] = False
         valid = flat_valid.reshape(valid.shape)

@@ -5,7 +5,8 @@
   the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
   analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
   (up to ``max_gate_m``) so that a person who left the view is picked up again. Two different
-  known classes never associate; ``unknown`` associates with anything.
+  known classes cost ``class_mismatch_m`` more (a confused detection still joins its track
+  when close); ``unknown`` associates with anything.
 - Filter: a constant-velocity Kalman filter (filterpy) over position and velocity with white
   acceleration noise (class-specific from the learned ``sigma_mps`` when known). A track's
   velocity is initialised from its first two observations (the paper started at zero, which
@@ -92,10 +93,9 @@ class Track:
 
     @property
     def class_name(self) -> str:
-        known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
-        if not known:
+        if not self.class_votes:
             return UNKNOWN
-        return max(sorted(known), key=lambda k: known[k])
+        return max(sorted(self.class_votes), key=lambda k: self.class_votes[k])
 
     @property
     def confidence(self) -> float:
@@ -226,7 +226,8 @@ class Tracker:
             track.confirmed = True
 
     def _vote(self, track: Track, m: Measurement) -> None:
-        track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + max(m.score, 1e-3)
+        weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, 1e-3)
+        track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
         track.score_sum += m.score
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
@@ -254,12 +255,12 @@ class Tracker:
         obs = np.array([m.center_map for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         gates = np.array([self._gate(t, stamp_s) for t in self.tracks])
-        allowed = cost <= gates[:, None]
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             for j, m in enumerate(measurements):
-                if allowed[i, j] and not _compatible(cls, m.class_name):
-                    allowed[i, j] = False
+                if not _compatible(cls, m.class_name):
+                    cost[i, j] += self.config.class_mismatch_m
+        allowed = cost <= gates[:, None]
         big = 1e6
         rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
         return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
