@@ -75,6 +75,7 @@ class ForegroundRun:
     observations: dict[str, Observation] = field(default_factory=dict)
     obs_truth_id: dict[str, int | None] = field(default_factory=dict)
     obs_visible_error_m: dict[str, float] = field(default_factory=dict)
+    obs_visible_error_xy_m: dict[str, float] = field(default_factory=dict)
     obs_frame: dict[str, int] = field(default_factory=dict)
     foreground_times_s: list[float] = field(default_factory=list)
     frames: int = 0
@@ -115,12 +116,14 @@ def _background(truth: Truth, background: str) -> tuple[list[Stage], World, str]
 
 def _frame_truth(
     frame: Frame, truth: Truth, observations: list[Observation], foreground_ids: set[int], step: int
-) -> tuple[dict[str, int | None], dict[str, float]]:
-    """Truth id per observation (majority of its pixel sample) and its visible-centre error."""
+) -> tuple[dict[str, int | None], dict[str, float], dict[str, float]]:
+    """Truth id per observation (majority of its pixel sample), its visible-centre error in
+    3D and horizontally."""
     rgb_rel = frame.source.split(" + ")[0] if frame.source else ""
     ids_img = truth.load_instance_ids(rgb_rel)
     ids: dict[str, int | None] = {}
     errors: dict[str, float] = {}
+    errors_xy: dict[str, float] = {}
     visible_centres: dict[int, NDArray[np.float64] | None] = {}
     cam = frame.camera
     for obs in observations:
@@ -152,8 +155,10 @@ def _frame_truth(
                 visible_centres[gid] = centre
         centre = visible_centres[gid]
         if centre is not None and "center_map" in obs.data:
-            errors[obs.uuid] = float(np.linalg.norm(np.asarray(obs.data["center_map"]) - centre))
-    return ids, errors
+            diff = np.asarray(obs.data["center_map"]) - centre
+            errors[obs.uuid] = float(np.linalg.norm(diff))
+            errors_xy[obs.uuid] = float(np.linalg.norm(diff[:2]))
+    return ids, errors, errors_xy
 
 
 def _run(
@@ -181,9 +186,10 @@ def _run(
             run.points.append(result.timings_s.get("foreground_points", 0.0))
             after = result.timings_s.get("foreground_points_after_background", 0.0)
             run.points_after_background.append(after)
-            ids, errors = _frame_truth(frame, truth, result.observations, fg_ids, step)
+            ids, errors, errors_xy = _frame_truth(frame, truth, result.observations, fg_ids, step)
             run.obs_truth_id.update(ids)
             run.obs_visible_error_m.update(errors)
+            run.obs_visible_error_xy_m.update(errors_xy)
         run.eval_overhead_s += time.perf_counter() - t0
 
     frames = itertools.islice(iter(reader), max_frames) if max_frames else iter(reader)
@@ -225,6 +231,7 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
 
     # localisation
     visible_err = list(run.obs_visible_error_m.values())
+    visible_err_xy = list(run.obs_visible_error_xy_m.values())
     centre_err: list[float] = []
     for inst in instances:
         gid = inst_truth[inst.uuid]
@@ -296,6 +303,9 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         "sum_i": len(instances),
         "sum_o": len(run.observations),
         "localisation_visible_m": _mean_std(visible_err),
+        "localisation_visible_median_m": float(np.median(visible_err)) if visible_err else None,
+        "localisation_visible_xy_m": _mean_std(visible_err_xy),
+        "localisation_visible_xy_median_m": float(np.median(visible_err_xy)) if visible_err_xy else None,
         "localisation_box_centre_m": _mean_std(centre_err),
         "people_dynamic_ratio": float(np.mean(sp_arr > dynamic_speed_mps)) if sp_arr.size else None,
         "people_speed_mps": _mean_std(sp_arr),

@@ -44,20 +44,31 @@ class Blob:
     points_map: FloatArray
     pixels_uv: NDArray[np.int32]
     image_box_xyxy: FloatArray
+    support_z_m: float | None = None
+    """Top of the floor or table the blob stands on, when the background filter cut its base."""
+
+    def _z_range(self) -> tuple[float, float]:
+        lo, hi = float(self.points_map[:, 2].min()), float(self.points_map[:, 2].max())
+        if self.support_z_m is not None and self.support_z_m < lo:
+            lo = self.support_z_m
+        return lo, hi
 
     @property
     def center_map(self) -> FloatArray:
         """Where the blob is, map frame: the centroid of its points horizontally (robust to
         depth noise, which moves the box's extreme points) and the middle of its vertical
         extent (the box centre height, independent of how densely each part was sampled)."""
-        lo, hi = self.points_map.min(axis=0), self.points_map.max(axis=0)
         centre = self.points_map.mean(axis=0)
-        centre[2] = (lo[2] + hi[2]) / 2.0
+        z_lo, z_hi = self._z_range()
+        centre[2] = (z_lo + z_hi) / 2.0
         return np.asarray(centre, dtype=np.float64)
 
     @property
     def extent_map(self) -> FloatArray:
-        return np.asarray(self.points_map.max(axis=0) - self.points_map.min(axis=0), dtype=np.float64)
+        extent = self.points_map.max(axis=0) - self.points_map.min(axis=0)
+        z_lo, z_hi = self._z_range()
+        extent[2] = z_hi - z_lo
+        return np.asarray(extent, dtype=np.float64)
 
 
 @dataclass
@@ -186,14 +197,37 @@ def _merge_fragments(
     return [np.concatenate(members[i]) if len(members[i]) > 1 else members[i][0] for i in kept]
 
 
+def _support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
+    """Top height of the support the blob stands on, if its base is within the filter margin."""
+    lo = blob.points_map.min(axis=0)
+    hi = blob.points_map.max(axis=0)
+    depth = float(np.median(blob.points_cam[:, 2]))
+    margin = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    best: float | None = None
+    for box in supports:
+        b_lo, b_hi = box.aabb()
+        if b_lo[0] > hi[0] or b_hi[0] < lo[0] or b_lo[1] > hi[1] or b_hi[1] < lo[1]:
+            continue  # not under the blob
+        top = float(b_hi[2])
+        if 0.0 <= lo[2] - top <= margin + config.cluster_tolerance_m and (best is None or top > best):
+            best = top
+    return best
+
+
 def segment(
     depth_m: NDArray[np.float32],
     camera: CameraIntrinsics,
     T_map_cam: FloatArray,
     background_boxes_map: Sequence[Box3D],
     config: ForegroundConfig,
+    support_boxes_map: Sequence[Box3D] = (),
 ) -> tuple[list[Blob], SegmentStats]:
-    """Algorithm 3: the foreground blobs of one depth image (see the module docstring)."""
+    """Algorithm 3: the foreground blobs of one depth image (see the module docstring).
+
+    ``support_boxes_map`` are the horizontal background boxes (floor, tables): a blob whose
+    base lies within the filter margin above one of them stands on it, and its box reaches
+    down to it (the filter removed its lowest points together with the support).
+    """
     import time
 
     stats = SegmentStats()
@@ -257,7 +291,10 @@ def segment(
                     min(float(camera.height), uv[:, 1].max() + half),
                 ]
             )
-            blobs.append(Blob(P_flat[sel], pm, uv, box))
+            blob = Blob(P_flat[sel], pm, uv, box)
+            if config.background_filter and support_boxes_map:
+                blob.support_z_m = _support_below(blob, support_boxes_map, config)
+            blobs.append(blob)
     stats.clusters = len(blobs)
     t3 = time.perf_counter()
     stats.timings_s = {

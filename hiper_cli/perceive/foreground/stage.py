@@ -23,6 +23,7 @@ from hiper_cli.types import Detections, Frame
 __all__ = ["ForegroundStage"]
 
 FloatArray = NDArray[np.float64]
+SUPPORT_CLASSES = ("floor", "table")
 
 
 class ForegroundStage:
@@ -110,7 +111,10 @@ class ForegroundStage:
             future = self._pool.submit(self._detect_timed, frame)
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
-        blobs, seg = segment(frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg)
+        supports = [
+            inst.box for inst in world.background.values() if inst.class_name in SUPPORT_CLASSES
+        ]
+        blobs, seg = segment(frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports)
         t_seg = time.perf_counter()
         if future is not None:
             try:
