@@ -178,9 +178,9 @@ class ForegroundStage:
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
         cfg = self.config
         n = len(blob.points_cam)
-        rng = np.random.default_rng(len(blob.points_cam) * 7919 + frame.pose_id)
-        pts_idx = rng.choice(n, size=min(n, cfg.points_per_observation), replace=False)
-        pix_idx = rng.choice(n, size=min(n, cfg.pixels_per_observation), replace=False)
+        # Evenly spread subsamples over the organised grid order (deterministic, cheap).
+        pts_idx = np.unique(np.linspace(0, n - 1, min(n, cfg.points_per_observation)).astype(np.int64))
+        pix_idx = np.unique(np.linspace(0, n - 1, min(n, cfg.pixels_per_observation)).astype(np.int64))
         detection = None
         if match.detection_index is not None:
             k = match.detection_index
