@@ -11,8 +11,10 @@ log with ``run_stages``, and compares with the ground truth in ``LOG/gt``:
   else an FP (also when it covers no foreground truth instance); ``unknown`` instances are
   counted apart;
 - localisation: per observation, the distance between the blob centre and the centre of the
-  truth instance's visible points in the same frame (what the sensor could see); per instance,
-  the distance between the tracked centre and the true box centre at the same stamps;
+  truth instance's visible points in the same frame (what the sensor could see), over the
+  classified observations (the Table III row), over all, and horizontally; per instance, the
+  distance between the tracked centre and the true box centre at the same stamps (this one
+  includes the bias of seeing only the near side of an object);
 - people: dynamic ratio and |v| statistics over the trajectory rows of person instances;
   the mean speed of moving people against the truth's speed at the same stamps;
 - identity switches: how often the instance observing a truth instance changes;
@@ -272,6 +274,9 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
     # localisation
     visible_err = list(run.obs_visible_error_m.values())
     visible_err_xy = list(run.obs_visible_error_xy_m.values())
+    classified_err = [
+        e for u, e in run.obs_visible_error_m.items() if run.observations[u].class_name != "unknown"
+    ]
     centre_err: list[float] = []
     for inst in instances:
         gid = inst_truth[inst.uuid]
@@ -342,6 +347,7 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         "unknown_instances": unknown,
         "sum_i": len(instances),
         "sum_o": len(run.observations),
+        "localisation_classified_m": _mean_std(classified_err),
         "localisation_visible_m": _mean_std(visible_err),
         "localisation_visible_median_m": float(np.median(visible_err)) if visible_err else None,
         "localisation_visible_xy_m": _mean_std(visible_err_xy),
