@@ -123,3 +123,12 @@ def test_eval_foreground_needs_ground_truth(tmp_path):
     result = CliRunner().invoke(app, ["eval", "foreground", str(tmp_path)])
     assert result.exit_code != 0
     assert "gt/world.json: not found" in result.output
+
+
+def test_every_option_is_documented():
+    from dataclasses import fields
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "foreground.md").read_text()
+    missing = [f.name for f in fields(ForegroundConfig) if f"`{f.name}`" not in doc]
+    assert not missing, f"docs/foreground.md does not mention {missing}"

@@ -104,8 +104,6 @@ class ForegroundConfig:
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
     """A track moving faster than this is ``dynamic``; slower is ``static``."""
-    speed_window_s: float = 0.5
-    """Trajectory velocities are smoothed over this window before deciding the state."""
     use_learned_priors: bool = True
     """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist."""
     prior_tolerance: float = 0.5
