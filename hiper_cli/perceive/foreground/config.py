@@ -64,7 +64,7 @@ class ForegroundConfig:
     unknown_class: str = "unknown"
     keep_unknown: bool = True
     """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
-    unknown_vote_weight: float = 0.5
+    unknown_vote_weight: float = 0.15
     """A track's class is the score-weighted vote of its observations; ``unknown`` ones weigh
     this much each, so a few confused detections cannot name a mostly unmatched track."""
 
