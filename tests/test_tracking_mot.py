@@ -99,6 +99,7 @@ def test_kalman_speed_of_a_constant_velocity_walker(speed):
 
 def test_different_known_classes_pay_a_penalty():
     tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5, gate_m=1.0))
+    tracker.step(-1 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
     tracker.step(0.0, [meas([1, 0, 0.5], "chair")])
     _, joined = tracker.step(1 / RATE_HZ, [meas([1.6, 0, 0.5], "person")])
     assert joined == [None] and len(tracker.tracks) == 2  # 0.6 m + 0.5 m > 1 m gate
@@ -132,3 +133,14 @@ def test_closing_a_track_smooths_its_first_rows():
     err_raw = np.abs(np.hypot(raw[:10, 4], raw[:10, 5]) - 0.6).mean()
     err_smooth = np.abs(np.hypot(smooth[:10, 4], smooth[:10, 5]) - 0.6).mean()
     assert err_smooth < err_raw / 2 and err_smooth < 0.05
+
+
+def test_one_confused_detection_does_not_name_a_track():
+    tracker = Tracker(ForegroundConfig(min_class_observations=2))
+    tracker.step(0.0, [meas([1, 0, 0.5], "unknown")])
+    tracker.step(1 / RATE_HZ, [meas([1, 0, 0.5], "bench")])
+    (track,) = tracker.tracks
+    assert track.class_name == "unknown"
+    tracker.step(2 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
+    tracker.step(3 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
+    assert track.class_name == "chair"

@@ -71,6 +71,9 @@ class ForegroundConfig:
     # --- tracking ---------------------------------------------------------------------------
     gate_m: float = 1.0
     """Hungarian assignment: an observation farther than this from a track cannot join it."""
+    min_class_observations: int = 2
+    """A track takes a class only after at least this many observations of it (one confused
+    detection cannot name a track)."""
     class_mismatch_m: float = 0.5
     """Association cost added when a track and an observation have different known classes
     (a confused detection still joins its track when it is close)."""

@@ -76,6 +76,8 @@ class Track:
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
+    class_counts: dict[str, int] = field(default_factory=dict)
+    min_class_observations: int = 1
     score_sum: float = 0.0
     observation_uuids: list[str] = field(default_factory=list)
     trajectory: list[list[float]] = field(default_factory=list)
@@ -93,9 +95,14 @@ class Track:
 
     @property
     def class_name(self) -> str:
-        if not self.class_votes:
+        """The vote winner among classes seen at least ``min_class_observations`` times."""
+        eligible = [
+            k for k in sorted(self.class_votes)
+            if k == UNKNOWN or self.class_counts.get(k, 0) >= self.min_class_observations
+        ]
+        if not eligible:
             return UNKNOWN
-        return max(sorted(self.class_votes), key=lambda k: self.class_votes[k])
+        return max(eligible, key=lambda k: self.class_votes[k])
 
     @property
     def confidence(self) -> float:
@@ -228,6 +235,7 @@ class Tracker:
     def _vote(self, track: Track, m: Measurement) -> None:
         weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, 1e-3)
         track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
+        track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
         track.score_sum += m.score
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
@@ -332,6 +340,7 @@ class Tracker:
             last_time_s=stamp_s,
             extent_m=np.asarray(m.extent_map, dtype=np.float64).copy(),
             first_center=np.asarray(m.center_map, dtype=np.float64).copy(),
+            min_class_observations=self.config.min_class_observations,
         )
         self._vote(track, m)
         track.confirmed = self.config.confirm_hits <= 1
