@@ -97,26 +97,30 @@ def test_kalman_speed_of_a_constant_velocity_walker(speed):
     assert speeds[-30:].mean() == pytest.approx(speed, abs=0.03)
 
 
-def test_different_known_classes_pay_a_penalty():
-    tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5, gate_m=1.0))
-    tracker.step(-1 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
-    tracker.step(0.0, [meas([1, 0, 0.5], "chair")])
-    _, joined = tracker.step(1 / RATE_HZ, [meas([1.6, 0, 0.5], "person")])
-    assert joined == [None] and len(tracker.tracks) == 2  # 0.6 m + 0.5 m > 1 m gate
-    _, joined = tracker.step(2 / RATE_HZ, [meas([1.02, 0, 0.5], "couch")])  # a confused detection
-    assert joined[0] == tracker.tracks[0].uuid
+def test_same_class_wins_and_a_confused_detection_still_joins():
+    tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5))
+    for k in range(10):
+        tracker.step(k / RATE_HZ, [meas([1, 0, 0.5], "chair")])
+    (chair,) = tracker.tracks
+    _, joined = tracker.step(10 / RATE_HZ, [meas([1.8, 0, 0.5], "person")])
+    assert joined == [None]  # outside the settled chair's gate
+    _, joined = tracker.step(11 / RATE_HZ, [meas([1.02, 0, 0.5], "couch")])  # a confused detection
+    assert joined == [chair.uuid]
+    # Two observations inside the gate: the chair takes the chair, not the nearer cup.
+    _, joined = tracker.step(12 / RATE_HZ, [meas([1.01, 0, 0.5], "cup"), meas([1.05, 0, 0.5], "chair")])
+    assert joined[1] == chair.uuid
 
 
 def test_learned_speed_bound_gates_association():
     # c_u = 0.5 m/s: a jump of 0.5 m in 1/30 s is impossible for this class.
     tracker = Tracker(ForegroundConfig(), lambda c: ClassPrior(cu_mps=0.5, sigma_mps=0.1))
     tracker.step(0.0, [meas([1, 0, 0.9])])
-    _, joined = tracker.step(1 / RATE_HZ, [meas([1.5, 0, 0.9])])
-    assert joined == [None]
+    _, joined = tracker.step(1 / RATE_HZ, [meas([1.4, 0, 0.9])])
+    assert joined == [None]  # 0.4 m > 0.5 m/s * dt + 0.15 m
     plain = Tracker(ForegroundConfig())
     plain.step(0.0, [meas([1, 0, 0.9])])
-    _, joined = plain.step(1 / RATE_HZ, [meas([1.5, 0, 0.9])])
-    assert joined[0] is not None
+    _, joined = plain.step(1 / RATE_HZ, [meas([1.4, 0, 0.9])])
+    assert joined[0] is not None  # within min_gate_m
 
 
 def test_closing_a_track_smooths_its_first_rows():

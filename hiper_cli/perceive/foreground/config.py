@@ -70,13 +70,17 @@ class ForegroundConfig:
 
     # --- tracking ---------------------------------------------------------------------------
     gate_m: float = 1.0
-    """Hungarian assignment: an observation farther than this from a track cannot join it."""
+    """Hungarian assignment: an observation farther than this from a track cannot join it ..."""
+    gate_sigmas: float = 4.0
+    min_gate_m: float = 0.5
+    """... and a settled track gates at gate_sigmas times its predicted position σ, at least
+    min_gate_m (a chair does not take the bottle on the table beside it)."""
     min_class_observations: int = 2
     """A track takes a class only after at least this many observations of it (one confused
     detection cannot name a track)."""
     class_mismatch_m: float = 0.5
-    """Association cost added when a track and an observation have different known classes
-    (a confused detection still joins its track when it is close)."""
+    """Association cost added (inside the gate) when a track and an observation have
+    different known classes: same-class pairs win, a confused detection still joins."""
     gate_margin_m: float = 0.15
     """Added to the learned c_u·dt gate (position noise of two measurements)."""
     confirm_hits: int = 3

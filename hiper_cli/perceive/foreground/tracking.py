@@ -4,9 +4,10 @@
   between the tracks' predicted centres and the observed centres, with a gate: ``gate_m``, or
   the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
   analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
-  (up to ``max_gate_m``) so that a person who left the view is picked up again. Two different
-  known classes cost ``class_mismatch_m`` more (a confused detection still joins its track
-  when close); ``unknown`` associates with anything.
+  (up to ``max_gate_m``) so that a person who left the view is picked up again; a settled
+  track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
+  Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
+  pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
 - Filter: a constant-velocity Kalman filter (filterpy) over position and velocity with white
   acceleration noise (class-specific from the learned ``sigma_mps`` when known). A track's
   velocity is initialised from its first two observations (the paper started at zero, which
@@ -251,7 +252,12 @@ class Tracker:
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             return float(prior.cu_mps) * dt + cfg.gate_margin_m
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0)
-        return min(cfg.gate_m + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
+        # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
+        # or fast-changing one up to gate_m.
+        P = np.asarray(track.kf.P, dtype=np.float64)[:3, :3]  # type: ignore[attr-defined]
+        sigma = float(np.sqrt(np.linalg.eigvalsh(P).max() + cfg.measurement_noise_m**2))
+        base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
+        return min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated Hungarian assignment."""
@@ -263,12 +269,12 @@ class Tracker:
         obs = np.array([m.center_map for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         gates = np.array([self._gate(t, stamp_s) for t in self.tracks])
+        allowed = cost <= gates[:, None]
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             for j, m in enumerate(measurements):
                 if not _compatible(cls, m.class_name):
                     cost[i, j] += self.config.class_mismatch_m
-        allowed = cost <= gates[:, None]
         big = 1e6
         rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
         return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
