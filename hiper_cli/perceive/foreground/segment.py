@@ -1,0 +1,390 @@
+"""Foreground segmentation (the paper's Algorithm 3) on an organised depth image.
+
+1. Downscale: take every ``pixel_step``-th pixel of the depth image (an organised subsample:
+   no voxel grid, no sorting) and deproject it with cached pixel rays.
+2. Filter the background: drop the points inside the background instances' boxes (map frame,
+   grown by a margin that grows with the squared depth like the sensor noise); the points
+   are moved into the map frame once and each box tests only the grid block it projects to.
+3. Euclidean cluster extraction: two points join one cluster when they are at most
+   grid neighbours (8-neighbourhood, or up to ``cluster_neighbour_cells`` apart along a row or
+   a column, which bridges missing samples) and closer than
+   ``cluster_tolerance_m + cluster_tolerance_per_m · depth`` in 3D (surfaces seen at a
+   grazing angle and the sensor's depth noise spread points further apart with range);
+   clusters are the connected components of that graph, kept when their size lies in
+   [``min_cluster_points``, ``max_cluster_points``] and their extent is below
+   ``max_cluster_extent_m``.
+
+Each kept cluster is a ``Blob``: its points in the camera and map frames, the full-resolution
+pixel of every point, and the image box of its projection.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.types import CameraIntrinsics
+
+__all__ = ["Blob", "SegmentStats", "inside_boxes", "segment"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass
+class Blob:
+    """One cluster: ``points_cam``/``points_map`` (N, 3) metres, ``pixels_uv`` (N, 2) int pixels,
+    ``image_box_xyxy`` (4,) pixels (the bounding box of the projected cluster)."""
+
+    points_cam: FloatArray
+    points_map: FloatArray
+    pixels_uv: NDArray[np.int32]
+    image_box_xyxy: FloatArray
+    support_z_m: float | None = None
+    """Top of the floor or table the blob stands on, when the background filter cut its base."""
+
+    def _z_range(self) -> tuple[float, float]:
+        lo, hi = float(self.points_map[:, 2].min()), float(self.points_map[:, 2].max())
+        if self.support_z_m is not None and self.support_z_m < lo:
+            lo = self.support_z_m
+        return lo, hi
+
+    @property
+    def center_map(self) -> FloatArray:
+        """Where the blob is, map frame: the centroid of its points horizontally (robust to
+        depth noise, which moves the box's extreme points) and the middle of its vertical
+        extent (the box centre height, independent of how densely each part was sampled)."""
+        centre = self.points_map.mean(axis=0)
+        z_lo, z_hi = self._z_range()
+        centre[2] = (z_lo + z_hi) / 2.0
+        return np.asarray(centre, dtype=np.float64)
+
+    @property
+    def extent_map(self) -> FloatArray:
+        extent = self.points_map.max(axis=0) - self.points_map.min(axis=0)
+        z_lo, z_hi = self._z_range()
+        extent[2] = z_hi - z_lo
+        return np.asarray(extent, dtype=np.float64)
+
+
+@dataclass
+class SegmentStats:
+    """How many points each step kept (for reports and the ablation)."""
+
+    points: int = 0
+    after_background: int = 0
+    clusters: int = 0
+    rejected_clusters: int = 0
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+
+@lru_cache(maxsize=8)
+def _rays(
+    camera: CameraIntrinsics, step: int
+) -> tuple[FloatArray, FloatArray, NDArray[np.int32], NDArray[np.int32]]:
+    """Normalised ray x/z and y/z for the subsampled grid, and its pixel coordinates."""
+    off = step // 2
+    us = np.arange(off, camera.width, step, dtype=np.int32)
+    vs = np.arange(off, camera.height, step, dtype=np.int32)
+    U, V = np.meshgrid(us, vs)
+    rx = np.asarray((U - camera.cx) / camera.fx, dtype=np.float64)
+    ry = np.asarray((V - camera.cy) / camera.fy, dtype=np.float64)
+    return rx, ry, U, V
+
+
+def inside_boxes(
+    points: FloatArray, boxes: Sequence[Box3D], margin_m: float | FloatArray
+) -> NDArray[np.bool_]:
+    """Which of ``points`` (N, 3) lie inside any of ``boxes`` (same frame) grown by ``margin_m``
+    (one value, or one per point)."""
+    inside = np.zeros(len(points), dtype=bool)
+    if len(points) == 0 or not boxes:
+        return inside
+    margin = np.asarray(margin_m, dtype=np.float64)
+    max_margin = float(margin.max())
+    per_point = margin.reshape(-1, 1) if margin.ndim else margin
+    plo, phi = points.min(axis=0), points.max(axis=0)
+    todo = np.arange(len(points))  # points not yet known to be inside: the set shrinks
+    for box in sorted(boxes, key=lambda b: -b.volume_m3):  # floors and walls first
+        lo, hi = box.aabb()
+        if np.any(lo - max_margin > phi) or np.any(hi + max_margin < plo):
+            continue  # no point can be inside
+        if len(todo) == 0:
+            break
+        rel = points[todo] - box.center_m
+        if not np.allclose(box.R, np.eye(3), atol=1e-9):
+            rel = rel @ box.R
+        local = np.abs(rel) - box.extent_m / 2.0
+        m = per_point[todo] if per_point.ndim else per_point
+        hit = np.all(local <= m, axis=1)
+        inside[todo[hit]] = True
+        todo = todo[~hit]
+    return inside
+
+
+def _cluster_labels(
+    P: FloatArray, valid: NDArray[np.bool_], tolerance_m: float, per_m: float, cells: int
+) -> NDArray[np.int64]:
+    """Connected components of the organised neighbour graph; -1 for invalid points.
+
+    Only the valid points are visited, so the cost follows the number of points left after
+    the background filter (the paper's observation: filtering speeds up segmentation).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    h, w = valid.shape
+    flat_valid = valid.ravel()
+    idx = np.flatnonzero(flat_valid)
+    labels = np.full(h * w, -1, dtype=np.int64)
+    n = len(idx)
+    if n == 0:
+        return labels
+    compact = np.full(h * w, -1, dtype=np.int64)
+    compact[idx] = np.arange(n)
+    ys, xs = np.divmod(idx, w)
+    pts = P.reshape(-1, 3)[idx]
+    tol = tolerance_m + per_m * pts[:, 2]
+    tol2 = tol * tol
+    rows: list[NDArray[np.int64]] = []
+    cols: list[NDArray[np.int64]] = []
+    # The 8-neighbourhood, plus straight jumps of up to ``cells`` over missing samples.
+    offsets = [(0, 1), (1, -1), (1, 0), (1, 1)] + [(0, k) for k in range(2, cells + 1)]
+    offsets += [(k, 0) for k in range(2, cells + 1)]
+    for dy, dx in offsets:
+        ny, nx = ys + dy, xs + dx
+        inside = (ny < h) & (nx >= 0) & (nx < w)
+        src = np.flatnonzero(inside)
+        nb = compact[ny[src] * w + nx[src]]
+        ok = nb >= 0
+        src, nb = src[ok], nb[ok]
+        diff = pts[src] - pts[nb]
+        close = np.einsum("ij,ij->i", diff, diff) <= tol2[src]
+        rows.append(src[close])
+        cols.append(nb[close])
+    r = np.concatenate(rows)
+    c = np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n)).tocsr()
+    _, comp = connected_components(graph, directed=False)
+    labels[idx] = comp
+    return labels
+
+
+def _merge_fragments(
+    groups: list[NDArray[np.int64]], map_full: FloatArray, grid_w: int, config: ForegroundConfig
+) -> list[NDArray[np.int64]]:
+    """Fold small fragments into a much larger neighbouring cluster.
+
+    Surfaces seen at a grazing angle (the side of a body at the silhouette) break away from
+    the object they belong to: consecutive samples are far apart in depth; so does a head
+    above a thin neck. A fragment smaller than ``fragment_ratio`` of a cluster whose grid box
+    touches its own and whose centre is within ``fragment_distance_m`` of that cluster's box
+    (map frame) joins that cluster.
+    """
+    if len(groups) < 2:
+        return groups
+    groups = sorted(groups, key=len, reverse=True)
+    pad = config.cluster_neighbour_cells + 1
+    boxes = []
+    for g in groups:
+        gy, gx = g // grid_w, g % grid_w
+        boxes.append((gy.min() - pad, gx.min() - pad, gy.max() + pad, gx.max() + pad))
+    centres = [map_full[g].mean(axis=0) for g in groups]
+    lows = [map_full[g].min(axis=0) for g in groups]
+    highs = [map_full[g].max(axis=0) for g in groups]
+    kept: list[int] = []
+    members: dict[int, list[NDArray[np.int64]]] = {}
+    for i, g in enumerate(groups):
+        target = None
+        for j in kept:
+            if len(g) > config.fragment_ratio * len(groups[j]):
+                continue
+            a, b = boxes[i], boxes[j]
+            if a[0] > b[2] or b[0] > a[2] or a[1] > b[3] or b[1] > a[3]:
+                continue
+            gap = np.maximum(np.maximum(lows[j] - centres[i], centres[i] - highs[j]), 0.0)
+            if np.linalg.norm(gap) <= config.fragment_distance_m:
+                target = j
+                break
+        if target is None:
+            kept.append(i)
+            members[i] = [g]
+        else:
+            members[target].append(g)
+    return [np.concatenate(members[i]) if len(members[i]) > 1 else members[i][0] for i in kept]
+
+
+def _box_roi(
+    box: Box3D, margin_m: float, camera: CameraIntrinsics, T_cam_map: FloatArray, step: int,
+    shape: tuple[int, int], config: ForegroundConfig,
+) -> tuple[slice, slice] | None:
+    """The rows and columns of the subsampled grid a box (grown by a margin) can cover; None
+    when it is out of view."""
+    grown = Box3D(box.center_m, box.extent_m + 2.0 * margin_m, box.R)
+    corners = grown.corners() @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+    z = corners[:, 2]
+    h, w = shape
+    if np.all(z < config.min_depth_m):
+        return None  # behind the camera
+    lo_c, hi_c = corners.min(axis=0), corners.max(axis=0)
+    if np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0)) > config.max_depth_m:
+        return None  # farther than the sensor sees
+    if np.any(z < 0.05):
+        return slice(0, h), slice(0, w)  # straddles the image plane: take the whole image
+    u = camera.fx * corners[:, 0] / z + camera.cx
+    v = camera.fy * corners[:, 1] / z + camera.cy
+    off = step // 2
+    c0 = int(np.floor((u.min() - off) / step))
+    c1 = int(np.ceil((u.max() - off) / step)) + 1
+    r0 = int(np.floor((v.min() - off) / step))
+    r1 = int(np.ceil((v.max() - off) / step)) + 1
+    c0, c1, r0, r1 = max(c0, 0), min(c1, w), max(r0, 0), min(r1, h)
+    if c0 >= c1 or r0 >= r1:
+        return None
+    return slice(r0, r1), slice(c0, c1)
+
+
+def _filter_background(
+    valid: NDArray[np.bool_],
+    P_map: FloatArray,
+    margin: FloatArray,
+    boxes: Sequence[Box3D],
+    camera: CameraIntrinsics,
+    T_map_cam: FloatArray,
+    step: int,
+    config: ForegroundConfig,
+) -> NDArray[np.bool_]:
+    """``valid`` without the grid points inside any box; each box only visits the part of the
+    grid it projects to."""
+    valid = valid.copy()
+    T_cam_map = np.asarray(np.linalg.inv(T_map_cam), dtype=np.float64)
+    max_margin = float(margin.max()) if margin.size else 0.0
+    for box in boxes:
+        roi = _box_roi(box, max_margin, camera, T_cam_map, step, valid.shape, config)
+        if roi is None:
+            continue
+        block = valid[roi]
+        cand = np.flatnonzero(block)
+        if len(cand) == 0:
+            continue
+        pts = P_map[roi].reshape(-1, 3)
+        m = margin[roi].ravel()
+        # Thinnest axis first (walls, floors): few points survive it, the others test fewer.
+        for axis in np.argsort(box.extent_m):
+            d = (pts[cand] - box.center_m) @ box.R[:, axis]
+            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= m[cand]]
+            if len(cand) == 0:
+                break
+        if len(cand):
+            flat = block.ravel()
+            flat[cand] = False
+            valid[roi] = flat.reshape(block.shape)
+    return valid
+
+
+def _support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
+    """Top height of the support the blob stands on, if its base is within the filter margin."""
+    lo = blob.points_map.min(axis=0)
+    hi = blob.points_map.max(axis=0)
+    depth = float(np.median(blob.points_cam[:, 2]))
+    margin = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    best: float | None = None
+    for box in supports:
+        b_lo, b_hi = box.aabb()
+        if b_lo[0] > hi[0] or b_hi[0] < lo[0] or b_lo[1] > hi[1] or b_hi[1] < lo[1]:
+            continue  # not under the blob
+        top = float(b_hi[2])
+        if 0.0 <= lo[2] - top <= margin + config.cluster_tolerance_m and (best is None or top > best):
+            best = top
+    return best
+
+
+def segment(
+    depth_m: NDArray[np.float32],
+    camera: CameraIntrinsics,
+    T_map_cam: FloatArray,
+    background_boxes_map: Sequence[Box3D],
+    config: ForegroundConfig,
+    support_boxes_map: Sequence[Box3D] = (),
+) -> tuple[list[Blob], SegmentStats]:
+    """Algorithm 3: the foreground blobs of one depth image (see the module docstring).
+
+    ``support_boxes_map`` are the horizontal background boxes (floor, tables): a blob whose
+    base lies within the filter margin above one of them stands on it, and its box reaches
+    down to it (the filter removed its lowest points together with the support).
+    """
+    import time
+
+    stats = SegmentStats()
+    t0 = time.perf_counter()
+    step = config.pixel_step
+    rx, ry, U, V = _rays(camera, step)
+    off = step // 2
+    z = depth_m[off::step, off::step].astype(np.float64)
+    valid = (z >= config.min_depth_m) & (z <= config.max_depth_m) & np.isfinite(z)
+    P = np.stack([rx * z, ry * z, z], axis=-1)  # (h, w, 3) camera frame
+    stats.points = int(valid.sum())
+    P_flat = P.reshape(-1, 3)
+    R, t = T_map_cam[:3, :3], T_map_cam[:3, 3]
+    map_full = P_flat @ R.T + t
+    t1 = time.perf_counter()
+    if config.background_filter and background_boxes_map:
+        margin = config.background_margin_m + config.background_margin_per_m2 * z * z
+        valid = _filter_background(
+            valid, map_full.reshape(P.shape), margin, background_boxes_map, camera, T_map_cam, step, config
+        )
+    stats.after_background = int(valid.sum())
+    t2 = time.perf_counter()
+    labels = _cluster_labels(
+        P, valid, config.cluster_tolerance_m, config.cluster_tolerance_per_m, config.cluster_neighbour_cells
+    )
+    member = np.flatnonzero(labels >= 0)
+    blobs: list[Blob] = []
+    if len(member):
+        lab = labels[member]
+        order = np.argsort(lab, kind="stable")
+        member, lab = member[order], lab[order]
+        starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
+        ends = np.r_[starts[1:], len(lab)]
+        sizes = ends - starts
+        U_flat, V_flat = U.ravel(), V.ravel()
+        half = step / 2.0
+        groups = [member[s:e] for s, e, size in zip(starts, ends, sizes, strict=True) if size >= 3]
+        groups = _merge_fragments(groups, map_full, valid.shape[1], config)
+        for sel in groups:
+            size = len(sel)
+            if size < config.min_cluster_points:
+                continue
+            if size > config.max_cluster_points:
+                stats.rejected_clusters += 1
+                continue
+            pm = map_full[sel]
+            if np.any(pm.max(axis=0) - pm.min(axis=0) > config.max_cluster_extent_m):
+                stats.rejected_clusters += 1
+                continue
+            uv = np.stack([U_flat[sel], V_flat[sel]], axis=1).astype(np.int32)
+            box = np.array(
+                [
+                    max(0.0, uv[:, 0].min() - half),
+                    max(0.0, uv[:, 1].min() - half),
+                    min(float(camera.width), uv[:, 0].max() + half),
+                    min(float(camera.height), uv[:, 1].max() + half),
+                ]
+            )
+            blob = Blob(P_flat[sel], pm, uv, box)
+            if config.background_filter and support_boxes_map:
+                blob.support_z_m = _support_below(blob, support_boxes_map, config)
+            blobs.append(blob)
+    stats.clusters = len(blobs)
+    t3 = time.perf_counter()
+    stats.timings_s = {
+        "deproject_s": t1 - t0,
+        "background_filter_s": t2 - t1,
+        "cluster_s": t3 - t2,
+    }
+    return blobs, stats

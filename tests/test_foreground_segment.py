@@ -1,0 +1,59 @@
+"""Algorithm 3 details: background boxes, fragments, supports."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground import ForegroundConfig
+from hiper_cli.perceive.foreground.segment import inside_boxes, segment
+from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
+
+
+def test_inside_boxes_rotated_box_and_per_point_margin():
+    c, s = np.cos(np.pi / 4), np.sin(np.pi / 4)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    box = Box3D(np.array([1.0, 0.0, 0.0]), np.array([2.0, 0.2, 0.2]), R)
+    pts = np.array([[1 + 0.9 * c, 0.9 * s, 0.0], [1.0, 0.0, 0.15], [1.0, 0.0, 0.15], [3.0, 3.0, 3.0]])
+    got = inside_boxes(pts, [box], np.array([0.0, 0.0, 0.06, 10.0]))
+    assert got.tolist() == [True, False, True, True]
+    assert not inside_boxes(pts, [], 0.1).any()
+
+
+def test_person_stands_on_the_floor_after_filtering():
+    boxes = [*room(), person(10, 3.0, 0.0)]
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = background_instances(boxes)
+    floor = [i.box for i in bg.values() if i.class_name == "floor"]
+    cfg = ForegroundConfig(pixel_step=2)
+    (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg, floor)
+    assert blob.points_map[:, 2].min() > 0.05  # the filter cut the feet with the floor ...
+    assert blob.support_z_m == pytest.approx(0.0)
+    assert blob.extent_map[2] == pytest.approx(1.7, abs=0.05)  # ... the box reaches down again
+    assert blob.center_map[2] == pytest.approx(0.85, abs=0.03)
+    (no_support,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg)
+    assert no_support.support_z_m is None and no_support.center_map[2] > 0.87
+
+
+def test_a_head_above_a_gap_joins_its_body():
+    body = SceneBox(10, np.array([3.0, 0.0, 0.75]), np.array([0.3, 0.5, 1.5]), "person")
+    head = SceneBox(11, np.array([3.0, 0.0, 1.75]), np.array([0.2, 0.2, 0.2]), "person")  # 0.4 m gap
+    boxes = [*room(), body, head]
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = [i.box for i in background_instances(boxes).values()]
+    cfg = ForegroundConfig(pixel_step=2, min_cluster_points=3)
+    (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
+    assert blob.points_map[:, 2].max() > 1.8
+    apart, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, ForegroundConfig(
+        pixel_step=2, min_cluster_points=3, fragment_ratio=0.0))
+    assert len(apart) == 2
+
+
+def test_boxes_behind_the_camera_are_skipped_and_cost_nothing():
+    boxes = [*room(), person(10, 3.0, 0.0)]
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = [i.box for i in background_instances(boxes).values()]
+    behind = [Box3D(np.array([-2.0, 0.0, 1.0]), np.array([0.5, 0.5, 0.5]))] * 50
+    cfg = ForegroundConfig(pixel_step=2)
+    blobs, stats = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg + behind, cfg)
+    blobs2, stats2 = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
+    assert stats.after_background == stats2.after_background and len(blobs) == len(blobs2) == 1
