@@ -1,9 +1,28 @@
 #!/usr/bin/env bash
-# The README's demo: the main job end to end on the built-in example log.
+# The README's demo: the main job end to end on the built-in example log, into an embedded
+# knowledge base (out/demo.hiper), then what it knows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${1:-.venv}"
 HIPER="$VENV/bin/hiper"
 LOG=fixtures/house_small
-echo "== hiper info $LOG"
+KB=out/demo.hiper
+
+# The COCO detector is not shipped (see README): use it when it is found, else the simulator's
+# noisy ground-truth detections that the example log carries.
+DETECTOR=truth
+for dir in "${HIPER_MODELS:-}" models ../shared/models; do
+  if [ -n "$dir" ] && [ -f "$dir/yolox_nano/yolox_nano.onnx" ]; then
+    DETECTOR=yolox; export HIPER_MODELS="$(cd "$dir" && pwd)"; break
+  fi
+done
+echo "demo: detector '$DETECTOR' (see README, 'The detector model')"
+
+rm -rf "$KB" out/demo.json
+mkdir -p out
+set -x
 "$HIPER" info "$LOG"
+"$HIPER" perceive "$LOG" --kb "$KB" --detector "$DETECTOR"
+"$HIPER" kb info --kb "$KB"
+"$HIPER" kb check --kb "$KB"
+"$HIPER" export out/demo.json --kb "$KB"
