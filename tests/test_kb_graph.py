@@ -12,25 +12,11 @@ from hiper_cli.graph.ontology import layer_graph, ontology_turtle
 from hiper_cli.model import Analysis, Box3D, Observation
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import FrameResult
-from tests.kb_helpers import ProbeStage, make_frame, oxigraph_binary, start_oxigraph
+from tests import kb_helpers
+from tests.kb_helpers import ProbeStage, make_frame
 
-
-@pytest.fixture(scope="module")
-def sparql_url(tmp_path_factory):
-    if oxigraph_binary() is None:
-        pytest.skip("the oxigraph server (pip install oxigraph, in the dev extra) is not installed")
-    proc, url = start_oxigraph(tmp_path_factory.mktemp("oxigraph"))
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-@pytest.fixture(params=["local", "sparql"])
-def kb_location(request, tmp_path):
-    """(location, docs_dir) for open_kb: a directory, or the server URL plus a documents dir."""
-    if request.param == "local":
-        return str(tmp_path / "scene.hiper"), None
-    return request.getfixturevalue("sparql_url"), tmp_path / "docs.hiper"
+sparql_url = kb_helpers.sparql_url  # fixtures shared with test_kb_exchange
+kb_location = kb_helpers.kb_location
 
 
 def _fill(kb, n_frames=12):
