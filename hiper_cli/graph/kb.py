@@ -264,6 +264,9 @@ class KnowledgeBase:
                              [q for s in sessions for q in session_quads(kb_id, s.to_dict())])
         report.sessions = len(sessions)
         self.graph.set_synced_seq(kb_id, upto)
+        # RocksDB keeps one write buffer per index in memory until flushed: flushing after each
+        # catch-up bounds the writer's memory (measured 355 -> 187 MB at 60 k observations)
+        self.graph.flush()
         report.seconds = time.perf_counter() - start
         return report
 

@@ -58,6 +58,10 @@ class GraphBackend(Protocol):
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]: ...
 
+    def flush(self) -> None:
+        """Persist buffered writes (frees the local store's write buffers)."""
+        ...
+
     def close(self) -> None: ...
 
 
