@@ -47,10 +47,7 @@ CREATE TABLE IF NOT EXISTS docs (
     body TEXT NOT NULL
 );
 CREATE INDEX IF NOT EXISTS docs_type_class_stamp ON docs (type, class, stamp_s);
-CREATE INDEX IF NOT EXISTS docs_type_layer ON docs (type, layer);
-CREATE INDEX IF NOT EXISTS docs_instance ON docs (instance_uuid) WHERE instance_uuid IS NOT NULL;
 CREATE INDEX IF NOT EXISTS docs_seq ON docs (seq);
-CREATE INDEX IF NOT EXISTS docs_env_type ON docs (env_uuid, type);
 CREATE VIRTUAL TABLE IF NOT EXISTS docs_box USING rtree(id, min_x, max_x, min_y, max_y, min_z, max_z);
 CREATE TABLE IF NOT EXISTS links (
     instance_uuid TEXT NOT NULL,
@@ -246,10 +243,9 @@ class DocumentStore:
     _UPSERT = (
         "INSERT INTO docs (uuid, type, layer, class, stamp_s, instance_uuid, session_id, env_uuid, "
         "seq, body) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT(uuid) DO UPDATE SET "
-        "type=excluded.type, layer=excluded.layer, class=excluded.class, stamp_s=excluded.stamp_s, "
-        "instance_uuid=excluded.instance_uuid, session_id=COALESCE(excluded.session_id, session_id), "
-        "env_uuid=COALESCE(excluded.env_uuid, env_uuid), seq=excluded.seq, body=excluded.body"
-    )
+        "class=excluded.class, stamp_s=excluded.stamp_s, seq=excluded.seq, body=excluded.body"
+    )  # an update sets only what changes (each indexed column in SET costs an index rewrite);
+    # a document keeps its type, layer, instance link, session and environment
 
     def put_many(
         self,
