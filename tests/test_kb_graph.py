@@ -212,3 +212,15 @@ def test_ontology_parses_and_declares_the_classes():
     supers = {(t.subject.value.rsplit("#", 1)[-1], t.object.value) for t in triples
               if t.predicate.value.endswith("subClassOf")}
     assert ("Observation", "http://www.w3.org/ns/sosa/Observation") in supers
+
+
+def test_read_while_a_writer_holds_the_store(tmp_path):
+    from hiper_cli.graph import open_kb_for_reading
+
+    with open_kb(tmp_path / "kb") as writer:
+        _fill(writer, 4)
+        writer.sync_graph()
+        with open_kb_for_reading(tmp_path / "kb") as reader:
+            assert reader.read_only
+            assert reader.info()["totals"]["observation"] == 8
+            assert reader.check(repair=False).ok

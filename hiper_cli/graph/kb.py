@@ -39,7 +39,15 @@ from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph, open_graph
 from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, Instance, Observation
 from hiper_cli.perceive.stage import FrameResult, World
 
-__all__ = ["DEFAULT_KB", "CheckReport", "KbConfig", "KnowledgeBase", "SyncReport", "open_kb"]
+__all__ = [
+    "DEFAULT_KB",
+    "CheckReport",
+    "KbConfig",
+    "KnowledgeBase",
+    "SyncReport",
+    "open_kb",
+    "open_kb_for_reading",
+]
 
 DEFAULT_KB = "scene.hiper"
 DOCUMENTS_FILE = "documents.sqlite"
@@ -374,6 +382,25 @@ class KnowledgeBase:
             "graph_synced_seq": self.graph.synced_seq(self.kb_id),
             "size_bytes": size,
         }
+
+
+def open_kb_for_reading(
+    location: str | Path = DEFAULT_KB, *, docs_dir: str | Path | None = None
+) -> KnowledgeBase:
+    """Open an existing knowledge base to read it, even while a ``perceive`` run writes it
+    (then read-only: the graph may lag the documents by the writer's sync interval)."""
+    try:
+        root = Path(docs_dir) if docs_dir is not None else Path(str(location))
+        if not str(location).startswith(("http://", "https://")) and not (root / DOCUMENTS_FILE).exists():
+            raise KnowledgeBaseError(
+                f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); "
+                f"run 'hiper perceive LOG --kb {root}'"
+            )
+        return open_kb(location, docs_dir=docs_dir)
+    except KnowledgeBaseError as err:
+        if "another hiper process" not in str(err):
+            raise
+        return open_kb(location, docs_dir=docs_dir, read_only=True)
 
 
 def open_kb(

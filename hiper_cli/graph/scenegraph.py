@@ -75,6 +75,7 @@ class LocalGraph:
 
     def __init__(self, path: Path, *, read_only: bool = False) -> None:
         self.location = str(path)
+        self.read_only = read_only
         try:
             self._store = ox.Store.read_only(str(path)) if read_only else ox.Store(str(path))
         except OSError as err:
@@ -126,10 +127,11 @@ class LocalGraph:
         return out
 
     def flush(self) -> None:
-        self._store.flush()
+        if not self.read_only:
+            self._store.flush()
 
     def close(self) -> None:
-        self._store.flush()
+        self.flush()
         del self._store
 
 
