@@ -1,0 +1,97 @@
+"""Options of background recognition, with the paper's values as named defaults.
+
+Paper section IV-C/D: planes are extracted from keyframes at the mapping rate (2 Hz), each
+plane is classified by the alignment of its normal and its height (wall, floor, ceiling,
+table, unknown) and merged into instances by criteria of increasing cost (class, alignment,
+box overlap, contour overlap). Lengths in metres, angles in degrees.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+from hiper_cli.errors import ConfigError
+
+__all__ = ["METHODS", "BackgroundConfig"]
+
+METHODS: tuple[str, ...] = ("fast", "ransac")
+
+
+@dataclass(frozen=True)
+class BackgroundConfig:
+    """Every knob of the background stage.
+
+    Extraction (``method="fast"``): the depth image is sampled every ``stride_px`` pixels,
+    grouped into cells of ``cell_px`` samples a side, each planar cell gets a least-squares
+    plane, and neighbouring cells with similar planes are grown into regions (PEAC/CAPE
+    style). ``method="ransac"`` runs open3d's ``segment_plane`` (the paper's SACSegmentation)
+    on the same samples instead.
+    """
+
+    method: str = "fast"
+    keyframe_hz: float = 2.0  # the paper's mapping rate
+    min_depth_m: float = 0.3
+    max_depth_m: float = 6.0
+    # fast extraction
+    stride_px: int = 4
+    cell_px: int = 5
+    cell_noise_m: float = 0.0025  # plane RMS allowed in a cell at 1 m (grows with depth squared)
+    cell_min_valid: float = 0.9  # fraction of valid samples a cell needs
+    jump_ratio: float = 0.05  # a depth step above this fraction of the depth splits surfaces
+    grow_angle_deg: float = 12.0
+    grow_offset_m: float = 0.04
+    inlier_m: float = 0.03  # point-to-plane distance of an inlier at 1 m (grows with depth)
+    min_plane_cells: int = 6
+    refine_passes: int = 2  # assign samples to the closest plane and refit, this many times
+    # ransac extraction (the paper's method)
+    ransac_max_planes: int = 8
+    ransac_iterations: int = 500
+    ransac_stride_px: int = 8
+    ransac_min_points: int = 150
+    # observations
+    min_area_m2: float = 0.15
+    pixel_sample: int = 64  # inlier pixels kept per observation for evaluation
+    contour_epsilon_px: float = 1.0
+    # classification in the map frame (z up)
+    horizontal_deg: float = 15.0  # floor, ceiling, table normals within this of vertical
+    vertical_deg: float = 10.0  # wall normals within this of horizontal
+    floor_max_height_m: float = 0.2
+    ceiling_min_height_m: float = 1.9
+    table_min_height_m: float = 0.4
+    table_max_height_m: float = 1.1
+    table_min_area_m2: float = 0.12
+    table_max_extent_m: float = 3.5
+    wall_min_height_m: float = 1.2  # a standing person is ~1.8 m tall but narrow and not flat
+    wall_min_width_m: float = 1.0
+    wall_min_area_m2: float = 1.0
+    wall_top_min_m: float = 1.5  # the observed part reaches this high (furniture rarely does)
+    # merging (Algorithm 2)
+    merge_angle_deg: float = 10.0
+    merge_offset_m: float = 0.1
+    merge_box_margin_m: float = 0.3
+    merge_contour_margin_m: float = 0.15
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ConfigError(f"background method {self.method!r}; expected one of {', '.join(METHODS)}")
+        if self.keyframe_hz <= 0:
+            raise ConfigError(f"background keyframe_hz must be positive, got {self.keyframe_hz}")
+        if self.stride_px < 1 or self.cell_px < 2 or self.ransac_stride_px < 1:
+            raise ConfigError("background stride_px, ransac_stride_px must be >= 1 and cell_px >= 2")
+        if not 0 < self.min_depth_m < self.max_depth_m:
+            raise ConfigError(
+                f"background depth range {self.min_depth_m}..{self.max_depth_m} m is empty; "
+                "expected 0 < min_depth_m < max_depth_m"
+            )
+
+    @classmethod
+    def from_options(cls, **options: Any) -> BackgroundConfig:
+        """Build from keyword options; an unknown name raises ``ConfigError``."""
+        names = [f.name for f in fields(cls)]
+        unknown = sorted(set(options) - set(names))
+        if unknown:
+            raise ConfigError(
+                f"unknown background option(s) {unknown}; expected one of {', '.join(names)}"
+            )
+        return cls(**options)

@@ -1,0 +1,298 @@
+"""Plane extraction from one organized depth image (Algorithm 1, ``DetectPlanes``).
+
+Two extractors return the same ``PlaneSegment`` list, planes in the camera optical frame:
+
+- ``fast`` (default): the depth image is sampled on a grid (``stride_px``), grouped into cells
+  of ``cell_px`` × ``cell_px`` samples, a least-squares plane is fitted to every cell from its
+  moments, planar cells whose neighbours carry a similar plane are joined (connected components
+  over the cell grid, as in PEAC, Feng et al. 2014, and CAPE, Proença and Gao 2018), each region
+  is refitted, extended to the inlier samples around it and refitted again.
+- ``ransac``: the paper's method: open3d's ``segment_plane`` run repeatedly on the samples,
+  each plane's inliers split into image-connected parts and refitted by least squares.
+
+A plane is ``[a, b, c, d]`` with ``a x + b y + c z + d = 0``, unit normal facing the camera.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.perceive.background.config import BackgroundConfig
+from hiper_cli.types import CameraIntrinsics
+
+__all__ = ["PlaneSegment", "SampleGrid", "extract_planes", "sample_grid"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SampleGrid:
+    """Depth samples every ``stride`` pixels: ``points_cam`` (h, w, 3), ``valid`` (h, w)."""
+
+    stride: int
+    points_cam: FloatArray
+    valid: NDArray[np.bool_]
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return int(self.valid.shape[0]), int(self.valid.shape[1])
+
+
+@dataclass(frozen=True)
+class PlaneSegment:
+    """One plane seen in one image: ``plane_cam`` (4,), its sample ``mask`` (h, w) on ``grid``."""
+
+    plane_cam: FloatArray
+    mask: NDArray[np.bool_]
+    rms_m: float
+    n_points: int
+
+
+def sample_grid(depth_m: NDArray[np.float32], camera: CameraIntrinsics, stride: int,
+                min_depth_m: float, max_depth_m: float) -> SampleGrid:
+    """Deproject every ``stride``-th pixel of ``depth_m`` into the camera frame."""
+    z = depth_m[::stride, ::stride].astype(np.float64)
+    valid = np.isfinite(z) & (z > min_depth_m) & (z < max_depth_m)
+    z = np.where(valid, z, 0.0)
+    u = np.arange(0, depth_m.shape[1], stride, dtype=np.float64)
+    v = np.arange(0, depth_m.shape[0], stride, dtype=np.float64)
+    x = (u[None, :] - camera.cx) / camera.fx * z
+    y = (v[:, None] - camera.cy) / camera.fy * z
+    return SampleGrid(stride, np.stack([x, y, z], axis=-1), valid)
+
+
+def _fit_from_moments(n: FloatArray, s1: FloatArray,
+                      s2: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Batched plane fit from point count (...), sums (..., 3) and outer-product sums (..., 3, 3).
+
+    Returns unit normals (..., 3) facing the origin (the camera), offsets d (...) and the
+    smallest two eigenvalues (..., 2) of the covariance (m²).
+    """
+    safe_n = np.maximum(n, 1.0)
+    mean = s1 / safe_n[..., None]
+    cov = s2 / safe_n[..., None, None] - mean[..., :, None] * mean[..., None, :]
+    evals, evecs = np.linalg.eigh(cov)
+    normal = evecs[..., :, 0]
+    d = -np.einsum("...i,...i->...", normal, mean)
+    flip = d < 0  # make n·0 + d > 0: the camera is on the normal's side
+    normal = np.where(flip[..., None], -normal, normal)
+    d = np.where(flip, -d, d)
+    return normal, d, np.maximum(evals[..., :2], 0.0)
+
+
+def _moments(points: FloatArray, weights: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Sums over the second-to-last axis of weighted points (..., k, 3)."""
+    n = weights.sum(axis=-1)
+    wp = points * weights[..., None]
+    s1 = wp.sum(axis=-2)
+    s2 = np.einsum("...ki,...kj->...ij", wp, points)
+    return n, s1, s2
+
+
+def _jumps(grid: SampleGrid, ratio: float) -> NDArray[np.bool_]:
+    """Samples next to a depth discontinuity (a step above ``ratio`` of the depth)."""
+    z = np.where(grid.valid, grid.points_cam[..., 2], np.nan)
+    out = np.zeros(z.shape, bool)
+    with np.errstate(invalid="ignore"):
+        dh = np.abs(np.diff(z, axis=1)) > ratio * np.fmin(z[:, 1:], z[:, :-1])
+        dv = np.abs(np.diff(z, axis=0)) > ratio * np.fmin(z[1:], z[:-1])
+    out[:, 1:] |= dh
+    out[:, :-1] |= dh
+    out[1:] |= dv
+    out[:-1] |= dv
+    return out
+
+
+def _extract_fast(grid: SampleGrid, cfg: BackgroundConfig) -> list[PlaneSegment]:
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    c = cfg.cell_px
+    h, w = grid.shape
+    gh, gw = h // c, w // c
+    if gh < 1 or gw < 1:
+        return []
+    pts = grid.points_cam[: gh * c, : gw * c].reshape(gh, c, gw, c, 3).transpose(0, 2, 1, 3, 4)
+    pts = pts.reshape(gh, gw, c * c, 3)
+    valid = grid.valid[: gh * c, : gw * c].reshape(gh, c, gw, c).transpose(0, 2, 1, 3)
+    wts: FloatArray = valid.reshape(gh, gw, c * c).astype(np.float64)
+    n, s1, s2 = _moments(pts, wts)
+    normal, d, evals = _fit_from_moments(n, s1, s2)
+    z_mean = s1[..., 2] / np.maximum(n, 1.0)
+    noise = cfg.cell_noise_m * np.maximum(z_mean, 1.0) ** 2
+    planar = (n >= cfg.cell_min_valid * c * c) & (np.sqrt(evals[..., 0]) < noise)
+    planar &= ~_jumps(grid, cfg.jump_ratio)[: gh * c, : gw * c].reshape(gh, c, gw, c).any(axis=(1, 3))
+    mean = s1 / np.maximum(n, 1.0)[..., None]
+
+    cos_grow = np.cos(np.radians(cfg.grow_angle_deg))
+    offset = cfg.grow_offset_m * np.maximum(z_mean, 1.0)
+    idx = np.arange(gh * gw).reshape(gh, gw)
+    rows: list[NDArray[np.int64]] = []
+    cols: list[NDArray[np.int64]] = []
+    for sa, sb in (
+        ((slice(None), slice(0, gw - 1)), (slice(None), slice(1, gw))),
+        ((slice(0, gh - 1), slice(None)), (slice(1, gh), slice(None))),
+    ):
+        na, nb = normal[sa], normal[sb]
+        ok = planar[sa] & planar[sb] & (np.einsum("...i,...i->...", na, nb) > cos_grow)
+        off_ab = np.abs(np.einsum("...i,...i->...", na, mean[sb]) + d[sa])
+        off_ba = np.abs(np.einsum("...i,...i->...", nb, mean[sa]) + d[sb])
+        ok &= (off_ab < offset[sa]) & (off_ba < offset[sb])
+        rows.append(idx[sa][ok])
+        cols.append(idx[sb][ok])
+    r = np.concatenate(rows)
+    cc = np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(r)), (r, cc)), shape=(gh * gw, gh * gw))
+    _, labels = connected_components(graph, directed=False)
+    labels = np.where(planar.reshape(-1), labels, -1)
+    counts = np.bincount(labels[labels >= 0], minlength=1) if np.any(labels >= 0) else np.zeros(1)
+    regions = [int(k) for k in np.flatnonzero(counts >= cfg.min_plane_cells)]
+    if not regions:
+        return []
+    # region planes from summed cell moments
+    flat_n, flat_s1, flat_s2 = n.reshape(-1), s1.reshape(-1, 3), s2.reshape(-1, 3, 3)
+    cells = [(labels == k).reshape(gh, gw) for k in regions]
+    cells = _join_regions(cells, flat_n, flat_s1, flat_s2, cfg)
+    planes = []
+    for sel in cells:
+        flat = sel.reshape(-1)
+        rn, rs1, rs2 = flat_n[flat].sum(), flat_s1[flat].sum(axis=0), flat_s2[flat].sum(axis=0)
+        nk, dk, _ = _fit_from_moments(np.array(rn), rs1, rs2)
+        planes.append(np.append(nk, dk))
+    return _refine(grid, np.array(planes), cells, cfg, cell=c)
+
+
+def _join_regions(cells: list[NDArray[np.bool_]], n: FloatArray, s1: FloatArray, s2: FloatArray,
+                  cfg: BackgroundConfig) -> list[NDArray[np.bool_]]:
+    """Join regions that touch (within two cells) and whose region-wide planes agree.
+
+    Cell normals are noisy far from the camera, so one surface may grow into several
+    regions; their region planes, fitted from many more samples, are accurate enough to
+    tell whether they are the same surface.
+    """
+    import cv2
+
+    while True:
+        stats = []
+        for sel in cells:
+            flat = sel.reshape(-1)
+            rn = n[flat].sum()
+            normal, d, _ = _fit_from_moments(np.array(rn), s1[flat].sum(axis=0), s2[flat].sum(axis=0))
+            stats.append((normal, d, s1[flat].sum(axis=0) / rn))
+        grown = [cv2.dilate(c.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool) for c in cells]
+        cos_join = np.cos(np.radians(cfg.grow_angle_deg))
+        pair = None
+        for a in range(len(cells)):
+            for b in range(a + 1, len(cells)):
+                na, da, ma = stats[a]
+                nb, db, mb = stats[b]
+                if float(na @ nb) < cos_join or not np.any(grown[a] & cells[b]):
+                    continue
+                z = max(float(ma[2]), float(mb[2]), 1.0)
+                if abs(float(na @ mb) + da) < cfg.grow_offset_m * z and abs(float(nb @ ma) + db) < (
+                    cfg.grow_offset_m * z
+                ):
+                    pair = (a, b)
+                    break
+            if pair:
+                break
+        if pair is None:
+            return cells
+        a, b = pair
+        cells = [c for k, c in enumerate(cells) if k not in pair] + [cells[a] | cells[b]]
+
+
+def _refine(grid: SampleGrid, planes: FloatArray, region_cells: list[NDArray[np.bool_]],
+            cfg: BackgroundConfig, cell: int) -> list[PlaneSegment]:
+    """Give every sample near a region to its closest plane, then refit each plane."""
+    import cv2
+
+    h, w = grid.shape
+    pts = grid.points_cam
+    z = pts[..., 2]
+    threshold = cfg.inlier_m * np.maximum(z, 1.0)
+    dist = np.abs(np.einsum("hwi,ki->khw", pts, planes[:, :3]) + planes[:, 3][:, None, None])
+    kernel = np.ones((3, 3), np.uint8)
+    for k, cells in enumerate(region_cells):
+        near = cv2.dilate(cells.astype(np.uint8), kernel).astype(bool)
+        near_px = np.zeros((h, w), bool)
+        up = np.repeat(np.repeat(near, cell, axis=0), cell, axis=1)
+        near_px[: up.shape[0], : up.shape[1]] = up[:h, :w]
+        dist[k][~near_px] = np.inf
+    dist[:, ~grid.valid] = np.inf
+    near_any = np.isfinite(dist)
+    rms = np.full(len(planes), np.inf)
+    out: list[PlaneSegment] = []
+    for _ in range(max(cfg.refine_passes, 1)):
+        # after the first pass each plane accepts samples within 2.5 of its own spreads
+        limit = np.minimum(threshold[None], np.maximum(2.5 * rms, 0.01)[:, None, None])
+        ok_dist = np.where(dist < limit, dist, np.inf)
+        best = np.argmin(ok_dist, axis=0)
+        label = np.where(np.isfinite(ok_dist.min(axis=0)), best, -1)
+        out = []
+        for k in range(len(planes)):
+            mask = label == k
+            count = int(mask.sum())
+            if count < 3:
+                continue
+            p = pts[mask]
+            normal, d, evals = _fit_from_moments(np.array(float(count)), p.sum(axis=0), p.T @ p)
+            planes[k] = np.append(normal, d)
+            rms[k] = float(np.sqrt(evals[0]))
+            out.append(PlaneSegment(planes[k].copy(), mask, rms[k], count))
+        fresh = np.abs(np.einsum("hwi,ki->khw", pts, planes[:, :3]) + planes[:, 3][:, None, None])
+        dist = np.where(near_any, fresh, np.inf)
+    return out
+
+
+def _extract_ransac(grid: SampleGrid, cfg: BackgroundConfig) -> list[PlaneSegment]:
+    import cv2
+    import open3d as o3d
+
+    h, w = grid.shape
+    flat_valid = np.flatnonzero(grid.valid.reshape(-1))
+    pts = grid.points_cam.reshape(-1, 3)
+    remaining = flat_valid
+    out: list[PlaneSegment] = []
+    rng_seed = 0
+    o3d.utility.random.seed(rng_seed)
+    for _ in range(cfg.ransac_max_planes):
+        if len(remaining) < cfg.ransac_min_points:
+            break
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(pts[remaining]))
+        mean_z = float(pts[remaining, 2].mean())
+        _, inliers = cloud.segment_plane(
+            distance_threshold=cfg.inlier_m * max(mean_z, 1.0) / 2.0,
+            ransac_n=3,
+            num_iterations=cfg.ransac_iterations,
+        )
+        inl = np.asarray(inliers, dtype=np.int64)
+        if len(inl) < cfg.ransac_min_points:
+            break
+        mask = np.zeros(h * w, bool)
+        mask[remaining[inl]] = True
+        remaining = np.delete(remaining, inl)
+        # one plane model may cover several surfaces: split its inliers by image connectivity
+        ncomp, comp = cv2.connectedComponents(mask.reshape(h, w).astype(np.uint8), connectivity=8)
+        for k in range(1, ncomp):
+            part = comp == k
+            count = int(part.sum())
+            if count < cfg.ransac_min_points // 3:
+                continue
+            p = grid.points_cam[part]
+            normal, d, evals = _fit_from_moments(np.array(float(count)), p.sum(axis=0), p.T @ p)
+            out.append(PlaneSegment(np.append(normal, d), part, float(np.sqrt(evals[0])), count))
+    return out
+
+
+def extract_planes(depth_m: NDArray[np.float32], camera: CameraIntrinsics,
+                   cfg: BackgroundConfig) -> tuple[SampleGrid, list[PlaneSegment]]:
+    """The planes of one depth image by ``cfg.method``, with the sample grid they refer to."""
+    if cfg.method == "ransac":
+        grid = sample_grid(depth_m, camera, cfg.ransac_stride_px, cfg.min_depth_m, cfg.max_depth_m)
+        return grid, _extract_ransac(grid, cfg)
+    grid = sample_grid(depth_m, camera, cfg.stride_px, cfg.min_depth_m, cfg.max_depth_m)
+    return grid, _extract_fast(grid, cfg)

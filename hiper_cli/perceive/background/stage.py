@@ -1,0 +1,156 @@
+"""The background stage: keyframes → plane observations → merged background instances."""
+
+from __future__ import annotations
+
+import copy
+import time
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D, Instance, Observation
+from hiper_cli.perceive.background.classify import classify_plane
+from hiper_cli.perceive.background.config import BackgroundConfig
+from hiper_cli.perceive.background.contour import (
+    PlaneFrame,
+    contour_from_mask,
+    to_polygon,
+    transform_plane,
+    transform_points,
+)
+from hiper_cli.perceive.background.merge import (
+    MapObservation,
+    match_instances,
+    merge_into,
+    new_instance,
+    to_map,
+)
+from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extract_planes
+from hiper_cli.perceive.stage import FrameResult, World
+from hiper_cli.types import Frame
+
+__all__ = ["BackgroundStage", "observe"]
+
+FloatArray = NDArray[np.float64]
+
+
+def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
+                 cfg: BackgroundConfig) -> Observation | None:
+    contour_cam = contour_from_mask(
+        seg.mask, grid.stride, frame.camera, seg.plane_cam, cfg.contour_epsilon_px, grid.points_cam
+    )
+    if len(contour_cam) < 3:
+        return None
+    pf = PlaneFrame(seg.plane_cam)
+    area = float(to_polygon(contour_cam, pf).area)
+    if area < cfg.min_area_m2:
+        return None
+    plane_map = transform_plane(seg.plane_cam, frame.T_map_cam)
+    class_name = classify_plane(plane_map, transform_points(contour_cam, frame.T_map_cam), cfg)
+    if class_name is None:
+        return None
+    uv = pf.to_2d(contour_cam)
+    lo, hi = uv.min(axis=0), uv.max(axis=0)
+    thickness = max(2.0 * seg.rms_m, 0.02)
+    box = Box3D(pf.to_3d((lo + hi) / 2.0)[0], np.array([*(hi - lo), thickness]), pf.R)
+    rows, cols = np.nonzero(seg.mask)
+    pick = np.linspace(0, len(rows) - 1, min(cfg.pixel_sample, len(rows))).astype(int)
+    pixels_uv = np.stack([cols[pick], rows[pick]], axis=1) * grid.stride
+    centroid = grid.points_cam[seg.mask].mean(axis=0)
+    z = float(centroid[2])
+    confidence = float(np.clip(1.0 - seg.rms_m / (cfg.inlier_m * max(z, 1.0)), 0.05, 1.0))
+    return Observation(
+        layer="background",
+        class_name=class_name,
+        confidence=confidence,
+        stamp_s=frame.stamp_s,
+        pose_id=frame.pose_id,
+        box=box,
+        data={
+            "plane_cam": seg.plane_cam.tolist(),
+            "contour_cam": contour_cam.tolist(),
+            "centroid_cam": centroid.tolist(),
+            "pixels_uv": pixels_uv.astype(int).tolist(),
+            "area_m2": area,
+            "rms_m": seg.rms_m,
+            "n_points": seg.n_points,
+            "method": cfg.method,
+        },
+    )
+
+
+def observe(frame: Frame, cfg: BackgroundConfig) -> list[Observation]:
+    """Algorithm 1 (``ExtractOb``): the classified plane observations of one frame."""
+    grid, segments = extract_planes(frame.depth_m, frame.camera, cfg)
+    out = []
+    for seg in segments:
+        obs = _observation(seg, grid, frame, cfg)
+        if obs is not None:
+            out.append(obs)
+    return out
+
+
+def merge_observations(observations: list[MapObservation], live: dict[str, Instance],
+                       cfg: BackgroundConfig) -> tuple[dict[str, Instance], list[str]]:
+    """Algorithm 2 for each observation; ``live`` is updated. Returns (touched, deleted)."""
+    touched: dict[str, Instance] = {}
+    deleted: list[str] = []
+    for mo in observations:
+        found = match_instances(mo, list(live.values()), cfg)
+        if not found:
+            inst = new_instance(mo, cfg)
+        else:
+            target = found[0] if found[0].uuid in touched else copy.deepcopy(found[0])
+            inst = merge_into(target, found[1:], mo, cfg)
+            for dup in found[1:]:
+                live.pop(dup.uuid, None)
+                touched.pop(dup.uuid, None)
+                deleted.append(dup.uuid)
+        live[inst.uuid] = inst
+        touched[inst.uuid] = inst
+    return touched, deleted
+
+
+def _warm_up() -> None:
+    """Import the extractors' libraries now, so the first keyframe's time is not inflated."""
+    import cv2  # noqa: F401
+    import scipy.sparse.csgraph  # noqa: F401
+    import shapely  # noqa: F401
+
+
+class BackgroundStage:
+    """Background recognition (paper IV-C/D) as a ``Stage``; options are ``BackgroundConfig`` fields."""
+
+    name = "background"
+
+    def __init__(self, log_path: Any = None, **options: Any) -> None:
+        del log_path  # the background needs nothing from the log besides the frames
+        self.config = BackgroundConfig.from_options(**options)
+        self._last_keyframe_s: float | None = None
+        _warm_up()
+
+    def is_keyframe(self, stamp_s: float) -> bool:
+        if self._last_keyframe_s is None:
+            return True
+        return stamp_s - self._last_keyframe_s >= 1.0 / self.config.keyframe_hz - 1e-3
+
+    def process(self, frame: Frame, world: World) -> FrameResult:
+        if not self.is_keyframe(frame.stamp_s):
+            return FrameResult(skipped="not a keyframe")
+        self._last_keyframe_s = frame.stamp_s
+        start = time.perf_counter()
+        observations = observe(frame, self.config)
+        live = dict(world.background)
+        touched, deleted = merge_observations(
+            [to_map(o, frame.T_map_cam) for o in observations], live, self.config
+        )
+        return FrameResult(
+            observations=observations,
+            instances=list(touched.values()),
+            deleted_instances=[u for u in deleted if u in world.background],
+            timings_s={"background_s": time.perf_counter() - start},
+        )
+
+    def finish(self, world: World) -> FrameResult:
+        return FrameResult()

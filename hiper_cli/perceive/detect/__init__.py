@@ -1,0 +1,69 @@
+"""2D object detectors behind one interface, chosen by name.
+
+``make_detector(name, log_path=...)`` builds one of:
+
+- ``yolox``: the COCO YOLOX-Nano ONNX model (see ``hiper_cli.perceive.detect.yolox``);
+- ``onnx:PATH``: a user's YOLOv8 / YOLO11 ONNX export (output ``[1, 4 + nc, N]``);
+- ``log``: the detections recorded in the log (``Frame.detections``);
+- ``truth``: the simulator's noisy ground-truth detections (``LOG/gt/detections.jsonl``).
+
+Every detector turns its native output into ``Detections`` (pixel xyxy boxes, class names,
+scores) so that no later stage sees an ONNX tensor.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+from hiper_cli.errors import ConfigError
+from hiper_cli.types import Detections, Frame
+
+__all__ = ["DETECTOR_NAMES", "Detector", "make_detector"]
+
+
+@runtime_checkable
+class Detector(Protocol):
+    """Finds objects in the colour image of a frame."""
+
+    name: str
+
+    def detect(self, frame: Frame) -> Detections:
+        """The 2D detections of ``frame.rgb`` in pixel coordinates of that image."""
+        ...
+
+
+DETECTOR_NAMES: tuple[str, ...] = ("yolox", "onnx:PATH", "log", "truth")
+
+
+def make_detector(name: str, *, log_path: str | Path | None = None, **options: Any) -> Detector:
+    """Build the detector registered as ``name``; unknown names raise ``ConfigError``.
+
+    ``log_path`` is the log being processed (the ``truth`` detector reads its ``gt/`` folder);
+    ``options`` go to the detector's constructor (e.g. ``score_threshold``).
+    """
+    if name == "yolox":
+        from hiper_cli.perceive.detect.yolox import YoloxDetector
+
+        return YoloxDetector(**options)
+    if name.startswith("onnx:"):
+        from hiper_cli.perceive.detect.yolo_onnx import YoloOnnxDetector
+
+        path = name[len("onnx:") :]
+        if not path:
+            raise ConfigError("detector 'onnx:PATH' needs a path, e.g. onnx:models/yolo11n.onnx")
+        return YoloOnnxDetector(Path(path), **options)
+    if name == "log":
+        from hiper_cli.perceive.detect.recorded import LogDetector
+
+        return LogDetector(**options)
+    if name == "truth":
+        from hiper_cli.perceive.detect.recorded import TruthDetector
+
+        if log_path is None:
+            raise ConfigError(
+                "detector 'truth' needs the log folder (log_path=...) to read gt/detections.jsonl; "
+                "it only works on logs written by hiper sim"
+            )
+        return TruthDetector(Path(log_path), **options)
+    raise ConfigError(f"unknown detector {name!r}; expected one of {', '.join(DETECTOR_NAMES)}")

@@ -1,0 +1,130 @@
+"""Options of the foreground stage: one frozen dataclass, the paper's constants as defaults."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+from hiper_cli.errors import ConfigError
+
+__all__ = ["ForegroundConfig"]
+
+
+@dataclass(frozen=True)
+class ForegroundConfig:
+    """Everything the foreground stage (segmentation, matching, tracking) can be told.
+
+    Segmentation (Algorithm 3) works on an organised subsample of the depth image: every
+    ``pixel_step``-th pixel in both directions (4 → 160×120 points for 640×480), far cheaper
+    than a voxel grid and with the same effect on density.
+    """
+
+    # --- detector ---------------------------------------------------------------------------
+    detector: str = "yolox"
+    """Registry name: ``yolox``, ``onnx:PATH``, ``log`` or ``truth``."""
+    min_detection_score: float = 0.3
+    """Detections below this score are ignored by the matching."""
+    detector_threads: bool = True
+    """Run the detector in a worker thread, concurrently with the point-cloud work."""
+
+    # --- segmentation (Algorithm 3) ---------------------------------------------------------
+    background_filter: bool = True
+    """Remove points inside background instance boxes (off = the paper's ablation C4)."""
+    pixel_step: int = 4
+    """Downscale: keep every n-th pixel of the depth image in both directions."""
+    min_depth_m: float = 0.3
+    max_depth_m: float = 5.0
+    """The paper's point cloud range of 5 m."""
+    background_margin_m: float = 0.05
+    """Background boxes are grown by this much on every side before filtering."""
+    cluster_tolerance_m: float = 0.1
+    """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
+    cluster_tolerance_per_m: float = 0.04
+    """... plus this much per metre of depth (grazing surfaces, depth noise)."""
+    cluster_neighbour_cells: int = 2
+    """How far (in subsampled grid cells) a neighbour may be; bridges small depth holes."""
+    fragment_ratio: float = 0.25
+    """A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
+    fragment_distance_m: float = 0.5
+    """... when their centres are closer than this (grazing surfaces break off objects)."""
+    min_cluster_points: int = 15
+    max_cluster_points: int = 8000
+    max_cluster_extent_m: float = 3.0
+    """Clusters longer than this in any direction are structure (walls, floor), not objects."""
+    points_per_observation: int = 64
+    """Subsample of ``points_cam`` stored in each observation."""
+    pixels_per_observation: int = 48
+    """Sample of pixel coordinates ``pixels_uv`` stored in each observation."""
+
+    # --- matching (Algorithm 4) -------------------------------------------------------------
+    iou_threshold: float = 0.5
+    """A blob takes a detection's class when the IoU of their image boxes exceeds this."""
+    unknown_class: str = "unknown"
+    keep_unknown: bool = True
+    """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
+
+    # --- tracking ---------------------------------------------------------------------------
+    gate_m: float = 1.0
+    """Hungarian assignment: an observation farther than this from a track cannot join it."""
+    gate_margin_m: float = 0.15
+    """Added to the learned c_u·dt gate (position noise of two measurements)."""
+    confirm_hits: int = 3
+    """A track becomes an instance after this many associated observations."""
+    max_age_s: float = 1.5
+    """A track without an update for this long is closed."""
+    tentative_max_age_s: float = 0.3
+    """A tentative (unconfirmed) track without an update for this long is dropped."""
+    lost_max_s: float = 20.0
+    """A track unseen for this long is closed even while out of view."""
+    search_speed_mps: float = 0.6
+    """The gate of an unseen track widens by this much per second unseen ..."""
+    max_gate_m: float = 3.0
+    """... up to this."""
+    velocity_decay_s: float = 0.5
+    """Time constant of the exponential decay of a track's velocity while it gets no updates."""
+    velocity_decay_grace_s: float = 0.1
+    """No decay for this long after the last update (a missed detection must not slow a walker)."""
+    accel_noise_mps2: float = 1.0
+    """Process noise: standard deviation of the white acceleration of the constant-velocity model."""
+    vertical_noise_ratio: float = 0.3
+    """Vertical process noise relative to horizontal (objects mostly move on the floor)."""
+    prior_accel_time_s: float = 0.5
+    """With a learned speed spread sigma, the acceleration noise is sigma / this time."""
+    measurement_noise_m: float = 0.03
+    """Measurement noise: standard deviation of an observed centre."""
+    smooth_closed_tracks: bool = True
+    """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
+    dynamic_speed_mps: float = 0.15
+    """A track moving faster than this is ``dynamic``; slower is ``static``."""
+    speed_window_s: float = 0.5
+    """Trajectory velocities are smoothed over this window before deciding the state."""
+    use_learned_priors: bool = True
+    """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist."""
+    prior_tolerance: float = 0.5
+    """Size / altitude priors reject a class when a blob is outside [lo·(1-t), hi·(1+t)]."""
+
+    def __post_init__(self) -> None:
+        if self.pixel_step < 1:
+            raise ConfigError(f"pixel_step must be >= 1, got {self.pixel_step}")
+        if not 0.0 <= self.iou_threshold <= 1.0:
+            raise ConfigError(f"iou_threshold must be in [0, 1], got {self.iou_threshold}")
+        if self.min_cluster_points < 1 or self.max_cluster_points < self.min_cluster_points:
+            raise ConfigError(
+                f"cluster sizes: need 1 <= min_cluster_points <= max_cluster_points, got "
+                f"{self.min_cluster_points} and {self.max_cluster_points}"
+            )
+        if self.cluster_tolerance_m <= 0 or self.gate_m <= 0:
+            raise ConfigError("cluster_tolerance_m and gate_m must be positive")
+        if self.confirm_hits < 1:
+            raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
+
+    @classmethod
+    def from_options(cls, **options: Any) -> ForegroundConfig:
+        """Build from keyword options; an unknown name raises ``ConfigError`` listing the known."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(options) - known)
+        if unknown:
+            raise ConfigError(
+                f"unknown foreground option(s) {unknown}; expected one of {', '.join(sorted(known))}"
+            )
+        return cls(**options)

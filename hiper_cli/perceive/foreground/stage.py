@@ -1,0 +1,251 @@
+"""The foreground stage: segmentation, detection (in a worker thread), matching and tracking."""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.errors import PerceptionError
+from hiper_cli.model import Box3D, Instance, Observation
+from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.match import Match, assign_classes
+from hiper_cli.perceive.foreground.segment import Blob, segment
+from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
+from hiper_cli.perceive.stage import FrameResult, World
+from hiper_cli.types import Detections, Frame
+
+__all__ = ["ForegroundStage"]
+
+FloatArray = NDArray[np.float64]
+
+
+class ForegroundStage:
+    """Foreground recognition of the HIPer model (paper IV-E to IV-H) as a pipeline ``Stage``.
+
+    ``ForegroundStage(log_path=..., **options)``: ``options`` are the fields of
+    ``ForegroundConfig`` (unknown names raise ``ConfigError``); ``log_path`` is the log being
+    processed (the ``truth`` detector reads ``LOG/gt``). ``detector_instance`` replaces the
+    registry lookup (tests, embedding).
+    """
+
+    name = "foreground"
+
+    def __init__(
+        self,
+        log_path: str | Path | None = None,
+        detector_instance: Detector | None = None,
+        **options: Any,
+    ) -> None:
+        self.config = ForegroundConfig.from_options(**options)
+        cfg = self.config
+        # Import the heavy modules now, not inside the first frame's timing.
+        import filterpy.kalman  # noqa: F401
+        import scipy.optimize
+        import scipy.sparse.csgraph  # noqa: F401
+
+        self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
+        self._pool: ThreadPoolExecutor | None = None
+        self._priors: dict[tuple[str, str], dict[str, Any]] = {}
+        self._analyses_seen = -1
+        self.tracker = Tracker(cfg, self._class_prior)
+        self._instances: dict[str, Instance] = {}
+
+    # --- learned priors ---------------------------------------------------------------------
+    def _refresh_priors(self, world: World) -> None:
+        if len(world.analyses) == self._analyses_seen:
+            return
+        self._analyses_seen = len(world.analyses)
+        self._priors = {}
+        for a in sorted(world.analyses, key=lambda a: a.created_s):
+            if a.kind in ("ods", "size", "altitude"):
+                self._priors[(a.kind, a.class_name)] = dict(a.values)
+
+    def _class_prior(self, class_name: str) -> ClassPrior:
+        ods = self._priors.get(("ods", class_name))
+        if not ods:
+            return ClassPrior()
+        cu, sigma = ods.get("cu_mps"), ods.get("sigma_mps")
+        return ClassPrior(
+            cu_mps=float(cu) if cu is not None else None,
+            sigma_mps=float(sigma) if sigma is not None else None,
+        )
+
+    def _fits_priors(self, class_name: str, blob: Blob) -> bool:
+        """False when the learned size / altitude of ``class_name`` rule the blob out."""
+        if not self.config.use_learned_priors:
+            return True
+        tol = self.config.prior_tolerance
+        size = self._priors.get(("size", class_name))
+        if size and "lo_m3" in size and "hi_m3" in size:
+            volume = float(np.prod(blob.extent_map))
+            if not float(size["lo_m3"]) * (1 - tol) <= volume <= float(size["hi_m3"]) * (1 + tol):
+                return False
+        alt = self._priors.get(("altitude", class_name))
+        if alt and "lo_m" in alt and "hi_m" in alt:
+            lo, hi = float(alt["lo_m"]), float(alt["hi_m"])
+            slack = tol * max(hi - lo, 0.2)
+            if not lo - slack <= float(blob.center_map[2]) <= hi + slack:
+                return False
+        return True
+
+    # --- the stage --------------------------------------------------------------------------
+    def _detect_timed(self, frame: Frame) -> tuple[Detections, float]:
+        t0 = time.perf_counter()
+        dets = self.detector.detect(frame)
+        return dets, time.perf_counter() - t0
+
+    def process(self, frame: Frame, world: World) -> FrameResult:
+        cfg = self.config
+        t_start = time.perf_counter()
+        future: Future[tuple[Detections, float]] | None = None
+        if cfg.detector_threads:
+            if self._pool is None:
+                self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
+            future = self._pool.submit(self._detect_timed, frame)
+        self._refresh_priors(world)
+        boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
+        blobs, seg = segment(frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg)
+        t_seg = time.perf_counter()
+        if future is not None:
+            try:
+                dets, detect_s = future.result()
+            except Exception as err:
+                where = frame.source or f"frame {frame.pose_id}"
+                raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
+        else:
+            dets, detect_s = self._detect_timed(frame)
+        t_det = time.perf_counter()
+        matches = assign_classes(
+            np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
+            dets,
+            iou_threshold=cfg.iou_threshold,
+            min_score=cfg.min_detection_score,
+            unknown=cfg.unknown_class,
+        )
+        observations: list[Observation] = []
+        measurements: list[Measurement] = []
+        for blob, match in zip(blobs, matches, strict=True):
+            if match.detection_index is not None and not self._fits_priors(match.class_name, blob):
+                match = Match(cfg.unknown_class, 0.0, None, match.iou)
+            if match.detection_index is None and not cfg.keep_unknown:
+                continue
+            obs = self._observation(frame, blob, match, dets)
+            observations.append(obs)
+            measurements.append(
+                Measurement(blob.center_map, blob.extent_map, match.class_name, match.score, obs.uuid)
+            )
+        t_match = time.perf_counter()
+        changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
+        confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
+        for obs, track_uuid in zip(observations, joined, strict=True):
+            if track_uuid in confirmed:
+                obs.instance_uuid = track_uuid
+        instances = [self._instance(t) for t in changed]
+        t_end = time.perf_counter()
+        timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}
+        timings.update(
+            {
+                "foreground_segment_s": t_seg - t_start,
+                "foreground_detect_s": detect_s,
+                "foreground_detect_wait_s": t_det - t_seg,
+                "foreground_match_s": t_match - t_det,
+                "foreground_track_s": t_end - t_match,
+                "foreground_s": t_end - t_start,
+                "foreground_points": float(seg.points),
+                "foreground_points_after_background": float(seg.after_background),
+            }
+        )
+        return FrameResult(observations=observations, instances=instances, timings_s=timings)
+
+    def finish(self, world: World) -> FrameResult:
+        closed = self.tracker.close_all()
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+        return FrameResult(instances=[self._instance(t) for t in closed])
+
+    # --- conversions ------------------------------------------------------------------------
+    def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
+        cfg = self.config
+        n = len(blob.points_cam)
+        rng = np.random.default_rng(len(blob.points_cam) * 7919 + frame.pose_id)
+        pts_idx = rng.choice(n, size=min(n, cfg.points_per_observation), replace=False)
+        pix_idx = rng.choice(n, size=min(n, cfg.pixels_per_observation), replace=False)
+        detection = None
+        if match.detection_index is not None:
+            k = match.detection_index
+            detection = {
+                "xyxy": [float(v) for v in dets.xyxy[k]],
+                "class": dets.class_names[k],
+                "score": float(dets.scores[k]),
+                "iou": match.iou,
+            }
+        return Observation(
+            layer="foreground",
+            class_name=match.class_name,
+            confidence=match.score,
+            stamp_s=frame.stamp_s,
+            pose_id=frame.pose_id,
+            box=Box3D.from_points(blob.points_cam),
+            data={
+                "image_box_xyxy": [float(v) for v in blob.image_box_xyxy],
+                "points_cam": np.round(blob.points_cam[pts_idx], 4).tolist(),
+                "pixels_uv": blob.pixels_uv[pix_idx].tolist(),
+                "center_map": [float(v) for v in blob.center_map],
+                "num_points": n,
+                "detection": detection,
+            },
+        )
+
+    def _instance(self, track: Track) -> Instance:
+        speed = float(np.hypot(*track.velocity[:2]))
+        state = "dynamic" if speed > self.config.dynamic_speed_mps and not track.closed else "static"
+        box = Box3D(track.position, track.extent_m)
+        inst = self._instances.get(track.uuid)
+        if inst is None:
+            inst = Instance(
+                layer="foreground",
+                class_name=track.class_name,
+                box=box,
+                first_seen_s=track.first_s,
+                last_seen_s=track.last_update_s,
+                uuid=track.uuid,
+                observation_uuids=track.observation_uuids,
+                data={"trajectory": track.trajectory},
+            )
+            self._instances[track.uuid] = inst
+        inst.class_name = track.class_name
+        inst.box = box
+        inst.last_seen_s = track.last_update_s
+        inst.state = state  # type: ignore[assignment]
+        inst.confidence = track.confidence
+        inst.data["closed"] = track.closed
+        return inst
+
+    def _visibility(self, frame: Frame) -> Any:
+        """A function telling which map points the camera sees now (in image, not occluded)."""
+        T_cam_map = np.linalg.inv(frame.T_map_cam)
+        cam = frame.camera
+        depth = frame.depth_m
+        cfg = self.config
+
+        def visible(points_map: FloatArray) -> NDArray[np.bool_]:
+            p = points_map @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+            z = p[:, 2]
+            ok = (z > cfg.min_depth_m) & (z < cfg.max_depth_m)
+            u = np.where(ok, cam.fx * p[:, 0] / np.where(ok, z, 1.0) + cam.cx, -1.0)
+            v = np.where(ok, cam.fy * p[:, 1] / np.where(ok, z, 1.0) + cam.cy, -1.0)
+            ok &= (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+            ui = np.clip(u.astype(int), 0, cam.width - 1)
+            vi = np.clip(v.astype(int), 0, cam.height - 1)
+            measured = depth[vi, ui]
+            occluded = (measured > 0) & (measured < z - 0.5)
+            return np.asarray(ok & ~occluded)
+
+        return visible

@@ -1,0 +1,348 @@
+"""3D multi-object tracking of foreground observations in the map frame.
+
+- Association: the Hungarian algorithm (scipy ``linear_sum_assignment``) on the distances
+  between the tracks' predicted centres and the observed centres, with a gate: ``gate_m``, or
+  the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
+  analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
+  (up to ``max_gate_m``) so that a person who left the view is picked up again. Two different
+  known classes never associate; ``unknown`` associates with anything.
+- Filter: a constant-velocity Kalman filter (filterpy) over position and velocity with white
+  acceleration noise (class-specific from the learned ``sigma_mps`` when known). A track's
+  velocity is initialised from its first two observations (the paper started at zero, which
+  biased the speeds low) with the matching covariance.
+- Unseen tracks: their velocity decays exponentially to zero (time constant
+  ``velocity_decay_s``) once they have been unseen for longer than two frames, so a missed
+  detection does not bias a moving track. A track only ages while its predicted centre is
+  visible to the camera (in the image, not hidden behind nearer depth): a person who walks out
+  of view keeps the identity for ``lost_max_s``.
+- Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother (every row
+  then uses all observations of the track, so the first rows are no longer noisy).
+- Life cycle: tentative → confirmed after ``confirm_hits`` observations → closed after
+  ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import new_uuid
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+
+__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
+
+FloatArray = NDArray[np.float64]
+UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """One observed blob for the tracker: centre and extent in the map frame."""
+
+    center_map: FloatArray
+    extent_map: FloatArray
+    class_name: str
+    score: float
+    observation_uuid: str
+
+
+@dataclass(frozen=True)
+class ClassPrior:
+    """Learned dynamics of a class (``ods`` analysis): upper speed bound and speed spread."""
+
+    cu_mps: float | None = None
+    sigma_mps: float | None = None
+
+
+@dataclass
+class Track:
+    """One tracked object; becomes an ``Instance`` once confirmed."""
+
+    uuid: str
+    kf: object  # filterpy.kalman.KalmanFilter
+    first_s: float
+    last_update_s: float
+    last_time_s: float
+    extent_m: FloatArray
+    hits: int = 1
+    unseen_in_view_s: float = 0.0
+    confirmed: bool = False
+    closed: bool = False
+    velocity_initialised: bool = False
+    first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
+    class_votes: dict[str, float] = field(default_factory=dict)
+    score_sum: float = 0.0
+    observation_uuids: list[str] = field(default_factory=list)
+    trajectory: list[list[float]] = field(default_factory=list)
+    # per trajectory row: posterior covariance and the process noise (q, q_vertical) used
+    covariances: list[FloatArray] = field(default_factory=list)
+    noises: list[tuple[float, float]] = field(default_factory=list)
+
+    @property
+    def position(self) -> FloatArray:
+        return np.asarray(self.kf.x[:3, 0], dtype=np.float64)  # type: ignore[attr-defined]
+
+    @property
+    def velocity(self) -> FloatArray:
+        return np.asarray(self.kf.x[3:, 0], dtype=np.float64)  # type: ignore[attr-defined]
+
+    @property
+    def class_name(self) -> str:
+        known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
+        if not known:
+            return UNKNOWN
+        return max(sorted(known), key=lambda k: known[k])
+
+    @property
+    def confidence(self) -> float:
+        return self.score_sum / max(self.hits, 1)
+
+
+def _process_noise(dt: float, q: float, q_vertical: float) -> FloatArray:
+    """Q of the constant-velocity model with white acceleration of variance q (z: q_vertical)."""
+    Q = np.zeros((6, 6))
+    for axis in range(3):
+        var = q_vertical if axis == 2 else q
+        Q[axis, axis] = var * dt**4 / 4.0
+        Q[axis, axis + 3] = Q[axis + 3, axis] = var * dt**3 / 2.0
+        Q[axis + 3, axis + 3] = var * dt**2
+    return Q
+
+
+def smooth_trajectory(track: Track) -> None:
+    """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place).
+
+    The filter's estimates at the start of a track rest on few observations; once the track is
+    closed every row can use all of them. Rows keep their stamps; positions and velocities
+    become the smoothed ones.
+    """
+    rows = track.trajectory
+    n = len(rows)
+    if n < 3 or len(track.covariances) != n:
+        return
+    xs = [np.asarray(r[1:7], dtype=np.float64) for r in rows]
+    Ps = [np.asarray(P, dtype=np.float64) for P in track.covariances]
+    for k in range(n - 2, -1, -1):
+        dt = rows[k + 1][0] - rows[k][0]
+        if dt <= 0:
+            continue
+        F = np.eye(6)
+        F[:3, 3:] = np.eye(3) * dt
+        x_k, P_k = np.asarray(rows[k][1:7], dtype=np.float64), track.covariances[k]
+        x_pred = F @ x_k
+        P_pred = F @ P_k @ F.T + _process_noise(dt, *track.noises[k + 1])
+        try:
+            C = P_k @ F.T @ np.linalg.inv(P_pred)
+        except np.linalg.LinAlgError:
+            continue
+        xs[k] = x_k + C @ (xs[k + 1] - x_pred)
+        Ps[k] = P_k + C @ (Ps[k + 1] - P_pred) @ C.T
+    for row, x in zip(rows, xs, strict=True):
+        row[1:7] = x.tolist()
+
+
+def _compatible(track_class: str, meas_class: str) -> bool:
+    return UNKNOWN in (track_class, meas_class) or track_class == meas_class
+
+
+class Tracker:
+    """Hungarian association + constant-velocity Kalman filters (see the module docstring)."""
+
+    def __init__(
+        self,
+        config: ForegroundConfig,
+        priors: Callable[[str], ClassPrior] | None = None,
+    ) -> None:
+        self.config = config
+        self.priors = priors or (lambda _name: ClassPrior())
+        self.tracks: list[Track] = []  # live (tentative or confirmed)
+        self.last_stamp_s: float | None = None
+
+    # --- Kalman pieces ----------------------------------------------------------------------
+    def _accel_noise(self, class_name: str) -> float:
+        prior = self.priors(class_name)
+        if self.config.use_learned_priors and prior.sigma_mps is not None:
+            return max(float(prior.sigma_mps), 0.05) / self.config.prior_accel_time_s
+        return self.config.accel_noise_mps2
+
+    def _new_kf(self, center: FloatArray) -> object:
+        from filterpy.kalman import KalmanFilter
+
+        kf = KalmanFilter(dim_x=6, dim_z=3)
+        kf.x = np.r_[center, np.zeros(3)].reshape(6, 1)
+        kf.H = np.hstack([np.eye(3), np.zeros((3, 3))])
+        r = self.config.measurement_noise_m**2
+        kf.R = np.eye(3) * r
+        kf.P = np.diag([r, r, r, 1.0, 1.0, 1.0])
+        return kf
+
+    def _predict(self, track: Track, stamp_s: float) -> None:
+        dt = stamp_s - track.last_time_s
+        if dt <= 0:
+            return
+        kf = track.kf
+        F = np.eye(6)
+        F[:3, 3:] = np.eye(3) * dt
+        q = self._accel_noise(track.class_name) ** 2
+        kf.predict(F=F, Q=_process_noise(dt, q, q * self.config.vertical_noise_ratio**2))  # type: ignore[attr-defined]
+        track.last_time_s = stamp_s
+
+    def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
+        """Shrink the velocity of a track that got no update (after a grace of two frames)."""
+        if stamp_s - track.last_update_s <= self.config.velocity_decay_grace_s or dt <= 0:
+            return
+        factor = math.exp(-dt / self.config.velocity_decay_s)
+        track.kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
+
+    def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
+        kf = track.kf
+        if not track.velocity_initialised and track.hits == 1:
+            dt = stamp_s - track.last_update_s
+            if dt > 1e-6:
+                # Two-point initialisation: v = (z2 - z1) / dt with its own covariance.
+                v = (m.center_map - track.first_center) / dt
+                r = self.config.measurement_noise_m**2
+                kf.x = np.r_[m.center_map, v].reshape(6, 1)  # type: ignore[attr-defined]
+                var_v = 2.0 * r / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
+                kf.P = np.diag([r, r, r, var_v, var_v, var_v])  # type: ignore[attr-defined]
+                track.velocity_initialised = True
+                if track.trajectory:  # the first row gets the velocity it could not know yet
+                    track.trajectory[0][4:7] = v.tolist()
+                    track.covariances[0] = np.array(kf.P, dtype=np.float64)  # type: ignore[attr-defined]
+            else:
+                kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
+        else:
+            kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
+        track.hits += 1
+        track.last_update_s = stamp_s
+        track.unseen_in_view_s = 0.0
+        track.extent_m = 0.8 * track.extent_m + 0.2 * m.extent_map
+        self._vote(track, m)
+        if not track.confirmed and track.hits >= self.config.confirm_hits:
+            track.confirmed = True
+
+    def _vote(self, track: Track, m: Measurement) -> None:
+        track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + max(m.score, 1e-3)
+        track.score_sum += m.score
+        track.observation_uuids.append(m.observation_uuid)
+        track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
+        q = self._accel_noise(track.class_name) ** 2
+        track.covariances.append(np.array(track.kf.P, dtype=np.float64))  # type: ignore[attr-defined]
+        track.noises.append((q, q * self.config.vertical_noise_ratio**2))
+
+    # --- association ------------------------------------------------------------------------
+    def _gate(self, track: Track, stamp_s: float) -> float:
+        cfg = self.config
+        dt = stamp_s - track.last_update_s
+        prior = self.priors(track.class_name)
+        if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
+            return float(prior.cu_mps) * dt + cfg.gate_margin_m
+        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0)
+        return min(cfg.gate_m + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
+
+    def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
+        """(track index, measurement index) pairs of the gated Hungarian assignment."""
+        from scipy.optimize import linear_sum_assignment
+
+        if not self.tracks or not measurements:
+            return []
+        pred = np.array([t.position for t in self.tracks])
+        obs = np.array([m.center_map for m in measurements])
+        cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
+        gates = np.array([self._gate(t, stamp_s) for t in self.tracks])
+        allowed = cost <= gates[:, None]
+        for i, t in enumerate(self.tracks):
+            cls = t.class_name
+            for j, m in enumerate(measurements):
+                if allowed[i, j] and not _compatible(cls, m.class_name):
+                    allowed[i, j] = False
+        big = 1e6
+        rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
+        return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
+
+    # --- one step ---------------------------------------------------------------------------
+    def step(
+        self,
+        stamp_s: float,
+        measurements: Sequence[Measurement],
+        visible: Callable[[FloatArray], NDArray[np.bool_]] | None = None,
+    ) -> tuple[list[Track], list[str | None]]:
+        """Advance to ``stamp_s`` with this frame's measurements.
+
+        ``visible(points_map (N, 3)) -> (N,) bool`` says which predicted centres the camera
+        could see now (None: all). Returns the tracks that changed (updated, newly confirmed or
+        closed) and, per measurement, the uuid of the track it joined (``None``: a new
+        tentative track).
+        """
+        dt_frame = 0.0 if self.last_stamp_s is None else max(stamp_s - self.last_stamp_s, 0.0)
+        self.last_stamp_s = stamp_s
+        for t in self.tracks:
+            self._predict(t, stamp_s)
+        pairs = self.associate(measurements, stamp_s)
+        changed: list[Track] = []
+        joined: list[str | None] = [None] * len(measurements)
+        updated = set()
+        for ti, mi in pairs:
+            track = self.tracks[ti]
+            self._update(track, measurements[mi], stamp_s)
+            joined[mi] = track.uuid
+            updated.add(ti)
+            if track.confirmed:
+                changed.append(track)
+        unseen = [i for i in range(len(self.tracks)) if i not in updated]
+        if unseen:
+            seen_now = (
+                visible(np.array([self.tracks[i].position for i in unseen]))
+                if visible is not None
+                else np.ones(len(unseen), dtype=bool)
+            )
+            for i, in_view in zip(unseen, seen_now, strict=True):
+                track = self.tracks[i]
+                self._decay(track, dt_frame, stamp_s)
+                if in_view:
+                    track.unseen_in_view_s += dt_frame
+                limit = self.config.max_age_s if track.confirmed else self.config.tentative_max_age_s
+                if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > self.config.lost_max_s:
+                    track.closed = True
+                    if track.confirmed:
+                        self._close(track)
+                        changed.append(track)
+        self.tracks = [t for t in self.tracks if not t.closed]
+        for j, m in enumerate(measurements):
+            if joined[j] is None:
+                self.tracks.append(self._birth(m, stamp_s))
+        return changed, joined
+
+    def _close(self, track: Track) -> None:
+        if self.config.smooth_closed_tracks:
+            smooth_trajectory(track)
+        track.covariances, track.noises = [], []
+
+    def _birth(self, m: Measurement, stamp_s: float) -> Track:
+        track = Track(
+            uuid=new_uuid(),
+            kf=self._new_kf(m.center_map),
+            first_s=stamp_s,
+            last_update_s=stamp_s,
+            last_time_s=stamp_s,
+            extent_m=np.asarray(m.extent_map, dtype=np.float64).copy(),
+            first_center=np.asarray(m.center_map, dtype=np.float64).copy(),
+        )
+        self._vote(track, m)
+        track.confirmed = self.config.confirm_hits <= 1
+        return track
+
+    def close_all(self) -> list[Track]:
+        """Close every live track (end of the log); returns the confirmed ones."""
+        out = []
+        for t in self.tracks:
+            t.closed = True
+            if t.confirmed:
+                self._close(t)
+                out.append(t)
+        self.tracks = []
+        return out

@@ -1,0 +1,300 @@
+"""``simulate``: drive the robot through a world, render every frame, write the log and its truth.
+
+Timeline: stamps ``k / rate_hz`` from 0; the mapping phase (no people, carts still) lasts
+``mapping_s``, then the operation phase adds the people and lets the carts move. Output:
+the TUM RGB-D folder (written by ``TumWriter``) plus ``gt/`` as specified in
+``hiper_cli.sim.truth``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.errors import ConfigError, LogError
+from hiper_cli.model import Box3D
+from hiper_cli.sim.meshes import Mesh, human, rot_z
+from hiper_cli.sim.noise import NoiseModel, detect
+from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
+from hiper_cli.sim.render import RenderConfig, Renderer
+from hiper_cli.sim.route import RouteConfig, plan_route
+from hiper_cli.sim.worlds import World, make_world
+
+__all__ = ["SimConfig", "SimResult", "simulate"]
+
+_STRIDES = 9  # leg poses per person, from -1 to 1
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Everything that shapes a log besides the world, its seed and its length."""
+
+    rate_hz: float = 30.0
+    mapping_s: float | None = None  # default: a third of the log, at most 60 s
+    render: RenderConfig = field(default_factory=RenderConfig)
+    route: RouteConfig = field(default_factory=RouteConfig)
+    people: SocialForceConfig = field(default_factory=SocialForceConfig)
+    noise: NoiseModel = field(default_factory=NoiseModel)
+    png_compression: int = 3
+
+    def mapping_for(self, seconds: float) -> float:
+        if self.mapping_s is None:
+            return min(seconds / 3.0, 60.0)
+        return self.mapping_s
+
+
+@dataclass(frozen=True)
+class SimResult:
+    out: Path
+    world: str
+    seed: int
+    frames: int
+    seconds: float
+    mapping_s: float
+    instances: int
+    people: int
+    elapsed_s: float
+
+    @property
+    def frames_per_s(self) -> float:
+        return self.frames / self.elapsed_s if self.elapsed_s > 0 else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "out": str(self.out),
+            "world": self.world,
+            "seed": self.seed,
+            "frames": self.frames,
+            "seconds": self.seconds,
+            "mapping_s": self.mapping_s,
+            "instances": self.instances,
+            "people": self.people,
+            "elapsed_s": round(self.elapsed_s, 3),
+            "frames_per_s": round(self.frames_per_s, 2),
+        }
+
+
+def _person_box(height_m: float, radius_m: float, x: float, y: float) -> Box3D:
+    return Box3D(np.array([x, y, height_m / 2.0]), np.array([2 * radius_m, 2 * radius_m, height_m]))
+
+
+def simulate(
+    world: str | World,
+    seconds: float,
+    seed: int,
+    out: str | Path,
+    config: SimConfig | None = None,
+    *,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> SimResult:
+    """Write a simulated log of ``seconds`` to ``out``; the same arguments give identical files."""
+    import cv2
+
+    from hiper_cli.perceive.logs import TumWriter
+    from hiper_cli.types import Frame
+
+    cfg = config or SimConfig()
+    if seconds <= 0 or cfg.rate_hz <= 0:
+        raise ConfigError(f"seconds={seconds}, rate_hz={cfg.rate_hz}: both must be positive")
+    w = make_world(world, seed) if isinstance(world, str) else world
+    mapping_s = cfg.mapping_for(seconds)
+    if not 0 <= mapping_s <= seconds:
+        raise ConfigError(f"mapping phase {mapping_s} s: expected between 0 and the log length {seconds} s")
+    n_frames = max(1, math.floor(seconds * cfg.rate_hz + 1e-9))
+    stamps = np.arange(n_frames) / cfg.rate_hz
+    route = plan_route(w, float(stamps[-1]) + 1.0, cfg.route)
+    renderer = Renderer([(o.id, o.mesh) for o in w.objects], cfg.render)
+    crowd = Crowd(w, seed, cfg.people)
+    carts = Carts(w.carts, seed)
+
+    people_meshes: list[list[Mesh]] = []
+    radius: list[float] = []
+    for spec in crowd.specs:
+        poses = [
+            human(spec.height_m, spec.skin, spec.shirt, spec.trousers, spec.hair, s)
+            for s in np.linspace(-1.0, 1.0, _STRIDES)
+        ]
+        people_meshes.append(poses)
+        radius.append(max(float(np.hypot(m.vertices[:, 0], m.vertices[:, 1]).max()) for m in poses))
+    classes = {o.id: o.class_name for o in w.objects}
+    classes.update({s.id: "person" for s in crowd.specs})
+    classes.update({c.id: "cart" for c in carts.specs})
+    picture_ids = frozenset(o.id for o in w.objects if o.class_name in ("picture", "tv"))
+
+    root = Path(out)
+    writer = TumWriter(root, renderer.camera, overwrite=overwrite)
+    gt = root / "gt"
+    (gt / "instance_ids").mkdir(parents=True, exist_ok=True)
+    for stale in (gt / "instance_ids").glob("*.png"):
+        stale.unlink()
+    first_box: dict[int, Box3D] = {}
+    tracks_rows: list[list[Any]] = []
+    png = [cv2.IMWRITE_PNG_COMPRESSION, int(cfg.png_compression)]
+    op_start = next((k for k, t in enumerate(stamps) if t >= mapping_s - 1e-9), n_frames)
+    started = time.perf_counter()
+
+    def _save(frame: Frame, ids: np.ndarray) -> None:
+        stem = writer.write(frame)
+        if not cv2.imwrite(str(gt / "instance_ids" / f"{stem}.png"), ids, png):
+            raise LogError(f"{gt / 'instance_ids'}: cannot write the id image; check the disk")
+
+    with ThreadPoolExecutor(max_workers=1) as pool, writer, (gt / "detections.jsonl").open("w") as det_fh:
+        pending: Future[None] | None = None
+        prev_t = 0.0
+        for k, t in enumerate(stamps):
+            operating = k >= op_start
+            dt = float(t - prev_t)
+            prev_t = float(t)
+            x, y, _ = route.state_at(float(t))
+            if operating and k > op_start:
+                crowd.step(dt, (x, y), carts.footprints())
+            carts.step(dt, operating and k > op_start)
+            dynamic: list[tuple[int, Mesh]] = []
+            if operating:
+                for i, spec in enumerate(crowd.specs):
+                    px, py = crowd.pos[i]
+                    s = round((crowd.stride(i) + 1.0) / 2.0 * (_STRIDES - 1))
+                    dynamic.append(
+                        (spec.id, people_meshes[i][s].transformed(rot_z(crowd.heading[i], (px, py, 0.0))))
+                    )
+                    box = _person_box(spec.height_m, radius[i], float(px), float(py))
+                    first_box.setdefault(spec.id, box)
+                    vx, vy = crowd.vel[i]
+                    tracks_rows.append(
+                        [f"{t:.6f}", spec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
+                    )
+            for i, cspec in enumerate(carts.specs):
+                cx, cy = carts.pos[i]
+                mesh = cspec.mesh.transformed(rot_z(cspec.yaw_rad, (cx, cy, 0.0)))
+                dynamic.append((cspec.id, mesh))
+                lo, hi = mesh.bounds()
+                box = Box3D((lo + hi) / 2.0, hi - lo)
+                first_box.setdefault(cspec.id, box)
+                vx, vy = carts.vel[i]
+                tracks_rows.append(
+                    [f"{t:.6f}", cspec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
+                )
+            T = route.pose_at(float(t))
+            rng = np.random.default_rng([seed, k])
+            image = renderer.render(T, dynamic, rng)
+            detections = detect(image.ids, classes, cfg.noise, rng, picture_ids)
+            det_fh.write(json.dumps({"stamp_s": round(float(t), 6), "detections": detections}) + "\n")
+            frame = Frame(
+                stamp_s=float(t),
+                rgb=image.rgb,
+                depth_m=image.depth_m,
+                camera=renderer.camera,
+                T_map_cam=T,
+                pose_id=k,
+                source=f"sim:{w.name}:{k}",
+            )
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(_save, frame, image.ids)
+            if progress is not None:
+                progress(k + 1, n_frames)
+        if pending is not None:
+            pending.result()
+
+    elapsed = time.perf_counter() - started
+    with (gt / "tracks.csv").open("w", newline="") as fh:
+        out_csv = csv.writer(fh)
+        out_csv.writerow(["stamp_s", "id", "x", "y", "z", "vx", "vy", "vz"])
+        out_csv.writerows(tracks_rows)
+    (gt / "noise.json").write_text(json.dumps(cfg.noise.to_dict(), indent=2) + "\n")
+    (gt / "world.json").write_text(
+        json.dumps(_world_doc(w, crowd, carts, first_box, cfg, stamps, op_start), indent=1) + "\n"
+    )
+    return SimResult(
+        root,
+        w.name,
+        seed,
+        n_frames,
+        float(seconds),
+        mapping_s,
+        len(w.objects) + len(crowd.specs) + len(carts.specs),
+        len(crowd.specs),
+        elapsed,
+    )
+
+
+def _world_doc(
+    w: World,
+    crowd: Crowd,
+    carts: Carts,
+    first_box: dict[int, Box3D],
+    cfg: SimConfig,
+    stamps: np.ndarray,
+    op_start: int,
+) -> dict[str, Any]:
+    instances: list[dict[str, Any]] = [
+        {
+            "id": o.id,
+            "name": o.name,
+            "class": o.class_name,
+            "layer": o.layer,
+            "state": "static",
+            "box": o.box.to_dict(),
+            "plane": list(o.plane) if o.plane else None,
+            "speed_mps": None,
+        }
+        for o in w.objects
+    ]
+    for spec in crowd.specs:
+        if spec.id in first_box:
+            instances.append(
+                {
+                    "id": spec.id,
+                    "name": spec.name,
+                    "class": "person",
+                    "layer": "foreground",
+                    "state": "dynamic",
+                    "box": first_box[spec.id].to_dict(),
+                    "plane": None,
+                    "speed_mps": spec.speed_mps,
+                }
+            )
+    for cspec in carts.specs:
+        instances.append(
+            {
+                "id": cspec.id,
+                "name": cspec.name,
+                "class": "cart",
+                "layer": "foreground",
+                "state": "dynamic",
+                "box": first_box[cspec.id].to_dict(),
+                "plane": None,
+                "speed_mps": cspec.speed_mps,
+            }
+        )
+    last = float(stamps[-1])
+    phases = []
+    if op_start > 0:
+        phases.append({"name": "mapping", "t_start_s": 0.0, "t_end_s": float(stamps[op_start - 1])})
+    if op_start < len(stamps):
+        phases.append({"name": "operation", "t_start_s": float(stamps[op_start]), "t_end_s": last})
+    return {
+        "world": w.name,
+        "seed": w.seed,
+        "rate_hz": cfg.rate_hz,
+        "bounds_m": list(w.bounds),
+        "ceiling_m": w.ceiling_m,
+        "walls_xy": [list(r) for r in w.walls],
+        "robot": {
+            "speed_mps": cfg.route.speed_mps,
+            "camera_height_m": cfg.route.camera_height_m,
+            "camera_pitch_deg": cfg.route.camera_pitch_deg,
+        },
+        "instances": instances,
+        "phases": phases,
+    }

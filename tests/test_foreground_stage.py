@@ -1,0 +1,125 @@
+"""The foreground stage end to end on ray-cast scenes, and ``hiper eval foreground``."""
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hiper_cli.cli import app
+from hiper_cli.errors import ConfigError
+from hiper_cli.model import Analysis
+from hiper_cli.perceive.foreground import ForegroundConfig, ForegroundStage
+from hiper_cli.perceive.foreground.segment import segment
+from hiper_cli.perceive.runner import run_stages
+from hiper_cli.perceive.stage import World, make_stage
+from tests.fg_scene import (
+    CAMERA,
+    background_instances,
+    chair,
+    make_frame,
+    person,
+    pose_looking_x,
+    room,
+    write_sim_log,
+)
+
+RATE_HZ = 30.0
+
+
+def walker_frames(n=60, speed=0.6):
+    return [
+        make_frame([*room(), person(10, 3.0, -1.0 + speed * k / RATE_HZ)], pose_looking_x(), k / RATE_HZ, k)
+        for k in range(n)
+    ]
+
+
+def test_unknown_option_is_a_config_error():
+    with pytest.raises(ConfigError, match="unknown foreground option"):
+        ForegroundStage(detector="log", iou=0.3)
+    with pytest.raises(ConfigError, match="iou_threshold must be in"):
+        ForegroundConfig(iou_threshold=1.5)
+
+
+def test_registry_builds_the_stage():
+    stage = make_stage("foreground", detector="log", pixel_step=2)
+    assert stage.name == "foreground"
+
+
+def test_background_filter_leaves_only_the_person():
+    boxes = [*room(), person(10, 3.0, 0.0), chair(11, 4.0, 1.0)]
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = [i.box for i in background_instances(boxes).values()]
+    cfg = ForegroundConfig(pixel_step=2)
+    blobs, stats = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
+    assert stats.after_background < stats.points / 3
+    centres = sorted(b.center_map[1] for b in blobs)
+    assert len(blobs) == 2 and centres == pytest.approx([0.0, 1.0], abs=0.05)
+    # Without the filter (C4) the person merges with the floor into one rejected cluster and
+    # strips of far floor become blobs.
+    off = ForegroundConfig(pixel_step=2, background_filter=False)
+    blobs_off, stats_off = segment(frame.depth_m, CAMERA, frame.T_map_cam, [], off)
+    assert stats_off.after_background == stats.points
+    assert not any(np.linalg.norm(b.center_map[:2] - [2.85, 0.0]) < 0.2 for b in blobs_off)
+    assert any(b.extent_map[2] < 0.05 for b in blobs_off)
+
+
+def test_walker_becomes_one_dynamic_person_with_its_speed():
+    stage = ForegroundStage(detector="log", pixel_step=2)
+    world, _ = run_stages(walker_frames(), [stage], World(background=background_instances(room())))
+    (inst,) = world.foreground.values()
+    assert inst.class_name == "person" and inst.layer == "foreground"
+    rows = np.array(inst.data["trajectory"])
+    assert rows.shape == (60, 7)
+    assert np.hypot(rows[:, 4], rows[:, 5]).mean() == pytest.approx(0.6, abs=0.05)
+    assert inst.box.center_m[0] == pytest.approx(2.85, abs=0.05)  # the visible front at x = 2.85
+    assert len(inst.observation_uuids) == 60
+
+
+def test_observations_carry_the_low_level_data():
+    stage = ForegroundStage(detector="log", pixel_step=2, confirm_hits=2)
+    world = World(background=background_instances(room()))
+    frames = walker_frames(3)
+    results = []
+    for f in frames:
+        r = stage.process(f, world)
+        world.apply(r)
+        results.append(r)
+    obs = results[-1].observations[0]
+    assert obs.class_name == "person" and obs.frame_id == "camera" and obs.pose_id == 2
+    assert set(obs.data) >= {"image_box_xyxy", "points_cam", "pixels_uv", "detection", "center_map"}
+    assert obs.data["detection"]["class"] == "person"
+    assert obs.instance_uuid in world.foreground
+    assert results[0].observations[0].instance_uuid is None  # tentative track: not yet an instance
+    assert {"foreground_s", "foreground_detect_s", "foreground_cluster_s"} <= set(results[-1].timings_s)
+    assert stage.finish(world).instances[0].data["closed"] is True
+
+
+def test_learned_size_prior_turns_implausible_blobs_unknown():
+    world = World(background=background_instances(room()))
+    world.analyses.append(Analysis("size", "person", 0, 1, {"lo_m3": 5.0, "hi_m3": 9.0}, created_s=1.0))
+    stage = ForegroundStage(detector="log", pixel_step=2)
+    r = stage.process(walker_frames(1)[0], world)
+    assert [o.class_name for o in r.observations] == ["unknown"]
+
+
+def test_eval_foreground_command_on_a_small_sim_log(tmp_path):
+    log = tmp_path / "log"
+    write_sim_log(log, seconds=2.0, fp_every=10)
+    args = ["eval", "foreground", str(log), "--json", "--no-ablation", "--background", "truth",
+            "--set", "pixel_step=2"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    ours = report["ours"]
+    assert ours["classification"] == {"chair": {"tp": 1, "fp": 0}, "person": {"tp": 1, "fp": 0}}
+    assert ours["identity_switches"] == 0
+    assert ours["moving_people_speed_error_mps"] == pytest.approx(0.0, abs=0.05)
+    assert ours["localisation_visible_m"][0] < 0.03
+    assert ours["frames"] == 60 and "ablation" not in report
+
+
+def test_eval_foreground_needs_ground_truth(tmp_path):
+    result = CliRunner().invoke(app, ["eval", "foreground", str(tmp_path)])
+    assert result.exit_code != 0
+    assert "gt/world.json: not found" in result.output

@@ -1,0 +1,132 @@
+"""The tracker: crossing tracks, leaving the view, velocity decay, Kalman speed estimates."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Tracker
+
+RATE_HZ = 30.0
+
+
+def meas(xyz, cls="person", k=0):
+    return Measurement(np.asarray(xyz, float), np.array([0.4, 0.4, 1.7]), cls, 0.9, f"o{k}")
+
+
+def run(tracker, positions_by_frame, visible=None):
+    """positions_by_frame: list of lists of (label, xyz); returns label -> set of track uuids."""
+    ids: dict[str, set[str]] = {}
+    for k, items in enumerate(positions_by_frame):
+        ms = [meas(xyz, k=k) for _, xyz in items]
+        _, joined = tracker.step(k / RATE_HZ, ms, visible(k) if visible else None)
+        for (label, _), uuid in zip(items, joined, strict=True):
+            if uuid is not None:
+                ids.setdefault(label, set()).add(uuid)
+    return ids
+
+
+def test_two_people_crossing_keep_their_identities():
+    rng = np.random.default_rng(3)
+    frames = []
+    for k in range(120):
+        t = k / RATE_HZ
+        a = np.array([2.0 + 0.6 * t, 0.0 + 0.6 * t, 0.9]) + rng.normal(0, 0.01, 3)
+        b = np.array([2.3 + 0.6 * t, 2.4 - 0.6 * t, 0.9]) + rng.normal(0, 0.01, 3)
+        frames.append([("a", a), ("b", b)])  # paths cross; at t = 2 s they pass 0.3 m apart
+    ids = run(Tracker(ForegroundConfig()), frames)
+    assert len(ids["a"]) == 1 and len(ids["b"]) == 1 and ids["a"] != ids["b"]
+
+
+def test_person_leaving_the_view_and_coming_back_keeps_its_identity():
+    tracker = Tracker(ForegroundConfig())
+    frames, hidden = [], set()
+    for k in range(240):
+        t = k / RATE_HZ
+        pos = np.array([3.0, -1.5 + 0.5 * t, 0.9])
+        if 1.5 <= t < 4.0:  # out of the camera's view for 2.5 s
+            frames.append([])
+            hidden.add(k)
+        else:
+            frames.append([("p", pos)])
+
+    def visible(k):
+        return lambda pts: np.full(len(pts), k not in hidden)
+
+    ids = run(tracker, frames, visible)
+    assert len(ids["p"]) == 1
+
+
+def test_track_in_view_without_updates_dies():
+    cfg = ForegroundConfig(max_age_s=0.5)
+    tracker = Tracker(cfg)
+    run(tracker, [[("p", [1.0, 0, 0.9])]] * 5 + [[]] * 30)
+    assert tracker.tracks == []
+
+
+def test_velocity_decays_while_unseen_but_not_after_one_miss():
+    cfg = ForegroundConfig(velocity_decay_s=0.5)
+    tracker = Tracker(cfg)
+    for k in range(30):
+        tracker.step(k / RATE_HZ, [meas([1.0 + 0.6 * k / RATE_HZ, 0, 0.9], k=k)])
+    (track,) = tracker.tracks
+    v0 = np.linalg.norm(track.velocity)
+    assert v0 == pytest.approx(0.6, abs=0.05)
+    tracker.step(30 / RATE_HZ, [])  # one missed frame: no decay
+    assert np.linalg.norm(track.velocity) == pytest.approx(v0, rel=1e-9)
+    for k in range(31, 61):
+        tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
+    v1 = np.linalg.norm(track.velocity)
+    unseen_decay_s = 60 / RATE_HZ - 30 / RATE_HZ - cfg.velocity_decay_grace_s
+    assert v1 < v0 * 0.2
+    assert v1 == pytest.approx(v0 * np.exp(-unseen_decay_s / 0.5), rel=0.15)
+
+
+@pytest.mark.parametrize("speed", [0.3, 0.6, 1.2])
+def test_kalman_speed_of_a_constant_velocity_walker(speed):
+    rng = np.random.default_rng(11)
+    tracker = Tracker(ForegroundConfig())
+    heading = np.array([np.cos(0.7), np.sin(0.7), 0.0])
+    for k in range(90):
+        pos = np.array([1.0, 1.0, 0.9]) + heading * speed * k / RATE_HZ + rng.normal(0, 0.01, 3)
+        tracker.step(k / RATE_HZ, [meas(pos, k=k)])
+    (track,) = tracker.tracks
+    rows = np.array(track.trajectory)
+    speeds = np.hypot(rows[:, 4], rows[:, 5])
+    assert len(rows) == 90
+    assert speeds.mean() == pytest.approx(speed, abs=0.05)  # not biased low: no zero start
+    assert speeds[-30:].mean() == pytest.approx(speed, abs=0.03)
+
+
+def test_different_known_classes_never_associate():
+    tracker = Tracker(ForegroundConfig())
+    tracker.step(0.0, [meas([1, 0, 0.5], "chair")])
+    _, joined = tracker.step(1 / RATE_HZ, [meas([1, 0, 0.5], "person")])
+    assert joined == [None] and len(tracker.tracks) == 2
+
+
+def test_learned_speed_bound_gates_association():
+    # c_u = 0.5 m/s: a jump of 0.5 m in 1/30 s is impossible for this class.
+    tracker = Tracker(ForegroundConfig(), lambda c: ClassPrior(cu_mps=0.5, sigma_mps=0.1))
+    tracker.step(0.0, [meas([1, 0, 0.9])])
+    _, joined = tracker.step(1 / RATE_HZ, [meas([1.5, 0, 0.9])])
+    assert joined == [None]
+    plain = Tracker(ForegroundConfig())
+    plain.step(0.0, [meas([1, 0, 0.9])])
+    _, joined = plain.step(1 / RATE_HZ, [meas([1.5, 0, 0.9])])
+    assert joined[0] is not None
+
+
+def test_closing_a_track_smooths_its_first_rows():
+    rng = np.random.default_rng(5)
+    tracker = Tracker(ForegroundConfig())
+    for k in range(60):
+        pos = np.array([1.0 + 0.6 * k / RATE_HZ, 0.0, 0.9]) + rng.normal(0, 0.01, 3)
+        tracker.step(k / RATE_HZ, [meas(pos, k=k)])
+    (track,) = tracker.tracks
+    raw = np.array(track.trajectory)
+    (closed,) = tracker.close_all()
+    smooth = np.array(closed.trajectory)
+    assert closed.closed and smooth.shape == raw.shape and np.allclose(smooth[:, 0], raw[:, 0])
+    err_raw = np.abs(np.hypot(raw[:10, 4], raw[:10, 5]) - 0.6).mean()
+    err_smooth = np.abs(np.hypot(smooth[:10, 4], smooth[:10, 5]) - 0.6).mean()
+    assert err_smooth < err_raw / 2 and err_smooth < 0.05
