@@ -120,6 +120,29 @@ def test_stage_factories_get_the_log_path_and_options(tmp_path, probe_registry):
         build_stages(["probe"], tmp_path / "log", {"ghost": {"x": 1}})
 
 
+class NeedsModel:
+    name = "needs_model"
+
+    def __init__(self, log_path=None, model=None):
+        if model is None:
+            raise ConfigError("stage needs_model: no model file; pass -o needs_model.model=PATH")
+
+
+def test_default_stages_that_cannot_build_are_reported_not_fatal(tmp_path, monkeypatch):
+    import hiper_cli.pipeline as pipeline
+
+    registry = {"probe": "tests.kb_helpers:ProbeStage", "needs_model": "tests.test_kb_pipeline:NeedsModel"}
+    monkeypatch.setattr(stage_module, "STAGES", registry)
+    monkeypatch.setattr(pipeline, "STAGES", registry)
+    stages, unavailable = build_stages(None, tmp_path / "log")
+    assert [s.name for s in stages] == ["probe"]
+    assert "no model file" in unavailable["needs_model"]
+    with pytest.raises(ConfigError, match="no model file"):
+        build_stages(["probe", "needs_model"], tmp_path / "log")
+    with pytest.raises(ConfigError, match="no model file"):
+        build_stages(None, tmp_path / "log", {"needs_model": {"model": None}})
+
+
 def _tum_log(root: Path, n=6) -> Path:
     with TumWriter(root, CAMERA) as writer:
         for i in range(n):
