@@ -130,6 +130,25 @@ def test_check_repairs_a_damaged_graph(kb_location):
         assert kb.check(repair=False).ok
 
 
+def test_check_finds_a_wrong_attribute(kb_location):
+    import pyoxigraph as ox
+
+    from hiper_cli.graph.ontology import h, node
+
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _, _, world = _fill(kb)
+        kb.sync_graph()
+        floor = next(iter(world.background.values()))
+        g = layer_graph(kb.kb_id, "background")
+        kb.graph.write(kb.kb_id, [node(floor.uuid).value], [],  # same counts, wrong class
+                       [ox.Quad(node(floor.uuid), h("className"), ox.Literal("ceiling"), g)])
+        report = kb.check(repair=False)
+        assert not report.ok
+        assert any("triples missing" in p for p in report.problems), report.problems
+        assert kb.check(repair=True).ok and kb.check(repair=False).ok
+
+
 def test_graph_catches_up_from_the_high_water_mark(kb_location):
     location, docs = kb_location
     with open_kb(location, docs_dir=docs) as kb:

@@ -460,13 +460,26 @@ class DocumentStore:
             if not rows:
                 return
             last_id = int(rows[-1][0])
-            out = []
-            for _, body, env in rows:
-                doc = json.loads(body)
-                if env is not None:
-                    doc.setdefault("env_uuid", env)
-                out.append(doc)
-            yield out
+            yield [self._stored(body, env) for _, body, env in rows]
+
+    @staticmethod
+    def _stored(body: str, env: str | None) -> dict[str, Any]:
+        """A body as stored (instances without their observation list), plus ``env_uuid``."""
+        doc: dict[str, Any] = json.loads(body)
+        if env is not None:
+            doc.setdefault("env_uuid", env)
+        return doc
+
+    def sample(self, n: int, seed: int = 0) -> list[dict[str, Any]]:
+        """Up to ``n`` documents spread evenly over the store, in the form ``changed_docs`` gives."""
+        total = int(self._scalar("SELECT MAX(id) FROM docs") or 0)
+        if total == 0 or n <= 0:
+            return []
+        step = max(1, total // n)
+        rows = self._db.execute(
+            "SELECT body, env_uuid FROM docs WHERE (id + ?) % ? = 0 LIMIT ?", (seed, step, n)
+        ).fetchall()
+        return [self._stored(body, env) for body, env in rows]
 
     _LINK_LAYER = (
         "COALESCE((SELECT layer FROM docs WHERE uuid = l.instance_uuid), "

@@ -58,10 +58,12 @@ GRAPH_DIR = "graph"
 class KbConfig:
     """``observation_detail``: how much of each observation the graph holds ("summary": class,
     stamp and provenance link; "full": also pose id, frame, confidence and box).
-    ``sync_batch``: documents per graph write when catching up."""
+    ``sync_batch``: documents per graph write when catching up. ``check_sample``: documents
+    whose graph nodes ``check`` compares triple by triple (beyond comparing all counts)."""
 
     observation_detail: str = "summary"
     sync_batch: int = 2000
+    check_sample: int = 500
 
     def __post_init__(self) -> None:
         if self.observation_detail not in OBSERVATION_DETAIL:
@@ -113,6 +115,16 @@ def _map_aabb(box: Box3D, T_map_box: Any) -> tuple[list[float], list[float]]:
     return (c - half).tolist(), (c + half).tolist()
 
 
+def _value(term: Any) -> Any:
+    """A comparable value of an RDF term: numbers by value (stores canonicalise "10.0" to "10")."""
+    datatype = getattr(getattr(term, "datatype", None), "value", "")
+    if datatype.endswith("#double"):
+        return float(term.value)
+    if datatype.endswith("#integer"):
+        return int(term.value)
+    return str(term)
+
+
 class KnowledgeBase:
     """Open with ``open_kb``. Not thread-safe; one writer process at a time."""
 
@@ -138,7 +150,8 @@ class KnowledgeBase:
         if detail is None and not read_only:
             docs.set_meta("observation_detail", config.observation_detail)
         elif detail is not None and detail != config.observation_detail:
-            self.config = KbConfig(observation_detail=detail, sync_batch=config.sync_batch)
+            self.config = KbConfig(observation_detail=detail, sync_batch=config.sync_batch,
+                                   check_sample=config.check_sample)
 
     # -- lifecycle ----------------------------------------------------------------------------
 
@@ -311,6 +324,26 @@ class KnowledgeBase:
             out[f"{layer}/wasDerivedFrom"] = n
         return out
 
+    def _compare_nodes(self, n: int) -> list[str]:
+        """Compare the graph nodes of up to ``n`` documents, spread over the store, triple by
+        triple with what the documents say they should be."""
+        docs = self.docs.sample(n)
+        if not docs:
+            return []
+        detail = self.config.observation_detail
+        expected = {(str(q.subject), str(q.predicate), _value(q.object), str(q.graph_name))
+                    for d in docs for q in doc_quads(self.kb_id, d, detail)}
+        subjects = " ".join(str(node(d["uuid"])) for d in docs)
+        rows = self.graph.query(
+            f"SELECT ?s ?p ?o ?g WHERE {{ VALUES ?s {{ {subjects} }} GRAPH ?g {{ ?s ?p ?o }} "
+            "FILTER(?p != prov:wasDerivedFrom) }"
+        )
+        actual = {(str(r["s"]), str(r["p"]), _value(r["o"]), str(r["g"])) for r in rows}
+        if actual == expected:
+            return []
+        return [f"graph nodes differ from their documents: {len(expected - actual)} triples missing, "
+                f"{len(actual - expected)} unexpected, in a sample of {len(docs)} documents"]
+
     def check(self, *, repair: bool = True) -> CheckReport:
         """Verify the documents and that the graph agrees with them; rebuild the graph from the
         documents when it does not (``repair``)."""
@@ -324,6 +357,7 @@ class KnowledgeBase:
             diff = [f"{k}: graph {graph_counts.get(k, 0)} vs documents {doc_counts.get(k, 0)}"
                     for k in keys if graph_counts.get(k, 0) != doc_counts.get(k, 0)]
             problems.append("graph and documents disagree: " + "; ".join(diff))
+        problems += self._compare_nodes(self.config.check_sample)
         report = CheckReport(ok=not problems, problems=problems, graph_counts=graph_counts,
                              document_counts=doc_counts)
         if problems and repair and not self.read_only:
