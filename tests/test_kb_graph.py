@@ -243,3 +243,26 @@ def test_read_while_a_writer_holds_the_store(tmp_path):
             assert reader.read_only
             assert reader.info()["totals"]["observation"] == 8
             assert reader.check(repair=False).ok
+
+
+def test_spatial_query_equals_brute_force(tmp_path):
+    rng = np.random.default_rng(7)
+    with open_kb(tmp_path / "kb") as kb:
+        env = kb.environment("lab")
+        session = kb.start_session(env, "/logs/rand", [])
+        expected = {}
+        for pose in range(40):
+            T = np.eye(4)
+            T[:3, 3] = rng.uniform(-5, 5, 3)
+            obs = [Observation("foreground", "cup", 0.5, float(pose), pose,
+                               Box3D(rng.uniform(-2, 2, 3), rng.uniform(0.05, 3.0, 3)))
+                   for _ in range(10)]
+            for o in obs:
+                expected[o.uuid] = o.box.transformed(T).aabb()
+            kb.write_frame(session, FrameResult(obs), pose_id=pose, stamp_s=float(pose), T_map_cam=T)
+        for _ in range(30):
+            lo = rng.uniform(-8, 8, 3)
+            hi = lo + rng.uniform(0.1, 3.0, 3)
+            truth = {u for u, (a, b) in expected.items() if np.all(b >= lo) and np.all(a <= hi)}
+            found = {d["uuid"] for d in kb.docs.in_box(lo.tolist(), hi.tolist(), type="observation")}
+            assert found == truth
