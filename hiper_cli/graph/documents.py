@@ -153,21 +153,21 @@ def _session(row: Sequence[Any]) -> Session:
 
 Box = tuple[Sequence[float], Sequence[float]]
 
-# Observations are indexed spatially by the 1 m (x, y) map cell of their box centre (a B-tree
-# insert is ~3x cheaper than an R*Tree insert at 500 k rows, measured); a query widens its
-# box by the largest half extent stored (meta ``grid_margin_m``). Other documents (instances,
-# few and moving) stay in the R*Tree ``docs_box``.
+# Observations are indexed spatially by the 1 m map cell (x, y, z) of their box centre in a
+# B-tree (cheaper to insert into than the R*Tree as it grows, measured); a query widens its box
+# by the largest half extent stored (meta ``grid_margin_m``) and scans one key range per (x, y)
+# column of cells. Other documents (instances, few and moving) stay in the R*Tree ``docs_box``.
 GRID_CELL_M = 1.0
-_GRID_OFFSET = 1 << 20
-_GRID_SPAN = 1 << 21
+_GRID_OFFSET = 1 << 19
+_GRID_SPAN = 1 << 20
 
 
 def _cell_index(v: float) -> int:
     return math.floor(v / GRID_CELL_M)
 
 
-def _cell_key(ix: int, iy: int) -> int:
-    return (ix + _GRID_OFFSET) * _GRID_SPAN + (iy + _GRID_OFFSET)
+def _cell_key(ix: int, iy: int, iz: int) -> int:
+    return ((ix + _GRID_OFFSET) * _GRID_SPAN + (iy + _GRID_OFFSET)) * _GRID_SPAN + (iz + _GRID_OFFSET)
 
 
 class DocumentStore:
@@ -297,9 +297,9 @@ class DocumentStore:
                 lo, hi = box_map
                 bounds = (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"])
                 if doc["type"] == "observation":
-                    cx, cy = (lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0
-                    margin = max(margin, hi[0] - cx, hi[1] - cy)
-                    grid.append((_cell_key(_cell_index(cx), _cell_index(cy)), *bounds))
+                    c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
+                    margin = max(margin, *(hi[k] - c[k] for k in range(3)))
+                    grid.append((_cell_key(*(_cell_index(v) for v in c)), *bounds))
                 else:
                     boxes.append(bounds)
             if doc["type"] == "observation" and doc.get("instance_uuid"):
@@ -492,19 +492,21 @@ class DocumentStore:
         margin = self._grid_margin()
         ix0, ix1 = _cell_index(lo[0] - margin), _cell_index(hi[0] + margin)
         iy0, iy1 = _cell_index(lo[1] - margin), _cell_index(hi[1] + margin)
+        iz0, iz1 = _cell_index(lo[2] - margin), _cell_index(hi[2] + margin)
         bounds = [hi[0], lo[0], hi[1], lo[1], hi[2], lo[2]]
         where = ("g.min_x <= ? AND g.max_x >= ? AND g.min_y <= ? AND g.max_y >= ? "
                  "AND g.min_z <= ? AND g.max_z >= ?")
         select = "SELECT d.body FROM obs_grid g CROSS JOIN docs d ON d.id = g.id WHERE "
         out: list[dict[str, Any]] = []
-        if (ix1 - ix0 + 1) > 4096:  # a huge box: scan
+        if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 4096:  # a huge box: scan
             rows = self._db.execute(select + where, bounds)
             out = [self._decode(b) for (b,) in rows]
         else:
             for ix in range(ix0, ix1 + 1):
-                rows = self._db.execute(select + "g.cell BETWEEN ? AND ? AND " + where,
-                                        [_cell_key(ix, iy0), _cell_key(ix, iy1), *bounds])
-                out.extend(self._decode(b) for (b,) in rows)
+                for iy in range(iy0, iy1 + 1):
+                    rows = self._db.execute(select + "g.cell BETWEEN ? AND ? AND " + where,
+                                            [_cell_key(ix, iy, iz0), _cell_key(ix, iy, iz1), *bounds])
+                    out.extend(self._decode(b) for (b,) in rows)
                 if limit is not None and len(out) >= limit:
                     break
         return out if limit is None else out[:limit]
