@@ -106,8 +106,9 @@ def build_stages(
 ) -> tuple[list[Stage], dict[str, str]]:
     """Stages by name (registry order), each built with ``log_path`` and its options.
 
-    ``names=None`` = every registered stage that is available; the others are reported in the
-    second return value. A stage named explicitly that cannot be built raises ``ConfigError``.
+    ``names=None`` = every registered stage that is available and builds with its defaults; the
+    others are reported in the second return value. A stage named explicitly, or given options,
+    that cannot be built raises ``ConfigError``.
     """
     options = dict(stage_options or {})
     unavailable: dict[str, str] = {}
@@ -123,7 +124,14 @@ def build_stages(
         )
     stages: list[Stage] = []
     for name in chosen:
-        stages.append(make_stage(name, log_path=log_path, **dict(options.get(name, {}))))
+        try:
+            stages.append(make_stage(name, log_path=log_path, **dict(options.get(name, {}))))
+        except ConfigError as err:
+            # a default stage that cannot run here (e.g. no detector model) is reported and
+            # left out; one the user named or configured is an error
+            if names is not None or name in options:
+                raise
+            unavailable[name] = str(err)
     return stages, unavailable
 
 

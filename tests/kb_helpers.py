@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.stage import FrameResult, World
@@ -136,3 +137,21 @@ def start_oxigraph(location: Path) -> tuple[subprocess.Popen[bytes], str]:
             time.sleep(0.1)
     proc.kill()
     raise RuntimeError("oxigraph server did not answer within 20 s")
+
+
+@pytest.fixture(scope="module")
+def sparql_url(tmp_path_factory):
+    if oxigraph_binary() is None:
+        pytest.skip("the oxigraph server (pip install oxigraph, in the dev extra) is not installed")
+    proc, url = start_oxigraph(tmp_path_factory.mktemp("oxigraph"))
+    yield url
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+@pytest.fixture(params=["local", "sparql"])
+def kb_location(request, tmp_path):
+    """(location, docs_dir) for open_kb: a directory, or the server URL plus a documents dir."""
+    if request.param == "local":
+        return str(tmp_path / "scene.hiper"), None
+    return request.getfixturevalue("sparql_url"), tmp_path / "docs.hiper"

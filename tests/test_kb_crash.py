@@ -18,17 +18,21 @@ WRITER = Path(__file__).with_name("kb_crash_writer.py")
 KILLS = 20
 
 
-def _run_and_kill(kb_dir: Path, rng: random.Random) -> int:
+def _run_and_kill(kb_dir: Path, rng: random.Random, stderr_path: Path) -> int:
     """Start the writer, kill it at a random instant once it writes; the last printed pose id."""
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    proc = subprocess.Popen([sys.executable, str(WRITER), str(kb_dir)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
-    assert proc.stdout is not None
-    first = proc.stdout.readline()
-    assert first.startswith("ready"), proc.stderr.read() if proc.stderr else first
-    time.sleep(rng.uniform(0.0, 0.15))
-    proc.send_signal(signal.SIGKILL)
-    out, _ = proc.communicate(timeout=30)
+    with stderr_path.open("w") as stderr:
+        proc = subprocess.Popen([sys.executable, str(WRITER), str(kb_dir)], stdout=subprocess.PIPE,
+                                stderr=stderr, text=True, env=env)
+        assert proc.stdout is not None
+        first = proc.stdout.readline()
+        assert first.startswith("ready"), stderr_path.read_text()
+        time.sleep(rng.uniform(0.0, 0.15))
+        proc.send_signal(signal.SIGKILL)
+        # read through the same buffered file as readline (it may have read ahead)
+        out = proc.stdout.read()
+        proc.stdout.close()
+        proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL
     printed = [int(line) for line in out.split()]
     return printed[-1] if printed else int(first.split()[1])
@@ -40,7 +44,7 @@ def test_kill_minus_nine_at_random_instants(tmp_path):
     committed = -1
     start = time.monotonic()
     for _ in range(KILLS):
-        printed = _run_and_kill(kb_dir, rng)
+        printed = _run_and_kill(kb_dir, rng, tmp_path / "writer.err")
         with open_kb(kb_dir) as kb:
             report = kb.check(repair=False)
             assert report.ok, report.problems

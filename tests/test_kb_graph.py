@@ -12,25 +12,11 @@ from hiper_cli.graph.ontology import layer_graph, ontology_turtle
 from hiper_cli.model import Analysis, Box3D, Observation
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import FrameResult
-from tests.kb_helpers import ProbeStage, make_frame, oxigraph_binary, start_oxigraph
+from tests import kb_helpers
+from tests.kb_helpers import ProbeStage, make_frame
 
-
-@pytest.fixture(scope="module")
-def sparql_url(tmp_path_factory):
-    if oxigraph_binary() is None:
-        pytest.skip("the oxigraph server (pip install oxigraph, in the dev extra) is not installed")
-    proc, url = start_oxigraph(tmp_path_factory.mktemp("oxigraph"))
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-@pytest.fixture(params=["local", "sparql"])
-def kb_location(request, tmp_path):
-    """(location, docs_dir) for open_kb: a directory, or the server URL plus a documents dir."""
-    if request.param == "local":
-        return str(tmp_path / "scene.hiper"), None
-    return request.getfixturevalue("sparql_url"), tmp_path / "docs.hiper"
+sparql_url = kb_helpers.sparql_url  # fixtures shared with test_kb_exchange
+kb_location = kb_helpers.kb_location
 
 
 def _fill(kb, n_frames=12):
@@ -144,6 +130,25 @@ def test_check_repairs_a_damaged_graph(kb_location):
         assert kb.check(repair=False).ok
 
 
+def test_check_finds_a_wrong_attribute(kb_location):
+    import pyoxigraph as ox
+
+    from hiper_cli.graph.ontology import h, node
+
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        _, _, world = _fill(kb)
+        kb.sync_graph()
+        floor = next(iter(world.background.values()))
+        g = layer_graph(kb.kb_id, "background")
+        kb.graph.write(kb.kb_id, [node(floor.uuid).value], [],  # same counts, wrong class
+                       [ox.Quad(node(floor.uuid), h("className"), ox.Literal("ceiling"), g)])
+        report = kb.check(repair=False)
+        assert not report.ok
+        assert any("triples missing" in p for p in report.problems), report.problems
+        assert kb.check(repair=True).ok and kb.check(repair=False).ok
+
+
 def test_graph_catches_up_from_the_high_water_mark(kb_location):
     location, docs = kb_location
     with open_kb(location, docs_dir=docs) as kb:
@@ -226,3 +231,38 @@ def test_ontology_parses_and_declares_the_classes():
     supers = {(t.subject.value.rsplit("#", 1)[-1], t.object.value) for t in triples
               if t.predicate.value.endswith("subClassOf")}
     assert ("Observation", "http://www.w3.org/ns/sosa/Observation") in supers
+
+
+def test_read_while_a_writer_holds_the_store(tmp_path):
+    from hiper_cli.graph import open_kb_for_reading
+
+    with open_kb(tmp_path / "kb") as writer:
+        _fill(writer, 4)
+        writer.sync_graph()
+        with open_kb_for_reading(tmp_path / "kb") as reader:
+            assert reader.read_only
+            assert reader.info()["totals"]["observation"] == 8
+            assert reader.check(repair=False).ok
+
+
+def test_spatial_query_equals_brute_force(tmp_path):
+    rng = np.random.default_rng(7)
+    with open_kb(tmp_path / "kb") as kb:
+        env = kb.environment("lab")
+        session = kb.start_session(env, "/logs/rand", [])
+        expected = {}
+        for pose in range(40):
+            T = np.eye(4)
+            T[:3, 3] = rng.uniform(-5, 5, 3)
+            obs = [Observation("foreground", "cup", 0.5, float(pose), pose,
+                               Box3D(rng.uniform(-2, 2, 3), rng.uniform(0.05, 3.0, 3)))
+                   for _ in range(10)]
+            for o in obs:
+                expected[o.uuid] = o.box.transformed(T).aabb()
+            kb.write_frame(session, FrameResult(obs), pose_id=pose, stamp_s=float(pose), T_map_cam=T)
+        for _ in range(30):
+            lo = rng.uniform(-8, 8, 3)
+            hi = lo + rng.uniform(0.1, 3.0, 3)
+            truth = {u for u, (a, b) in expected.items() if np.all(b >= lo) and np.all(a <= hi)}
+            found = {d["uuid"] for d in kb.docs.in_box(lo.tolist(), hi.tolist(), type="observation")}
+            assert found == truth

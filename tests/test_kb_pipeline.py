@@ -120,6 +120,29 @@ def test_stage_factories_get_the_log_path_and_options(tmp_path, probe_registry):
         build_stages(["probe"], tmp_path / "log", {"ghost": {"x": 1}})
 
 
+class NeedsModel:
+    name = "needs_model"
+
+    def __init__(self, log_path=None, model=None):
+        if model is None:
+            raise ConfigError("stage needs_model: no model file; pass -o needs_model.model=PATH")
+
+
+def test_default_stages_that_cannot_build_are_reported_not_fatal(tmp_path, monkeypatch):
+    import hiper_cli.pipeline as pipeline
+
+    registry = {"probe": "tests.kb_helpers:ProbeStage", "needs_model": "tests.test_kb_pipeline:NeedsModel"}
+    monkeypatch.setattr(stage_module, "STAGES", registry)
+    monkeypatch.setattr(pipeline, "STAGES", registry)
+    stages, unavailable = build_stages(None, tmp_path / "log")
+    assert [s.name for s in stages] == ["probe"]
+    assert "no model file" in unavailable["needs_model"]
+    with pytest.raises(ConfigError, match="no model file"):
+        build_stages(["probe", "needs_model"], tmp_path / "log")
+    with pytest.raises(ConfigError, match="no model file"):
+        build_stages(None, tmp_path / "log", {"needs_model": {"model": None}})
+
+
 def _tum_log(root: Path, n=6) -> Path:
     with TumWriter(root, CAMERA) as writer:
         for i in range(n):
@@ -165,7 +188,8 @@ def test_cli_perceive_errors(tmp_path, probe_registry):
     result = runner.invoke(app, ["perceive", str(tmp_path / "none"), "--kb", str(tmp_path / "k")])
     assert result.exit_code == 1 and "no such file" in _text(result)
     result = runner.invoke(app, ["kb", "info", "--kb", str(tmp_path / "empty")])
-    assert result.exit_code == 0  # created on first use, empty
+    assert result.exit_code == 1 and "no knowledge base there" in _text(result)
+    assert not (tmp_path / "empty").exists()
 
 
 def test_cli_perceive_progress_bar_and_table(tmp_path, probe_registry):
@@ -173,3 +197,15 @@ def test_cli_perceive_progress_bar_and_table(tmp_path, probe_registry):
     result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "kb"), "--stages", "probe"])
     assert result.exit_code == 0, result.output
     assert "3 frames read" in _text(result) and "floor" in result.output
+
+
+def test_cli_kb_bench_reports_every_figure():
+    result = runner.invoke(app, ["kb", "bench", "--sizes", "300", "--queries", "5", "--json"])
+    assert result.exit_code == 0, result.output
+    (row,) = json.loads(result.output)
+    assert row["observations"] == 300 and row["consistent"] is True
+    assert row["ingest_obs_per_s"] > 0 and row["graph_sync_obs_per_s"] > 0 and row["peak_rss_mb"] > 0
+    assert set(row["latency"]) == {"by_uuid", "class_in_10s_window", "observations_of_instance",
+                                   "spatial_1m_box", "sparql_instances_of_class"}
+    result = runner.invoke(app, ["kb", "bench", "--sizes", "ten"])
+    assert result.exit_code == 2 and "comma-separated integers" in _text(result)

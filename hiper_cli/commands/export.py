@@ -34,10 +34,10 @@ def export_command(
 
     Example: hiper export scene.json --kb scene.hiper --format json
     """
-    from hiper_cli.graph import open_kb
+    from hiper_cli.graph import open_kb_for_reading
     from hiper_cli.graph.exchange import export_kb, guess_format
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         summary = export_kb(knowledge, out, fmt or guess_format(out), observations=observations)
     if as_json:
         print_json(summary)

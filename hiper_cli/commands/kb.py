@@ -29,9 +29,9 @@ def info_command(
 
     Example: hiper kb info --kb scene.hiper --json
     """
-    from hiper_cli.graph import open_kb
+    from hiper_cli.graph import open_kb_for_reading
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         data = knowledge.info()
     if as_json:
         print_json(data)

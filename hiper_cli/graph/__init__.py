@@ -3,6 +3,22 @@
 One public entry: ``open_kb(location) -> KnowledgeBase``.
 """
 
-from hiper_cli.graph.kb import DEFAULT_KB, CheckReport, KbConfig, KnowledgeBase, SyncReport, open_kb
+from hiper_cli.graph.kb import (
+    DEFAULT_KB,
+    CheckReport,
+    KbConfig,
+    KnowledgeBase,
+    SyncReport,
+    open_kb,
+    open_kb_for_reading,
+)
 
-__all__ = ["DEFAULT_KB", "CheckReport", "KbConfig", "KnowledgeBase", "SyncReport", "open_kb"]
+__all__ = [
+    "DEFAULT_KB",
+    "CheckReport",
+    "KbConfig",
+    "KnowledgeBase",
+    "SyncReport",
+    "open_kb",
+    "open_kb_for_reading",
+]

@@ -17,6 +17,7 @@ write (~1,300 docs/s at 2 k documents, ~600/s at 5 k), SQLite with JSON document
 from __future__ import annotations
 
 import json
+import math
 import sqlite3
 import time
 from collections.abc import Iterator, Sequence
@@ -47,11 +48,13 @@ CREATE TABLE IF NOT EXISTS docs (
     body TEXT NOT NULL
 );
 CREATE INDEX IF NOT EXISTS docs_type_class_stamp ON docs (type, class, stamp_s);
-CREATE INDEX IF NOT EXISTS docs_type_layer ON docs (type, layer);
-CREATE INDEX IF NOT EXISTS docs_instance ON docs (instance_uuid) WHERE instance_uuid IS NOT NULL;
 CREATE INDEX IF NOT EXISTS docs_seq ON docs (seq);
-CREATE INDEX IF NOT EXISTS docs_env_type ON docs (env_uuid, type);
 CREATE VIRTUAL TABLE IF NOT EXISTS docs_box USING rtree(id, min_x, max_x, min_y, max_y, min_z, max_z);
+CREATE TABLE IF NOT EXISTS obs_grid (
+    id INTEGER PRIMARY KEY, cell INTEGER NOT NULL,
+    min_x REAL, max_x REAL, min_y REAL, max_y REAL, min_z REAL, max_z REAL
+);
+CREATE INDEX IF NOT EXISTS obs_grid_cell ON obs_grid (cell, min_x, max_x, min_y, max_y, min_z, max_z);
 CREATE TABLE IF NOT EXISTS links (
     instance_uuid TEXT NOT NULL,
     observation_uuid TEXT NOT NULL,
@@ -150,6 +153,22 @@ def _session(row: Sequence[Any]) -> Session:
 
 Box = tuple[Sequence[float], Sequence[float]]
 
+# Observations are indexed spatially by the 1 m map cell (x, y, z) of their box centre in a
+# B-tree (cheaper to insert into than the R*Tree as it grows, measured); a query widens its box
+# by the largest half extent stored (meta ``grid_margin_m``) and scans one key range per (x, y)
+# column of cells. Other documents (instances, few and moving) stay in the R*Tree ``docs_box``.
+GRID_CELL_M = 1.0
+_GRID_OFFSET = 1 << 19
+_GRID_SPAN = 1 << 20
+
+
+def _cell_index(v: float) -> int:
+    return math.floor(v / GRID_CELL_M)
+
+
+def _cell_key(ix: int, iy: int, iz: int) -> int:
+    return ((ix + _GRID_OFFSET) * _GRID_SPAN + (iy + _GRID_OFFSET)) * _GRID_SPAN + (iz + _GRID_OFFSET)
+
 
 class DocumentStore:
     """JSON documents in one SQLite file. Writes happen inside ``transaction()``."""
@@ -246,10 +265,9 @@ class DocumentStore:
     _UPSERT = (
         "INSERT INTO docs (uuid, type, layer, class, stamp_s, instance_uuid, session_id, env_uuid, "
         "seq, body) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT(uuid) DO UPDATE SET "
-        "type=excluded.type, layer=excluded.layer, class=excluded.class, stamp_s=excluded.stamp_s, "
-        "instance_uuid=excluded.instance_uuid, session_id=COALESCE(excluded.session_id, session_id), "
-        "env_uuid=COALESCE(excluded.env_uuid, env_uuid), seq=excluded.seq, body=excluded.body"
-    )
+        "class=excluded.class, stamp_s=excluded.stamp_s, seq=excluded.seq, body=excluded.body"
+    )  # an update sets only what changes (each indexed column in SET costs an index rewrite);
+    # a document keeps its type, layer, instance link, session and environment
 
     def put_many(
         self,
@@ -264,6 +282,8 @@ class DocumentStore:
         seq = self._current_seq()
         rows = []
         boxes = []
+        grid = []
+        margin = 0.0
         obs_links = []
         for doc, box_map in items:
             stamp = doc.get("stamp_s", doc.get("last_seen_s", doc.get("t_end_s")))
@@ -275,7 +295,13 @@ class DocumentStore:
                          doc.get("instance_uuid"), session_id, env_uuid, seq, dumps(stored)))
             if box_map is not None:
                 lo, hi = box_map
-                boxes.append((lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
+                bounds = (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"])
+                if doc["type"] == "observation":
+                    c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
+                    margin = max(margin, *(hi[k] - c[k] for k in range(3)))
+                    grid.append((_cell_key(*(_cell_index(v) for v in c)), *bounds))
+                else:
+                    boxes.append(bounds)
             if doc["type"] == "observation" and doc.get("instance_uuid"):
                 obs_links.append((doc["instance_uuid"], doc["uuid"], seq))
         db = self._db
@@ -284,6 +310,13 @@ class DocumentStore:
             db.executemany(
                 "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?", boxes
             )
+        if grid:
+            db.executemany(
+                "INSERT OR REPLACE INTO obs_grid SELECT id, ?, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?",
+                grid,
+            )
+            if margin > self._grid_margin():
+                self.set_meta("grid_margin_m", repr(margin))
         if obs_links:
             db.executemany("INSERT OR IGNORE INTO links VALUES (?, ?, ?)", obs_links)
         for doc, _ in items:
@@ -327,6 +360,7 @@ class DocumentStore:
             return False
         self._db.execute("DELETE FROM docs WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM docs_box WHERE id = ?", (row[0],))
+        self._db.execute("DELETE FROM obs_grid WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM links WHERE instance_uuid = ?", (uuid,))
         self._db.execute("INSERT OR REPLACE INTO tombstones VALUES (?, ?, ?, ?)", (uuid, row[1], row[2], seq))
         return True
@@ -430,6 +464,11 @@ class DocumentStore:
         self, lo: Sequence[float], hi: Sequence[float], *, type: str | None = None, limit: int | None = None
     ) -> list[dict[str, Any]]:
         """Documents whose map-frame box intersects the axis-aligned box [lo, hi]."""
+        out: list[dict[str, Any]] = []
+        if type in (None, "observation"):
+            out = self._observations_in_box(lo, hi, limit)
+        if type == "observation" or (limit is not None and len(out) >= limit):
+            return out
         sql = (
             "SELECT d.body FROM docs_box b CROSS JOIN docs d ON d.id = b.id "
             "WHERE b.max_x >= ? AND b.min_x <= ? AND b.max_y >= ? AND b.min_y <= ? "
@@ -440,8 +479,37 @@ class DocumentStore:
             sql += " AND d.type = ?"
             params.append(type)
         if limit is not None:
-            sql += f" LIMIT {int(limit)}"
-        return [self._decode(b) for (b,) in self._db.execute(sql, params)]
+            sql += f" LIMIT {int(limit) - len(out)}"
+        return out + [self._decode(b) for (b,) in self._db.execute(sql, params)]
+
+    def _grid_margin(self) -> float:
+        value = self.meta("grid_margin_m")
+        return 0.0 if value is None else float(value)
+
+    def _observations_in_box(
+        self, lo: Sequence[float], hi: Sequence[float], limit: int | None
+    ) -> list[dict[str, Any]]:
+        margin = self._grid_margin()
+        ix0, ix1 = _cell_index(lo[0] - margin), _cell_index(hi[0] + margin)
+        iy0, iy1 = _cell_index(lo[1] - margin), _cell_index(hi[1] + margin)
+        iz0, iz1 = _cell_index(lo[2] - margin), _cell_index(hi[2] + margin)
+        bounds = [hi[0], lo[0], hi[1], lo[1], hi[2], lo[2]]
+        where = ("g.min_x <= ? AND g.max_x >= ? AND g.min_y <= ? AND g.max_y >= ? "
+                 "AND g.min_z <= ? AND g.max_z >= ?")
+        select = "SELECT d.body FROM obs_grid g CROSS JOIN docs d ON d.id = g.id WHERE "
+        out: list[dict[str, Any]] = []
+        if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 4096:  # a huge box: scan
+            rows = self._db.execute(select + where, bounds)
+            out = [self._decode(b) for (b,) in rows]
+        else:
+            for ix in range(ix0, ix1 + 1):
+                for iy in range(iy0, iy1 + 1):
+                    rows = self._db.execute(select + "g.cell BETWEEN ? AND ? AND " + where,
+                                            [_cell_key(ix, iy, iz0), _cell_key(ix, iy, iz1), *bounds])
+                    out.extend(self._decode(b) for (b,) in rows)
+                if limit is not None and len(out) >= limit:
+                    break
+        return out if limit is None else out[:limit]
 
     def counts(self) -> list[tuple[str, str | None, str | None, int]]:
         """(type, layer, class, count) for every group of documents."""
@@ -464,13 +532,26 @@ class DocumentStore:
             if not rows:
                 return
             last_id = int(rows[-1][0])
-            out = []
-            for _, body, env in rows:
-                doc = json.loads(body)
-                if env is not None:
-                    doc.setdefault("env_uuid", env)
-                out.append(doc)
-            yield out
+            yield [self._stored(body, env) for _, body, env in rows]
+
+    @staticmethod
+    def _stored(body: str, env: str | None) -> dict[str, Any]:
+        """A body as stored (instances without their observation list), plus ``env_uuid``."""
+        doc: dict[str, Any] = json.loads(body)
+        if env is not None:
+            doc.setdefault("env_uuid", env)
+        return doc
+
+    def sample(self, n: int, seed: int = 0) -> list[dict[str, Any]]:
+        """Up to ``n`` documents spread evenly over the store, in the form ``changed_docs`` gives."""
+        total = int(self._scalar("SELECT MAX(id) FROM docs") or 0)
+        if total == 0 or n <= 0:
+            return []
+        step = max(1, total // n)
+        rows = self._db.execute(
+            "SELECT body, env_uuid FROM docs WHERE (id + ?) % ? = 0 LIMIT ?", (seed, step, n)
+        ).fetchall()
+        return [self._stored(body, env) for body, env in rows]
 
     _LINK_LAYER = (
         "COALESCE((SELECT layer FROM docs WHERE uuid = l.instance_uuid), "
@@ -533,6 +614,9 @@ class DocumentStore:
         problems = [str(r[0]) for r in self._db.execute("PRAGMA quick_check") if r[0] != "ok"]
         orphans = int(
             self._scalar("SELECT COUNT(*) FROM docs_box b LEFT JOIN docs d ON d.id = b.id WHERE d.id IS NULL")
+        )
+        orphans += int(
+            self._scalar("SELECT COUNT(*) FROM obs_grid g LEFT JOIN docs d ON d.id = g.id WHERE d.id IS NULL")
         )
         if orphans:
             problems.append(f"{orphans} spatial index rows without a document")

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import time
+import warnings
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -112,7 +113,9 @@ def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = Fa
             )
         for name, iri in prefixes.items():
             dataset.bind(name, iri)
-        dataset.serialize(destination=str(out), format="json-ld")
+        with warnings.catch_warnings():  # rdflib 7.x's own JSON-LD plugin uses deprecated calls
+            warnings.simplefilter("ignore", DeprecationWarning)
+            dataset.serialize(destination=str(out), format="json-ld")
     else:
         import networkx as nx
 
@@ -186,7 +189,11 @@ def _docs_from_json(data: dict[str, Any], source: Path) -> list[dict[str, Any]]:
         })
     for a in data.get("analyses", []):
         out.append({**a, "type": "analysis"})
-    out.extend(data.get("observations", []))
+    live = {d["uuid"] for d in out if d["type"] == "instance"}
+    for o in data.get("observations", []):
+        if o.get("instance_uuid") not in live:  # its instance was merged away before the export
+            o = {**o, "instance_uuid": None}
+        out.append(o)
     return out
 
 

@@ -58,6 +58,10 @@ class GraphBackend(Protocol):
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]: ...
 
+    def flush(self) -> None:
+        """Persist buffered writes (frees the local store's write buffers)."""
+        ...
+
     def close(self) -> None: ...
 
 
@@ -71,6 +75,7 @@ class LocalGraph:
 
     def __init__(self, path: Path, *, read_only: bool = False) -> None:
         self.location = str(path)
+        self.read_only = read_only
         try:
             self._store = ox.Store.read_only(str(path)) if read_only else ox.Store(str(path))
         except OSError as err:
@@ -122,10 +127,11 @@ class LocalGraph:
         return out
 
     def flush(self) -> None:
-        self._store.flush()
+        if not self.read_only:
+            self._store.flush()
 
     def close(self) -> None:
-        self._store.flush()
+        self.flush()
         del self._store
 
 
