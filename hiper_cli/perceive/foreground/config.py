@@ -154,6 +154,18 @@ class ForegroundConfig:
             )
         if self.cluster_tolerance_m <= 0 or self.gate_m <= 0:
             raise ConfigError("cluster_tolerance_m and gate_m must be positive")
+        nonnegative = (
+            "table_leg_band_m", "split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac"
+        )
+        for name in nonnegative:
+            if getattr(self, name) < 0:
+                raise ConfigError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if not 0.0 < self.join_containment <= 1.0:
+            raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
+        if not 0.0 <= self.background_noise_min_cos <= 1.0:
+            raise ConfigError(
+                f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
+            )
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
 
