@@ -67,6 +67,10 @@ class ForegroundConfig:
     """Sample of pixel coordinates ``pixels_uv`` stored in each observation."""
 
     # --- refinement with the detections (before Algorithm 4) -------------------------------
+    trim_iou: float = 0.3
+    """A blob overlapping a detection box with at least this IoU loses its points outside the
+    (grown) box, when they are at most ``trim_max_share`` of it (1: off) ..."""
+    trim_max_share: float = 0.4
     detection_split: bool = False
     """Split a blob whose pixels fall into two or more detection boxes (touching objects). Off
     by default: on the simulated house it raised identity switches and localisation error
@@ -77,7 +81,7 @@ class ForegroundConfig:
     """Join blobs inside one detection box that an occluder cut apart."""
     join_containment: float = 0.8
     """Share of a blob's pixels that must lie in the (grown) detection box to join ..."""
-    detection_margin_frac: float = 0.05
+    detection_margin_frac: float = 0.0
     """... the box grown by this share of its size on every side (detector jitter) ..."""
     join_depth_m: float = 0.4
     """... their median depths at most this far apart ..."""

@@ -6,6 +6,10 @@ chairs pushed under a table) and cuts one object in two when something nearer hi
 middle. The detector sees those cases from the image; this step uses its boxes before the
 IoU matching of Algorithm 4:
 
+0. **Trim**: a blob whose image box overlaps a detection box with IoU at least ``trim_iou``
+   loses the points outside that box (grown by ``detection_margin_frac`` of its size and one
+   sample step), when they are at most ``trim_max_share`` of it: a table leg or a wall corner
+   that the clustering attached to a chair.
 1. **Split**: a blob whose pixels fall into two or more detection boxes (each holding at least
    ``min_cluster_points`` of them) is divided. Every point goes to the smallest box it lies in
    (the specific object in front of a larger one); a point inside several boxes then goes to
@@ -114,6 +118,25 @@ def _split(
     return groups if len(groups) >= 2 else None
 
 
+def _trim(
+    blob: Blob, boxes: FloatArray, grown: FloatArray, config: ForegroundConfig
+) -> NDArray[np.int64] | None:
+    """The points of ``blob`` inside the (grown) box of the detection it overlaps best, when
+    that IoU reaches ``trim_iou`` and the points outside are at most ``trim_max_share``."""
+    from hiper_cli.perceive.foreground.match import iou_matrix
+
+    iou = iou_matrix(blob.image_box_xyxy.reshape(1, 4), boxes)[0]
+    k = int(np.argmax(iou))
+    if iou[k] < config.trim_iou:
+        return None
+    inside = _inside(blob.pixels_uv, grown[k : k + 1])[:, 0]
+    n_out = int((~inside).sum())
+    if n_out == 0 or n_out > config.trim_max_share * len(inside):
+        return None
+    keep = np.flatnonzero(inside)
+    return keep if len(keep) >= config.min_cluster_points else None
+
+
 def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig) -> int | None:
     """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
     share = _inside(blob.pixels_uv, boxes).mean(axis=0)
@@ -177,10 +200,18 @@ def refine_blobs(
                 changed.extend([True] * len(groups))
     else:
         out, changed = list(blobs), [False] * len(blobs)
+    size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
+    pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
+    grown = boxes + pad
+    if config.trim_iou < 1.0:
+        for i, blob in enumerate(out):
+            if blob.fragment:
+                continue
+            keep = _trim(blob, boxes, grown, config)
+            if keep is not None:
+                out[i] = _sub_blob(blob, keep, step, width, height)
+                changed[i] = True
     if config.detection_join and len(out) >= 2:
-        size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
-        pad = np.tile(size * config.detection_margin_frac, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
-        grown = boxes + pad
         owners = [_owner(b, grown, areas, config) for b in out]
         by_owner: dict[int, list[int]] = {}
         for i, k in enumerate(owners):
@@ -209,8 +240,8 @@ def refine_blobs(
         if drop:
             out = [b for i, b in enumerate(out) if i not in drop] + extra
             changed = [c for i, c in enumerate(changed) if i not in drop] + [True] * len(extra)
-    keep = [i for i, b in enumerate(out) if not b.fragment]
-    out, changed = [out[i] for i in keep], [changed[i] for i in keep]
+    whole_blobs = [i for i, b in enumerate(out) if not b.fragment]
+    out, changed = [out[i] for i in whole_blobs], [changed[i] for i in whole_blobs]
     if config.background_filter and support_boxes_map:
         for blob, was_changed in zip(out, changed, strict=True):
             if was_changed:
