@@ -83,9 +83,9 @@ class ForegroundConfig:
     """Share of a blob's pixels that must lie in the (grown) detection box to join ..."""
     detection_margin_frac: float = 0.0
     """... the box grown by this share of its size on every side (detector jitter) ..."""
-    join_depth_m: float = 0.4
+    join_depth_m: float = 0.25
     """... their median depths at most this far apart ..."""
-    join_gap_m: float = 0.6
+    join_gap_m: float = 0.3
     """... and their nearest points at most this far apart."""
 
     # --- matching (Algorithm 4) -------------------------------------------------------------
