@@ -39,6 +39,14 @@ class ForegroundConfig:
     """Background boxes are grown by this much on every side before filtering ..."""
     background_margin_per_m2: float = 0.005
     """... plus this times the squared depth (structured-light depth noise grows with z²)."""
+    background_noise_along_ray: bool = True
+    """The z² part grows a box face by the noise projected on the face's normal (depth noise
+    lies along the viewing ray: a floor seen at a grazing angle needs little of it) ..."""
+    background_noise_min_cos: float = 0.25
+    """... at least this share of it (edges, flying pixels)."""
+    table_leg_band_m: float = 0.0
+    """Filter a band this wide under the edges of every background table top: its legs (0: off;
+    needs accurate table boxes: with the background stage's table estimates it cut chairs)."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04
@@ -57,6 +65,28 @@ class ForegroundConfig:
     """Subsample of ``points_cam`` stored in each observation."""
     pixels_per_observation: int = 48
     """Sample of pixel coordinates ``pixels_uv`` stored in each observation."""
+
+    # --- refinement with the detections (before Algorithm 4) -------------------------------
+    trim_iou: float = 0.3
+    """A blob overlapping a detection box with at least this IoU loses its points outside the
+    (grown) box, when they are at most ``trim_max_share`` of it (1: off) ..."""
+    trim_max_share: float = 0.4
+    detection_split: bool = False
+    """Split a blob whose pixels fall into two or more detection boxes (touching objects). Off
+    by default: on the simulated house it raised identity switches and localisation error
+    (jittered and missed boxes make the split flicker from frame to frame)."""
+    split_attach_m: float = 0.15
+    """A split blob's point outside every box joins the nearest labelled point within this."""
+    detection_join: bool = True
+    """Join blobs inside one detection box that an occluder cut apart."""
+    join_containment: float = 0.8
+    """Share of a blob's pixels that must lie in the (grown) detection box to join ..."""
+    detection_margin_frac: float = 0.0
+    """... the box grown by this share of its size on every side (detector jitter) ..."""
+    join_depth_m: float = 0.25
+    """... their median depths at most this far apart ..."""
+    join_gap_m: float = 0.3
+    """... and their nearest points at most this far apart."""
 
     # --- matching (Algorithm 4) -------------------------------------------------------------
     iou_threshold: float = 0.5
@@ -128,6 +158,18 @@ class ForegroundConfig:
             )
         if self.cluster_tolerance_m <= 0 or self.gate_m <= 0:
             raise ConfigError("cluster_tolerance_m and gate_m must be positive")
+        nonnegative = (
+            "table_leg_band_m", "split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac"
+        )
+        for name in nonnegative:
+            if getattr(self, name) < 0:
+                raise ConfigError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if not 0.0 < self.join_containment <= 1.0:
+            raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
+        if not 0.0 <= self.background_noise_min_cos <= 1.0:
+            raise ConfigError(
+                f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
+            )
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
 

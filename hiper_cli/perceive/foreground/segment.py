@@ -31,7 +31,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["Blob", "SegmentStats", "inside_boxes", "segment"]
+__all__ = ["Blob", "SegmentStats", "inside_boxes", "segment", "support_below", "table_leg_boxes"]
 
 FloatArray = NDArray[np.float64]
 
@@ -47,6 +47,8 @@ class Blob:
     image_box_xyxy: FloatArray
     support_z_m: float | None = None
     """Top of the floor or table the blob stands on, when the background filter cut its base."""
+    fragment: bool = False
+    """Fewer points than ``min_cluster_points``: kept only to be joined to an object (refine)."""
 
     def _z_range(self) -> tuple[float, float]:
         lo, hi = float(self.points_map[:, 2].min()), float(self.points_map[:, 2].max())
@@ -258,12 +260,23 @@ def _filter_background(
     T_map_cam: FloatArray,
     step: int,
     config: ForegroundConfig,
+    noise: FloatArray | None = None,
 ) -> NDArray[np.bool_]:
     """``valid`` without the grid points inside any box; each box only visits the part of the
-    grid it projects to."""
+    grid it projects to.
+
+    ``margin`` (h, w) grows every box on every side. ``noise`` (h, w), when given, is the depth
+    noise of each point: it grows a box face by that noise projected on the face's normal (depth
+    noise moves a point along its viewing ray, so a floor seen at a grazing angle needs far less
+    margin than a wall seen head-on), at least ``background_noise_min_cos`` of it.
+    """
     valid = valid.copy()
     T_cam_map = np.asarray(np.linalg.inv(T_map_cam), dtype=np.float64)
     max_margin = float(margin.max()) if margin.size else 0.0
+    if noise is not None and noise.size:
+        max_margin += float(noise.max())
+        rays = P_map - T_map_cam[:3, 3]
+        rays /= np.maximum(np.linalg.norm(rays, axis=-1, keepdims=True), 1e-9)
     for box in boxes:
         roi = _box_roi(box, max_margin, camera, T_cam_map, step, valid.shape, config)
         if roi is None:
@@ -274,10 +287,16 @@ def _filter_background(
             continue
         pts = P_map[roi].reshape(-1, 3)
         m = margin[roi].ravel()
+        if noise is not None:
+            n_roi, r_roi = noise[roi].ravel(), rays[roi].reshape(-1, 3)
         # Thinnest axis first (walls, floors): few points survive it, the others test fewer.
         for axis in np.argsort(box.extent_m):
             d = (pts[cand] - box.center_m) @ box.R[:, axis]
-            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= m[cand]]
+            m_c = m[cand]
+            if noise is not None:
+                cos = np.maximum(np.abs(r_roi[cand] @ box.R[:, axis]), config.background_noise_min_cos)
+                m_c = m_c + n_roi[cand] * cos
+            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= m_c]
             if len(cand) == 0:
                 break
         if len(cand):
@@ -287,7 +306,33 @@ def _filter_background(
     return valid
 
 
-def _support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
+def table_leg_boxes(top: Box3D, band_m: float, height_m: float = 1.2) -> list[Box3D]:
+    """Where a table's legs stand: four boxes under the edges of its top (``band_m`` wide,
+    reaching ``height_m`` down from the top's underside), in the frame of ``top``.
+
+    The background layer knows a table as its top plane; its legs survive the background
+    filter and join the chairs beside them into one cluster. Filtering this band under the
+    top's perimeter removes the legs and keeps what stands beside (or under) the table.
+    """
+    if band_m <= 0:
+        return []
+    R = np.asarray(top.R, dtype=np.float64)
+    normal = int(np.argmax(np.abs(R[2, :])))  # the top's axis closest to the vertical
+    a, b = (k for k in range(3) if k != normal)
+    underside_z = float(top.center_m[2]) - float(np.abs(R[2, normal]) * top.extent_m[normal]) / 2.0
+    out = []
+    for along, across in ((a, b), (b, a)):
+        band = min(band_m, float(top.extent_m[along]) / 2.0)
+        for sign in (-1.0, 1.0):
+            extent = np.zeros(3)
+            extent[normal], extent[along], extent[across] = height_m, band, top.extent_m[across]
+            centre = top.center_m + sign * (top.extent_m[along] - band) / 2.0 * R[:, along]
+            centre = np.array([centre[0], centre[1], underside_z - height_m / 2.0])
+            out.append(Box3D(centre, extent, R))
+    return out
+
+
+def support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
     """Top height of the support the blob stands on, if its base is within the filter margin."""
     lo = blob.points_map.min(axis=0)
     hi = blob.points_map.max(axis=0)
@@ -311,12 +356,15 @@ def segment(
     background_boxes_map: Sequence[Box3D],
     config: ForegroundConfig,
     support_boxes_map: Sequence[Box3D] = (),
+    keep_fragments: bool = False,
 ) -> tuple[list[Blob], SegmentStats]:
     """Algorithm 3: the foreground blobs of one depth image (see the module docstring).
 
     ``support_boxes_map`` are the horizontal background boxes (floor, tables): a blob whose
     base lies within the filter margin above one of them stands on it, and its box reaches
     down to it (the filter removed its lowest points together with the support).
+    ``keep_fragments``: clusters of 3 to ``min_cluster_points`` points are returned too, as
+    blobs with ``fragment=True`` (for ``refine_blobs`` to join them to their object).
     """
     import time
 
@@ -334,9 +382,14 @@ def segment(
     map_full = P_flat @ R.T + t
     t1 = time.perf_counter()
     if config.background_filter and background_boxes_map:
-        margin = config.background_margin_m + config.background_margin_per_m2 * z * z
+        noise = config.background_margin_per_m2 * z * z
+        if config.background_noise_along_ray:
+            margin, along = np.full(z.shape, config.background_margin_m), noise
+        else:
+            margin, along = config.background_margin_m + noise, None
         valid = _filter_background(
-            valid, map_full.reshape(P.shape), margin, background_boxes_map, camera, T_map_cam, step, config
+            valid, map_full.reshape(P.shape), margin, background_boxes_map, camera, T_map_cam, step, config,
+            along,
         )
     stats.after_background = int(valid.sum())
     t2 = time.perf_counter()
@@ -358,7 +411,8 @@ def segment(
         groups = _merge_fragments(groups, map_full, valid.shape[1], config)
         for sel in groups:
             size = len(sel)
-            if size < config.min_cluster_points:
+            fragment = size < config.min_cluster_points
+            if fragment and not keep_fragments:
                 continue
             if size > config.max_cluster_points:
                 stats.rejected_clusters += 1
@@ -376,11 +430,11 @@ def segment(
                     min(float(camera.height), uv[:, 1].max() + half),
                 ]
             )
-            blob = Blob(P_flat[sel], pm, uv, box)
+            blob = Blob(P_flat[sel], pm, uv, box, fragment=fragment)
             if config.background_filter and support_boxes_map:
-                blob.support_z_m = _support_below(blob, support_boxes_map, config)
+                blob.support_z_m = support_below(blob, support_boxes_map, config)
             blobs.append(blob)
-    stats.clusters = len(blobs)
+    stats.clusters = sum(1 for b in blobs if not b.fragment)
     t3 = time.perf_counter()
     stats.timings_s = {
         "deproject_s": t1 - t0,

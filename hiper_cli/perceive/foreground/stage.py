@@ -15,7 +15,8 @@ from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.match import Match, assign_classes
-from hiper_cli.perceive.foreground.segment import Blob, segment
+from hiper_cli.perceive.foreground.refine import refine_blobs
+from hiper_cli.perceive.foreground.segment import Blob, segment, table_leg_boxes
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
@@ -114,7 +115,15 @@ class ForegroundStage:
         supports = [
             inst.box for inst in world.background.values() if inst.class_name in SUPPORT_CLASSES
         ]
-        blobs, seg = segment(frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports)
+        if cfg.background_filter and cfg.table_leg_band_m > 0:
+            for inst in world.background.values():
+                if inst.class_name == "table":
+                    boxes.extend(table_leg_boxes(inst.box, cfg.table_leg_band_m))
+        refine = cfg.detection_split or cfg.detection_join
+        blobs, seg = segment(
+            frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports,
+            keep_fragments=cfg.detection_join,
+        )
         t_seg = time.perf_counter()
         if future is not None:
             try:
@@ -125,6 +134,10 @@ class ForegroundStage:
         else:
             dets, detect_s = self._detect_timed(frame)
         t_det = time.perf_counter()
+        if refine:
+            usable = dets.xyxy[dets.scores >= cfg.min_detection_score] if len(dets) else np.zeros((0, 4))
+            blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports)
+        t_refine = time.perf_counter()
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
             dets,
@@ -158,7 +171,8 @@ class ForegroundStage:
                 "foreground_segment_s": t_seg - t_start,
                 "foreground_detect_s": detect_s,
                 "foreground_detect_wait_s": t_det - t_seg,
-                "foreground_match_s": t_match - t_det,
+                "foreground_refine_s": t_refine - t_det,
+                "foreground_match_s": t_match - t_refine,
                 "foreground_track_s": t_end - t_match,
                 "foreground_s": t_end - t_start,
                 "foreground_points": float(seg.points),

@@ -1,0 +1,249 @@
+"""Blobs refined with the 2D detections of the same frame: split what touches, join what an
+occluder cut apart.
+
+Euclidean clustering cannot tell two objects apart that touch (a bottle on a chair seat,
+chairs pushed under a table) and cuts one object in two when something nearer hides its
+middle. The detector sees those cases from the image; this step uses its boxes before the
+IoU matching of Algorithm 4:
+
+0. **Trim**: a blob whose image box overlaps a detection box with IoU at least ``trim_iou``
+   loses the points outside that box (grown by ``detection_margin_frac`` of its size and one
+   sample step), when they are at most ``trim_max_share`` of it: a table leg or a wall corner
+   that the clustering attached to a chair.
+1. **Split**: a blob whose pixels fall into two or more detection boxes (each holding at least
+   ``min_cluster_points`` of them) is divided. Every point goes to the smallest box it lies in
+   (the specific object in front of a larger one); a point inside several boxes then goes to
+   the box whose points' median depth is nearest its own (a chair seen through the bottle's
+   box keeps the chair's depth). Points outside every box join the group of their nearest
+   labelled point when it is within ``split_attach_m``; the rest form a group of their own.
+   Groups smaller than ``min_cluster_points`` join the group of their nearest point.
+2. **Join**: blobs that lie inside the same detection box (a share ``join_containment`` of
+   their pixels, the box grown by ``detection_margin_frac`` of its size for detector jitter;
+   the smallest such box owns them), whose median depths differ by at most ``join_depth_m``
+   and whose nearest points are at most ``join_gap_m`` apart become one blob (a person
+   behind a table: the torso above it, the legs below it).
+
+No detection, no change: with a low-recall detector the step costs almost nothing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.segment import Blob, support_below
+
+__all__ = ["refine_blobs"]
+
+FloatArray = NDArray[np.float64]
+
+
+def _inside(uv: NDArray[np.int32], boxes: FloatArray) -> NDArray[np.bool_]:
+    """(N, K): pixel n inside box k (xyxy, pixel centres, half-open like the image box)."""
+    u = uv[:, 0:1].astype(np.float64) + 0.5
+    v = uv[:, 1:2].astype(np.float64) + 0.5
+    in_u = (u >= boxes[None, :, 0]) & (u <= boxes[None, :, 2])
+    return np.asarray(in_u & (v >= boxes[None, :, 1]) & (v <= boxes[None, :, 3]))
+
+
+def _sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:
+    uv = blob.pixels_uv[sel]
+    half = step / 2.0
+    box = np.array(
+        [
+            max(0.0, uv[:, 0].min() - half),
+            max(0.0, uv[:, 1].min() - half),
+            min(float(width), uv[:, 0].max() + half),
+            min(float(height), uv[:, 1].max() + half),
+        ]
+    )
+    return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box)
+
+
+def _nearest_label(
+    query: FloatArray, points: FloatArray, labels: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], FloatArray]:
+    from scipy.spatial import cKDTree
+
+    dist, idx = cKDTree(points).query(query)
+    return labels[np.asarray(idx, dtype=np.int64)], np.asarray(dist, dtype=np.float64)
+
+
+def _split(
+    blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig
+) -> list[NDArray[np.int64]] | None:
+    """Index groups of the points of ``blob``, or None when it stays whole."""
+    inside = _inside(blob.pixels_uv, boxes)
+    counts = inside.sum(axis=0)
+    cand = np.flatnonzero(counts >= config.min_cluster_points)
+    if len(cand) < 2:
+        return None
+    inside = inside[:, cand]
+    n = len(blob.points_cam)
+    # 1. the smallest box holding the point
+    order = np.argsort(areas[cand])  # candidate columns, smallest box first
+    labels = np.full(n, -1, dtype=np.int64)
+    for col in order[::-1]:  # the smallest box writes last
+        labels[inside[:, col]] = col
+    # 2. points in several boxes: the box whose points' median depth is nearest
+    z = blob.points_cam[:, 2]
+    multi = np.flatnonzero(inside.sum(axis=1) >= 2)
+    if len(multi):
+        medians = np.array(
+            [np.median(z[labels == c]) if np.any(labels == c) else np.inf for c in range(len(cand))]
+        )
+        cost = np.where(inside[multi], np.abs(z[multi, None] - medians[None, :]), np.inf)
+        labels[multi] = np.argmin(cost, axis=1)
+    # 3. points outside every box: the nearest labelled point's group, when close
+    free = np.flatnonzero(labels < 0)
+    own = np.flatnonzero(labels >= 0)
+    if len(free) and len(own):
+        near, dist = _nearest_label(blob.points_cam[free], blob.points_cam[own], labels[own])
+        labels[free] = np.where(dist <= config.split_attach_m, near, len(cand))
+    # 4. groups too small join the group of their nearest point
+    sizes = np.bincount(labels, minlength=len(cand) + 1)
+    small = np.flatnonzero((sizes > 0) & (sizes < config.min_cluster_points))
+    if len(small):
+        is_small = np.isin(labels, small)
+        keep = np.flatnonzero(~is_small)
+        if len(keep) == 0:
+            return None
+        near, _ = _nearest_label(blob.points_cam[is_small], blob.points_cam[keep], labels[keep])
+        labels[is_small] = near
+    groups = [np.flatnonzero(labels == g) for g in np.unique(labels)]
+    return groups if len(groups) >= 2 else None
+
+
+def _trim(
+    blob: Blob, boxes: FloatArray, grown: FloatArray, config: ForegroundConfig
+) -> NDArray[np.int64] | None:
+    """The points of ``blob`` inside the (grown) box of the detection it overlaps best, when
+    that IoU reaches ``trim_iou`` and the points outside are at most ``trim_max_share``."""
+    from hiper_cli.perceive.foreground.match import iou_matrix
+
+    iou = iou_matrix(blob.image_box_xyxy.reshape(1, 4), boxes)[0]
+    k = int(np.argmax(iou))
+    if iou[k] < config.trim_iou:
+        return None
+    inside = _inside(blob.pixels_uv, grown[k : k + 1])[:, 0]
+    n_out = int((~inside).sum())
+    if n_out == 0 or n_out > config.trim_max_share * len(inside):
+        return None
+    keep = np.flatnonzero(inside)
+    return keep if len(keep) >= config.min_cluster_points else None
+
+
+def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig) -> int | None:
+    """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
+    share = _inside(blob.pixels_uv, boxes).mean(axis=0)
+    ok = np.flatnonzero(share >= config.join_containment)
+    if len(ok) == 0:
+        return None
+    return int(ok[np.argmin(areas[ok])])
+
+
+def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
+    from scipy.spatial import cKDTree
+
+    if abs(float(np.median(a.points_cam[:, 2])) - float(np.median(b.points_cam[:, 2]))) > config.join_depth_m:
+        return False
+    small, large = (a, b) if len(a.points_cam) <= len(b.points_cam) else (b, a)
+    dist, _ = cKDTree(large.points_cam).query(small.points_cam, distance_upper_bound=config.join_gap_m)
+    return bool(np.isfinite(dist).any())
+
+
+def _concat(blobs: Sequence[Blob], step: int, width: int, height: int) -> Blob:
+    whole = Blob(
+        np.concatenate([b.points_cam for b in blobs]),
+        np.concatenate([b.points_map for b in blobs]),
+        np.concatenate([b.pixels_uv for b in blobs]),
+        np.zeros(4),
+    )
+    return _sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
+
+
+def refine_blobs(
+    blobs: Sequence[Blob],
+    detection_boxes_xyxy: FloatArray,
+    config: ForegroundConfig,
+    width: int,
+    height: int,
+    support_boxes_map: Sequence[Box3D] = (),
+) -> list[Blob]:
+    """Split and join ``blobs`` with this frame's detection boxes (see the module docstring).
+
+    Fragments (``Blob.fragment``, fewer than ``min_cluster_points`` points) may join an object
+    in their detection box; those that do not are dropped.
+
+    ``detection_boxes_xyxy`` (K, 4) pixels: the detections the matching will use. Blobs that
+    are neither split nor joined are returned as they are.
+    """
+    boxes = np.asarray(detection_boxes_xyxy, dtype=np.float64).reshape(-1, 4)
+    if len(boxes) == 0 or not blobs:
+        return [b for b in blobs if not b.fragment]
+    step = config.pixel_step
+    areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+    out: list[Blob] = []
+    changed: list[bool] = []
+    if config.detection_split:
+        for blob in blobs:
+            groups = None if blob.fragment else _split(blob, boxes, areas, config)
+            if groups is None:
+                out.append(blob)
+                changed.append(False)
+            else:
+                out.extend(_sub_blob(blob, g, step, width, height) for g in groups)
+                changed.extend([True] * len(groups))
+    else:
+        out, changed = list(blobs), [False] * len(blobs)
+    size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
+    pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
+    grown = boxes + pad
+    if config.trim_iou < 1.0:
+        for i, blob in enumerate(out):
+            if blob.fragment:
+                continue
+            keep = _trim(blob, boxes, grown, config)
+            if keep is not None:
+                out[i] = _sub_blob(blob, keep, step, width, height)
+                changed[i] = True
+    if config.detection_join and len(out) >= 2:
+        owners = [_owner(b, grown, areas, config) for b in out]
+        by_owner: dict[int, list[int]] = {}
+        for i, k in enumerate(owners):
+            if k is not None:
+                by_owner.setdefault(k, []).append(i)
+        drop: set[int] = set()
+        extra: list[Blob] = []
+        for members in by_owner.values():
+            if len(members) < 2:
+                continue
+            members = sorted(members, key=lambda i: -len(out[i].points_cam))
+            merged: list[list[int]] = []
+            for i in members:  # greedy: join the first group with a close member
+                for group in merged:
+                    if any(_close(out[i], out[j], config) for j in group):
+                        group.append(i)
+                        break
+                else:
+                    merged.append([i])
+            for group in merged:
+                if len(group) > 1:
+                    drop.update(group)
+                    whole = _concat([out[j] for j in group], step, width, height)
+                    whole.fragment = len(whole.points_cam) < config.min_cluster_points
+                    extra.append(whole)
+        if drop:
+            out = [b for i, b in enumerate(out) if i not in drop] + extra
+            changed = [c for i, c in enumerate(changed) if i not in drop] + [True] * len(extra)
+    whole_blobs = [i for i, b in enumerate(out) if not b.fragment]
+    out, changed = [out[i] for i in whole_blobs], [changed[i] for i in whole_blobs]
+    if config.background_filter and support_boxes_map:
+        for blob, was_changed in zip(out, changed, strict=True):
+            if was_changed:
+                blob.support_z_m = support_below(blob, support_boxes_map, config)
+    return out

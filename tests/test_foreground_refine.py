@@ -1,0 +1,141 @@
+"""Blobs refined with the detections: occluded objects joined, touching ones split, fragments."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.errors import ConfigError
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground import ForegroundConfig
+from hiper_cli.perceive.foreground.refine import refine_blobs
+from hiper_cli.perceive.foreground.segment import segment, table_leg_boxes
+from tests.fg_scene import (
+    CAMERA,
+    SceneBox,
+    background_instances,
+    chair,
+    make_frame,
+    person,
+    pose_looking_x,
+    room,
+)
+
+
+def _segment(boxes, cfg, keep_fragments=False):
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = [i.box for i in background_instances(boxes).values()]
+    blobs, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg, keep_fragments=keep_fragments)
+    return frame, blobs
+
+
+def _refine(blobs, xyxy, cfg):
+    return refine_blobs(blobs, np.asarray(xyxy, dtype=np.float64), cfg, CAMERA.width, CAMERA.height)
+
+
+def _person_behind_a_table():
+    top = SceneBox(3, np.array([2.2, 0.0, 0.68]), np.array([0.4, 1.5, 0.1]), "table", True)
+    return [*room(), top, person(10, 3.0, 0.0)]
+
+
+def test_a_person_cut_by_a_table_becomes_one_blob_inside_its_detection():
+    cfg = ForegroundConfig(pixel_step=2)
+    frame, blobs = _segment(_person_behind_a_table(), cfg)
+    assert len(blobs) == 2  # torso above the table, legs below it
+    (whole,) = _refine(blobs, frame.detections.xyxy, cfg)
+    assert len(whole.points_cam) == sum(len(b.points_cam) for b in blobs)
+    assert whole.points_map[:, 2].min() < 0.2 and whole.points_map[:, 2].max() > 1.6
+    assert whole.image_box_xyxy[3] > max(b.image_box_xyxy[3] for b in blobs) - 1  # spans both
+    no_join = ForegroundConfig(pixel_step=2, detection_join=False)
+    assert len(_refine(blobs, frame.detections.xyxy, no_join)) == 2
+    assert len(_refine(blobs, np.zeros((0, 4)), cfg)) == 2  # no detection, no change
+
+
+def test_fragments_join_their_object_or_are_dropped():
+    cfg = ForegroundConfig(pixel_step=2, min_cluster_points=100)  # the legs (63 points) are a fragment
+    frame, plain = _segment(_person_behind_a_table(), cfg)
+    assert len(plain) == 1
+    _, blobs = _segment(_person_behind_a_table(), cfg, keep_fragments=True)
+    assert sorted(b.fragment for b in blobs) == [False, True]
+    (whole,) = _refine(blobs, frame.detections.xyxy, cfg)
+    assert not whole.fragment and len(whole.points_cam) == sum(len(b.points_cam) for b in blobs)
+    (alone,) = _refine(blobs, np.zeros((0, 4)), cfg)  # nothing to join: the fragment goes
+    assert len(alone.points_cam) == len(plain[0].points_cam)
+
+
+def test_blobs_at_different_depths_in_one_box_stay_apart():
+    boxes = [*room(), person(10, 3.0, 0.0), chair(11, 4.5, 0.8)]
+    cfg = ForegroundConfig(pixel_step=2, join_gap_m=5.0)
+    _, blobs = _segment(boxes, cfg)
+    assert len(blobs) == 2
+    both = [[0.0, 0.0, 160.0, 120.0]]  # one box around everything
+    assert len(_refine(blobs, both, cfg)) == 2  # 1.5 m apart in depth
+    assert len(_refine(blobs, both, ForegroundConfig(pixel_step=2, join_gap_m=5.0, join_depth_m=5.0))) == 1
+
+
+def test_touching_people_are_split_by_their_detections():
+    boxes = [*room(), person(10, 3.0, -0.25), person(11, 3.0, 0.25)]
+    cfg = ForegroundConfig(pixel_step=2, detection_split=True)
+    frame, blobs = _segment(boxes, cfg)
+    assert len(blobs) == 1  # they touch: one cluster
+    out = _refine(blobs, frame.detections.xyxy, cfg)
+    assert len(out) == 2
+    ids = frame.extras["ids"]
+    for b in out:
+        hit = ids[b.pixels_uv[:, 1], b.pixels_uv[:, 0]]
+        assert np.mean(hit == np.bincount(hit).argmax()) > 0.95  # each part is one person
+    assert sorted(float(b.center_map[1]) for b in out) == pytest.approx([-0.25, 0.25], abs=0.05)
+    assert len(_refine(blobs, frame.detections.xyxy, ForegroundConfig(pixel_step=2))) == 1  # off by default
+
+
+def test_floor_margin_follows_the_viewing_ray():
+    # A low box far away: depth noise there is large along the ray but the floor is seen at a
+    # grazing angle, so only a thin slice above it is noise.
+    low = SceneBox(10, np.array([4.6, 0.0, 0.15]), np.array([0.4, 0.6, 0.3]), "chair")
+    boxes = [*room(), low]
+    (blob,) = _segment(boxes, ForegroundConfig(pixel_step=2))[1]
+    assert blob.points_map[:, 2].min() < 0.09
+    (old,) = _segment(boxes, ForegroundConfig(pixel_step=2, background_noise_along_ray=False))[1]
+    assert old.points_map[:, 2].min() > 0.14  # 0.05 + 0.005 * 4.5² of the box's base is lost
+
+
+def test_noisy_floor_far_away_leaves_no_blobs():
+    rng = np.random.default_rng(3)
+    frame = make_frame(room(), pose_looking_x(), 0.0, 0)
+    z = frame.depth_m.astype(np.float64)
+    noisy = (z + rng.normal(0.0, 0.0015, z.shape) * z * z).astype(np.float32)  # σ = 1.5 mm · z²
+    bg = [i.box for i in background_instances(room()).values()]
+    blobs, _ = segment(noisy, CAMERA, frame.T_map_cam, bg, ForegroundConfig(pixel_step=2))
+    assert blobs == []
+
+
+def test_table_leg_boxes_cover_the_perimeter_under_the_top():
+    top = Box3D(np.array([2.0, 1.0, 0.73]), np.array([1.6, 0.8, 0.04]))
+    legs = table_leg_boxes(top, 0.12)
+    assert len(legs) == 4
+
+    def inside(p):
+        return any(np.all(np.abs(np.asarray(p) - b.center_m) <= b.extent_m / 2 + 1e-9) for b in legs)
+
+    assert inside([1.25, 0.65, 0.3])  # a leg at a corner
+    assert inside([2.0, 1.35, 0.05])  # under a long edge
+    assert not inside([2.0, 1.0, 0.3])  # a chair pushed under the middle
+    assert not inside([2.0, 1.5, 0.3])  # a chair beside the table
+    assert not inside([1.25, 0.65, 0.8])  # above the top
+    assert table_leg_boxes(top, 0.0) == []
+    with pytest.raises(ConfigError, match="table_leg_band_m"):
+        ForegroundConfig(table_leg_band_m=-1.0)
+
+
+def test_a_leg_beside_a_chair_is_trimmed_to_the_chair_detection():
+    pole = SceneBox(12, np.array([3.0, 0.4, 0.4]), np.array([0.05, 0.05, 0.8]), "leg")  # 0.13 m away
+    boxes = [*room(), chair(11, 3.0, 0.0), pole]
+    cfg = ForegroundConfig(pixel_step=2)
+    frame, (blob,) = _segment(boxes, cfg)
+    ids = frame.extras["ids"]
+    assert np.any(ids[blob.pixels_uv[:, 1], blob.pixels_uv[:, 0]] == 12)  # one cluster with the leg
+    ys, xs = np.nonzero(ids == 11)
+    chair_box = [[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]]
+    (trimmed,) = _refine([blob], chair_box, cfg)
+    assert not np.any(ids[trimmed.pixels_uv[:, 1], trimmed.pixels_uv[:, 0]] == 12)
+    assert len(trimmed.points_cam) == int(np.sum(ids[blob.pixels_uv[:, 1], blob.pixels_uv[:, 0]] == 11))
+    (kept,) = _refine([blob], chair_box, ForegroundConfig(pixel_step=2, trim_iou=1.0))  # off
+    assert len(kept.points_cam) == len(blob.points_cam)
