@@ -3,7 +3,6 @@
 import subprocess
 import sys
 
-import click
 import pytest
 import typer.main
 from typer.testing import CliRunner
@@ -19,7 +18,7 @@ def _all_commands():
     stack = [((), root)]
     while stack:
         path, cmd = stack.pop()
-        if isinstance(cmd, click.Group):
+        if hasattr(cmd, "commands"):  # a group (typer's own group class is no click.Group)
             for name, sub in cmd.commands.items():
                 stack.append(((*path, name), sub))
         else:
@@ -33,6 +32,11 @@ def test_version():
 
 
 COMMANDS = list(_all_commands())
+
+
+def test_command_tree_is_discovered():
+    names = {" ".join(path) for path, _ in COMMANDS}
+    assert {"info", "perceive", "sim", "kb info", "eval background", "eval foreground"} <= names
 
 
 @pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) for p, _ in COMMANDS])
