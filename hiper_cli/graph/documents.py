@@ -31,6 +31,7 @@ from hiper_cli.errors import KnowledgeBaseError
 __all__ = ["SCHEMA_VERSION", "DocumentStore", "Session", "dumps"]
 
 SCHEMA_VERSION = 1
+PAGE_SIZE = 2048
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -180,6 +181,11 @@ class DocumentStore:
                 self._db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, isolation_level=None)
             else:
                 self._db = sqlite3.connect(str(self.path), isolation_level=None, timeout=30.0)
+                # 2 KiB pages (only takes effect on a new file): a frame dirties a few dozen
+                # index pages spread over the file and COMMIT copies each into the WAL, so
+                # smaller pages mean fewer bytes per commit (measured: 4 KiB -> 2 KiB +20 %
+                # ingest at 100 k observations; 1 KiB was slower: deeper trees)
+                self._db.execute(f"PRAGMA page_size={PAGE_SIZE}")
                 self._db.execute("PRAGMA journal_mode=WAL")
                 # NORMAL in WAL mode: a killed process never loses a committed transaction;
                 # only a power cut may lose the last ones (never corrupts).
@@ -204,6 +210,10 @@ class DocumentStore:
                 "export with the hiper that wrote it and import here"
             )
         self._seq: int | None = None
+        # instance uuid -> number of its links, for links committed by this connection (saves a
+        # COUNT per instance upsert); entries written in an open transaction wait in _pending
+        self._link_counts: dict[str, int] = {}
+        self._pending_link_counts: dict[str, int] = {}
 
     def close(self) -> None:
         self._db.close()
@@ -223,10 +233,17 @@ class DocumentStore:
             yield seq
         except BaseException:
             self._seq = None
+            self._pending_link_counts.clear()
             self._db.execute("ROLLBACK")
             raise
         self._seq = None
-        self._db.execute("COMMIT")
+        try:
+            self._db.execute("COMMIT")
+        except BaseException:
+            self._pending_link_counts.clear()
+            raise
+        self._link_counts.update(self._pending_link_counts)
+        self._pending_link_counts.clear()
 
     def _current_seq(self) -> int:
         if self._seq is None:
@@ -318,7 +335,12 @@ class DocumentStore:
             if margin > self._grid_margin():
                 self.set_meta("grid_margin_m", repr(margin))
         if obs_links:
+            before = db.total_changes
             db.executemany("INSERT OR IGNORE INTO links VALUES (?, ?, ?)", obs_links)
+            all_new = db.total_changes - before == len(obs_links)
+            for instance_uuid, _, _ in obs_links:
+                known = self._known_links(instance_uuid)
+                self._pending_link_counts[instance_uuid] = known + 1 if all_new and known >= 0 else -1
         for doc, _ in items:
             if doc["type"] == "instance":
                 self._link_instance(doc["uuid"], doc.get("observation_uuids", []), seq)
@@ -328,14 +350,24 @@ class DocumentStore:
     def _link_instance(self, instance_uuid: str, observation_uuids: Sequence[str], seq: int) -> None:
         """Links of an instance to its observations. Observation lists usually only grow, so
         only the tail beyond the stored count is inserted; anything else inserts them all."""
-        known = int(self._scalar("SELECT COUNT(*) FROM links WHERE instance_uuid = ?", (instance_uuid,)))
-        if known == len(observation_uuids):
+        if self._known_links(instance_uuid) == len(observation_uuids):
             return
-        sql = "INSERT OR IGNORE INTO links VALUES (?, ?, ?)"
-        self._db.executemany(sql, [(instance_uuid, o, seq) for o in observation_uuids[known:]])
-        known = int(self._scalar("SELECT COUNT(*) FROM links WHERE instance_uuid = ?", (instance_uuid,)))
-        if known < len(observation_uuids):
-            self._db.executemany(sql, [(instance_uuid, o, seq) for o in observation_uuids])
+        known = self._count_links(instance_uuid)
+        if known != len(observation_uuids):
+            sql = "INSERT OR IGNORE INTO links VALUES (?, ?, ?)"
+            self._db.executemany(sql, [(instance_uuid, o, seq) for o in observation_uuids[known:]])
+            known = self._count_links(instance_uuid)
+            if known < len(observation_uuids):
+                self._db.executemany(sql, [(instance_uuid, o, seq) for o in observation_uuids])
+                known = self._count_links(instance_uuid)
+        self._pending_link_counts[instance_uuid] = known
+
+    def _known_links(self, instance_uuid: str) -> int:
+        """The cached number of links of an instance, -1 when unknown."""
+        return self._pending_link_counts.get(instance_uuid, self._link_counts.get(instance_uuid, -1))
+
+    def _count_links(self, instance_uuid: str) -> int:
+        return int(self._scalar("SELECT COUNT(*) FROM links WHERE instance_uuid = ?", (instance_uuid,)))
 
     def _decode(self, body: str) -> dict[str, Any]:
         """A stored body as its ``to_dict`` form (instances get their observation list back,
@@ -362,6 +394,7 @@ class DocumentStore:
         self._db.execute("DELETE FROM docs_box WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM obs_grid WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM links WHERE instance_uuid = ?", (uuid,))
+        self._pending_link_counts[uuid] = 0
         self._db.execute("INSERT OR REPLACE INTO tombstones VALUES (?, ?, ?, ?)", (uuid, row[1], row[2], seq))
         return True
 
