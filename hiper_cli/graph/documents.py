@@ -48,14 +48,16 @@ CREATE TABLE IF NOT EXISTS docs (
     seq INTEGER NOT NULL,
     body TEXT NOT NULL
 );
-CREATE INDEX IF NOT EXISTS docs_type_class_stamp ON docs (type, class, stamp_s);
+DROP INDEX IF EXISTS docs_type_class_stamp;
+CREATE INDEX IF NOT EXISTS docs_type_stamp_class ON docs (type, stamp_s, class);
 CREATE INDEX IF NOT EXISTS docs_seq ON docs (seq);
 CREATE VIRTUAL TABLE IF NOT EXISTS docs_box USING rtree(id, min_x, max_x, min_y, max_y, min_z, max_z);
-CREATE TABLE IF NOT EXISTS obs_grid (
-    id INTEGER PRIMARY KEY, cell INTEGER NOT NULL,
-    min_x REAL, max_x REAL, min_y REAL, max_y REAL, min_z REAL, max_z REAL
-);
-CREATE INDEX IF NOT EXISTS obs_grid_cell ON obs_grid (cell, min_x, max_x, min_y, max_y, min_z, max_z);
+CREATE TABLE IF NOT EXISTS obs_cells (
+    cell INTEGER NOT NULL, id INTEGER NOT NULL,
+    min_x REAL, max_x REAL, min_y REAL, max_y REAL, min_z REAL, max_z REAL,
+    PRIMARY KEY (cell, id)
+) WITHOUT ROWID;
+CREATE INDEX IF NOT EXISTS obs_cells_id ON obs_cells (id);
 CREATE TABLE IF NOT EXISTS links (
     instance_uuid TEXT NOT NULL,
     observation_uuid TEXT NOT NULL,
@@ -154,17 +156,17 @@ def _session(row: Sequence[Any]) -> Session:
 
 Box = tuple[Sequence[float], Sequence[float]]
 
-# Observations are indexed spatially by the 1 m map cell (x, y, z) of their box centre in a
+# Observations are indexed spatially by the 2 m map cell (x, y, z) of their box centre in a
 # B-tree (cheaper to insert into than the R*Tree as it grows, measured); a query widens its box
 # by the largest half extent stored (meta ``grid_margin_m``) and scans one key range per (x, y)
 # column of cells. Other documents (instances, few and moving) stay in the R*Tree ``docs_box``.
-GRID_CELL_M = 1.0
+GRID_CELL_M = 2.0  # new stores; one written before this value was chosen keeps 1 m (meta)
 _GRID_OFFSET = 1 << 19
 _GRID_SPAN = 1 << 20
 
 
-def _cell_index(v: float) -> int:
-    return math.floor(v / GRID_CELL_M)
+def _cell_index(v: float, cell_m: float) -> int:
+    return math.floor(v / cell_m)
 
 
 def _cell_key(ix: int, iy: int, iz: int) -> int:
@@ -210,10 +212,33 @@ class DocumentStore:
                 "export with the hiper that wrote it and import here"
             )
         self._seq: int | None = None
+        cell = self.meta("grid_cell_m")
+        legacy = self._scalar("SELECT name FROM sqlite_master WHERE name = 'obs_grid'") is not None
+        if not read_only and (cell is None or legacy):
+            self._migrate_grid(cell, legacy)
+            cell = self.meta("grid_cell_m")
+        self._grid_cell_m = float(cell or 1.0)
         # instance uuid -> number of its links, for links committed by this connection (saves a
         # COUNT per instance upsert); entries written in an open transaction wait in _pending
         self._link_counts: dict[str, int] = {}
         self._pending_link_counts: dict[str, int] = {}
+
+    def _migrate_grid(self, cell: str | None, legacy: bool) -> None:
+        """Stores written before the (cell, id) keyed ``obs_cells`` table (1 m cells in
+        ``obs_grid``) keep their cell size and move their rows over, once."""
+        self._db.execute("BEGIN IMMEDIATE")
+        try:
+            if cell is None:
+                cell = "1.0" if legacy else repr(GRID_CELL_M)
+                self.set_meta("grid_cell_m", cell)
+            if legacy:
+                self._db.execute("INSERT OR REPLACE INTO obs_cells SELECT cell, id, min_x, max_x, min_y, "
+                                 "max_y, min_z, max_z FROM obs_grid")
+                self._db.execute("DROP TABLE obs_grid")
+        except BaseException:
+            self._db.execute("ROLLBACK")
+            raise
+        self._db.execute("COMMIT")
 
     def close(self) -> None:
         self._db.close()
@@ -301,6 +326,7 @@ class DocumentStore:
         boxes = []
         grid = []
         margin = 0.0
+        cell_m = self._grid_cell_m
         obs_links = []
         for doc, box_map in items:
             stamp = doc.get("stamp_s", doc.get("last_seen_s", doc.get("t_end_s")))
@@ -316,7 +342,7 @@ class DocumentStore:
                 if doc["type"] == "observation":
                     c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
                     margin = max(margin, *(hi[k] - c[k] for k in range(3)))
-                    grid.append((_cell_key(*(_cell_index(v) for v in c)), *bounds))
+                    grid.append((_cell_key(*(_cell_index(v, cell_m) for v in c)), *bounds))
                 else:
                     boxes.append(bounds)
             if doc["type"] == "observation" and doc.get("instance_uuid"):
@@ -328,9 +354,11 @@ class DocumentStore:
                 "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?", boxes
             )
         if grid:
+            # a re-written observation may move to another cell: drop its old entry first
+            db.executemany("DELETE FROM obs_cells WHERE id = (SELECT id FROM docs WHERE uuid = ?)",
+                           [(g[-1],) for g in grid])
             db.executemany(
-                "INSERT OR REPLACE INTO obs_grid SELECT id, ?, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?",
-                grid,
+                "INSERT INTO obs_cells SELECT ?, id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?", grid
             )
             if margin > self._grid_margin():
                 self.set_meta("grid_margin_m", repr(margin))
@@ -392,7 +420,7 @@ class DocumentStore:
             return False
         self._db.execute("DELETE FROM docs WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM docs_box WHERE id = ?", (row[0],))
-        self._db.execute("DELETE FROM obs_grid WHERE id = ?", (row[0],))
+        self._db.execute("DELETE FROM obs_cells WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM links WHERE instance_uuid = ?", (uuid,))
         self._pending_link_counts[uuid] = 0
         self._db.execute("INSERT OR REPLACE INTO tombstones VALUES (?, ?, ?, ?)", (uuid, row[1], row[2], seq))
@@ -522,14 +550,14 @@ class DocumentStore:
     def _observations_in_box(
         self, lo: Sequence[float], hi: Sequence[float], limit: int | None
     ) -> list[dict[str, Any]]:
-        margin = self._grid_margin()
-        ix0, ix1 = _cell_index(lo[0] - margin), _cell_index(hi[0] + margin)
-        iy0, iy1 = _cell_index(lo[1] - margin), _cell_index(hi[1] + margin)
-        iz0, iz1 = _cell_index(lo[2] - margin), _cell_index(hi[2] + margin)
+        margin, cell_m = self._grid_margin(), self._grid_cell_m
+        ix0, ix1 = _cell_index(lo[0] - margin, cell_m), _cell_index(hi[0] + margin, cell_m)
+        iy0, iy1 = _cell_index(lo[1] - margin, cell_m), _cell_index(hi[1] + margin, cell_m)
+        iz0, iz1 = _cell_index(lo[2] - margin, cell_m), _cell_index(hi[2] + margin, cell_m)
         bounds = [hi[0], lo[0], hi[1], lo[1], hi[2], lo[2]]
         where = ("g.min_x <= ? AND g.max_x >= ? AND g.min_y <= ? AND g.max_y >= ? "
                  "AND g.min_z <= ? AND g.max_z >= ?")
-        select = "SELECT d.body FROM obs_grid g CROSS JOIN docs d ON d.id = g.id WHERE "
+        select = "SELECT d.body FROM obs_cells g CROSS JOIN docs d ON d.id = g.id WHERE "
         out: list[dict[str, Any]] = []
         if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 4096:  # a huge box: scan
             rows = self._db.execute(select + where, bounds)
@@ -649,7 +677,9 @@ class DocumentStore:
             self._scalar("SELECT COUNT(*) FROM docs_box b LEFT JOIN docs d ON d.id = b.id WHERE d.id IS NULL")
         )
         orphans += int(
-            self._scalar("SELECT COUNT(*) FROM obs_grid g LEFT JOIN docs d ON d.id = g.id WHERE d.id IS NULL")
+            self._scalar(
+                "SELECT COUNT(*) FROM obs_cells g LEFT JOIN docs d ON d.id = g.id WHERE d.id IS NULL"
+            )
         )
         if orphans:
             problems.append(f"{orphans} spatial index rows without a document")
