@@ -9,6 +9,7 @@ import uuid
 import numpy as np
 import pytest
 
+from hiper_cli.graph import documents
 from hiper_cli.graph.documents import GRID_CELL_M, DocumentStore
 from hiper_cli.graph.kb import open_kb
 from hiper_cli.model import Box3D, Instance, Observation, new_uuid
@@ -53,6 +54,7 @@ def test_links_follow_the_instance_through_a_rolled_back_frame(tmp_path):
         assert len(kb.docs.observations_of(inst.uuid)) == 11
     with open_kb(tmp_path / "kb") as kb:  # a fresh connection (empty cache) sees the same
         assert len(kb.docs.observations_of(inst.uuid)) == 11
+        kb.sync_graph()
         assert kb.check(repair=False).ok
 
 
@@ -90,3 +92,49 @@ def test_a_store_with_the_former_grid_table_is_migrated(tmp_path):
     assert [d["uuid"] for d in store.in_box([0.0] * 3, [1.0] * 3)] == [doc["uuid"]]
     assert store.integrity_problems() == []
     store.close()
+
+
+@pytest.mark.parametrize("staged_rows", [7, 10_000])
+def test_staged_and_clustered_rows_answer_the_same(tmp_path, monkeypatch, staged_rows):
+    monkeypatch.setattr(documents, "STAGED_ROWS", staged_rows)
+    rng = np.random.default_rng(3)
+    with open_kb(tmp_path / "kb") as kb:
+        env = kb.environment("lab")
+        session = kb.start_session(env, "/logs/rand", [])
+        tracks = [Instance("foreground", "cup", Box3D(np.zeros(3), np.ones(3)), 0.0, 0.0) for _ in range(3)]
+        expected = {}
+        for pose in range(30):
+            T = np.eye(4)
+            T[:3, 3] = rng.uniform(-5, 5, 3)
+            obs = [Observation("foreground", "cup", 0.5, float(pose), pose,
+                               Box3D(rng.uniform(-2, 2, 3), rng.uniform(0.05, 3.0, 3)), instance_uuid=t.uuid)
+                   for t in tracks]
+            for o, t in zip(obs, tracks, strict=True):
+                expected[o.uuid] = o.box.transformed(T).aabb()
+                t.observation_uuids.append(o.uuid)
+            kb.write_frame(session, FrameResult(obs, list(tracks)), pose_id=pose, stamp_s=float(pose),
+                           T_map_cam=T)
+        staged = kb.docs._db.execute("SELECT COUNT(*) FROM obs_cells_new").fetchone()[0]
+        assert (staged < 7) if staged_rows == 7 else (staged == 90)
+        for _ in range(30):
+            lo = rng.uniform(-8, 8, 3)
+            hi = lo + rng.uniform(0.1, 3.0, 3)
+            truth = {u for u, (a, b) in expected.items() if np.all(b >= lo) and np.all(a <= hi)}
+            assert {d["uuid"] for d in kb.docs.in_box(lo.tolist(), hi.tolist(), type="observation")} == truth
+        for t in tracks:
+            assert kb.docs.get(t.uuid)["observation_uuids"] == t.observation_uuids
+            assert len(kb.docs.observations_of(t.uuid)) == 30
+        assert kb.docs.link_count() == 90
+        kb.sync_graph()
+        assert kb.check(repair=False).ok
+
+
+def test_documents_keep_non_finite_numbers_and_numpy_values():
+    doc = {"uuid": "u", "data": {"trajectory": np.array([[0.0, np.nan], [1.0, 2.0]]), "n": np.int64(3)},
+           "speed": float("inf"), "none": None}
+    text = documents.dumps(doc)
+    back = documents.loads(text)
+    assert np.isnan(back["data"]["trajectory"][0][1]) and back["speed"] == float("inf")
+    assert back["data"]["n"] == 3 and back["none"] is None
+    finite = {"uuid": "v", "box": np.arange(3.0), "name": "é"}
+    assert documents.loads(documents.dumps(finite)) == {"uuid": "v", "box": [0.0, 1.0, 2.0], "name": "é"}
