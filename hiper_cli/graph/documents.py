@@ -2,7 +2,9 @@
 
 Every entity (observation, instance, analysis, environment) is one JSON document keyed by uuid,
 with indexed columns for what queries filter on: type, layer, class, stamp, instance link,
-session, environment, and an R*Tree over the map-frame axis-aligned box for spatial queries.
+session, environment; observations are indexed spatially by the 2 m map cell of their box
+centre (``obs_cells``), instances in an R*Tree over their map-frame box. Spatial-index rows
+and instance links are staged in append-only tables and moved in batches (see docs/kb.md).
 
 Every write transaction takes the next value of a monotonically increasing change sequence
 (``seq``); changed rows carry it, deletions leave a tombstone carrying it. The scene graph is
