@@ -207,5 +207,11 @@ def test_cli_kb_bench_reports_every_figure():
     assert row["ingest_obs_per_s"] > 0 and row["graph_sync_obs_per_s"] > 0 and row["peak_rss_mb"] > 0
     assert set(row["latency"]) == {"by_uuid", "class_in_10s_window", "observations_of_instance",
                                    "spatial_1m_box", "sparql_instances_of_class"}
+    result = runner.invoke(app, ["kb", "bench", "--sizes", "4500", "--queries", "5", "--graph-sync-s", "0",
+                                 "--json"])
+    assert result.exit_code == 0, result.output
+    (row,) = json.loads(result.output)  # more than STAGED_ROWS: staged rows were moved once
+    assert row["consistent"] is True and row["config"]["graph_sync_s"] == 0
+    assert 0 < row["peak_rss_before_final_sync_mb"] <= row["peak_rss_mb"]
     result = runner.invoke(app, ["kb", "bench", "--sizes", "ten"])
     assert result.exit_code == 2 and "comma-separated integers" in _text(result)

@@ -103,6 +103,11 @@ def bench_command(
     detail: Annotated[
         str, typer.Option("--detail", help="Observations in the graph: summary or full.")
     ] = "summary",
+    graph_sync_s: Annotated[
+        float,
+        typer.Option("--graph-sync-s", help="Graph sync interval during ingest, as perceive (2 s); "
+                     "0 = once after the ingest (shows the document side's memory alone)."),
+    ] = 2.0,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Ingest rate, p50/p95 query latencies and peak memory at several sizes (fresh KBs in /tmp).
@@ -119,7 +124,7 @@ def bench_command(
     if not counts or min(counts) <= 0:
         raise ConfigError(f"--sizes {sizes!r}: expected positive observation counts")
     config = BenchConfig(obs_per_frame=obs_per_frame, queries=queries, instance_updates=not no_instances,
-                         observation_detail=detail)
+                         observation_detail=detail, graph_sync_s=graph_sync_s)
     out = console()
 
     def show(r: dict[str, Any]) -> None:

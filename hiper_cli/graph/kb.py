@@ -104,15 +104,18 @@ def _aabb(lo: Any, hi: Any) -> tuple[list[float], list[float]]:
     return [float(v) for v in lo], [float(v) for v in hi]
 
 
-def _map_aabb(box: Box3D, T_map_box: Any) -> tuple[list[float], list[float]]:
-    """(min, max) of the axis-aligned map-frame box around ``box`` given in a frame mapped into
-    the map by ``T_map_box`` (None = the box is in the map frame already)."""
-    R, c = box.R, box.center_m
+def _map_aabbs(boxes: Sequence[Box3D], T_map_box: Any) -> list[tuple[list[float], list[float]]]:
+    """(min, max) of the axis-aligned map-frame box around each box, given in a frame mapped
+    into the map by ``T_map_box`` (None = the boxes are in the map frame already); one
+    vectorised pass per frame."""
+    R = np.stack([b.R for b in boxes])
+    c = np.stack([b.center_m for b in boxes])
+    half_extent = np.stack([b.extent_m for b in boxes]) / 2.0
     if T_map_box is not None:
         R = T_map_box[:3, :3] @ R
-        c = T_map_box[:3, :3] @ c + T_map_box[:3, 3]
-    half = np.abs(R) @ (box.extent_m / 2.0)
-    return (c - half).tolist(), (c + half).tolist()
+        c = c @ T_map_box[:3, :3].T + T_map_box[:3, 3]
+    half = np.einsum("nij,nj->ni", np.abs(R), half_extent)
+    return list(zip((c - half).tolist(), (c + half).tolist(), strict=True))
 
 
 def _value(term: Any) -> Any:
@@ -227,9 +230,13 @@ class KnowledgeBase:
         return seq
 
     def _put_result(self, result: FrameResult, session_id: int | None, env_uuid: str, T: Any) -> None:
-        obs_items = [(o.to_dict(), None if T is None else _map_aabb(o.box, T)) for o in result.observations]
+        boxes: list[Any] = [None] * len(result.observations)
+        if T is not None and result.observations:
+            boxes = _map_aabbs([o.box for o in result.observations], T)
+        obs_items = [(o.to_dict(), b) for o, b in zip(result.observations, boxes, strict=True)]
         self.docs.put_many(obs_items, session_id=session_id, env_uuid=env_uuid)
-        inst_items = [(i.to_dict(), _map_aabb(i.box, None)) for i in result.instances]
+        inst_boxes = _map_aabbs([i.box for i in result.instances], None) if result.instances else []
+        inst_items = [(i.to_dict(), b) for i, b in zip(result.instances, inst_boxes, strict=True)]
         self.docs.put_many(inst_items, session_id=session_id, env_uuid=env_uuid)
         for uuid in result.deleted_instances:
             self.docs.delete(uuid)
