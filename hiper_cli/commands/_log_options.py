@@ -1,16 +1,20 @@
 """The options every command that opens a sensor log takes, and the call that opens it.
 
-A command declares the options it wants with the ``*_OPTION`` constants below and hands
-their values to ``open_log_from_flags``:
+A command takes all of them by decorating itself with ``with_log_flags``; it then receives
+their values as one ``log_flags`` dict for ``open_log_from_flags``:
 
-    def perceive(log: Path = LOG_ARGUMENT, poses: Path | None = POSES_OPTION, ...):
-        reader = open_log_from_flags(log, poses=poses, camera=camera, preset=preset, ...)
+    @with_log_flags
+    def perceive(log: Path = LOG_ARGUMENT, *, log_flags: dict[str, Any], ...):
+        reader = open_log_from_flags(log, **log_flags)
 """
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -50,6 +54,51 @@ MAP_FRAME_OPTION = typer.Option("map", "--map-frame", help="tf parent frame of t
 CAMERA_FRAME_OPTION = typer.Option(
     None, "--camera-frame", help="tf child frame of the poses (default: the colour images' frame_id)."
 )
+
+
+# (parameter name, type, typer option) of every log flag, in --help order
+LOG_FLAGS: tuple[tuple[str, Any, Any], ...] = (
+    ("poses", Path | None, POSES_OPTION),
+    ("camera", Path | None, CAMERA_OPTION),
+    ("preset", str | None, PRESET_OPTION),
+    ("fx", float | None, FX_OPTION),
+    ("fy", float | None, FY_OPTION),
+    ("cx", float | None, CX_OPTION),
+    ("cy", float | None, CY_OPTION),
+    ("width", int | None, WIDTH_OPTION),
+    ("height", int | None, HEIGHT_OPTION),
+    ("depth_scale", float | None, DEPTH_SCALE_OPTION),
+    ("max_dt", float, MAX_DT_OPTION),
+    ("rgb_topic", str | None, RGB_TOPIC_OPTION),
+    ("depth_topic", str | None, DEPTH_TOPIC_OPTION),
+    ("info_topic", str | None, INFO_TOPIC_OPTION),
+    ("pose_topic", str | None, POSE_TOPIC_OPTION),
+    ("detections_topic", str | None, DETECTIONS_TOPIC_OPTION),
+    ("map_frame", str, MAP_FRAME_OPTION),
+    ("camera_frame", str | None, CAMERA_FRAME_OPTION),
+)
+
+
+def with_log_flags(func: Callable[..., Any]) -> Callable[..., Any]:
+    """Give a command every log flag; it receives their values as ``log_flags`` (a dict).
+
+    The flags are appended to the command's own parameters in its signature, which is what
+    typer reads, so all commands that open a log share one definition of them.
+    """
+    signature = inspect.signature(func, eval_str=True)
+    own = [p for name, p in signature.parameters.items() if name != "log_flags"]
+    flags = [
+        inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option, annotation=kind)
+        for name, kind, option in LOG_FLAGS
+    ]
+
+    @functools.wraps(func)
+    def command(*args: Any, **kwargs: Any) -> Any:
+        log_flags = {name: kwargs.pop(name) for name, _, _ in LOG_FLAGS}
+        return func(*args, log_flags=log_flags, **kwargs)
+
+    command.__signature__ = signature.replace(parameters=[*own, *flags])  # type: ignore[attr-defined]
+    return command
 
 
 def open_log_from_flags(

@@ -7,28 +7,7 @@ from typing import Any
 
 import typer
 
-from hiper_cli.commands._log_options import (
-    CAMERA_FRAME_OPTION,
-    CAMERA_OPTION,
-    CX_OPTION,
-    CY_OPTION,
-    DEPTH_SCALE_OPTION,
-    DEPTH_TOPIC_OPTION,
-    DETECTIONS_TOPIC_OPTION,
-    FX_OPTION,
-    FY_OPTION,
-    HEIGHT_OPTION,
-    INFO_TOPIC_OPTION,
-    LOG_ARGUMENT,
-    MAP_FRAME_OPTION,
-    MAX_DT_OPTION,
-    POSE_TOPIC_OPTION,
-    POSES_OPTION,
-    PRESET_OPTION,
-    RGB_TOPIC_OPTION,
-    WIDTH_OPTION,
-    open_log_from_flags,
-)
+from hiper_cli.commands._log_options import LOG_ARGUMENT, open_log_from_flags, with_log_flags
 from hiper_cli.commands._render import JSON_OPTION, console, print_json
 
 HELP = (
@@ -45,31 +24,9 @@ def info(
     check: bool = typer.Option(
         False, "--check", help="Decode every image and report the frames that cannot be read."
     ),
-    poses: Path | None = POSES_OPTION,
-    camera: Path | None = CAMERA_OPTION,
-    preset: str | None = PRESET_OPTION,
-    fx: float | None = FX_OPTION,
-    fy: float | None = FY_OPTION,
-    cx: float | None = CX_OPTION,
-    cy: float | None = CY_OPTION,
-    width: int | None = WIDTH_OPTION,
-    height: int | None = HEIGHT_OPTION,
-    depth_scale: float | None = DEPTH_SCALE_OPTION,
-    max_dt: float = MAX_DT_OPTION,
-    rgb_topic: str | None = RGB_TOPIC_OPTION,
-    depth_topic: str | None = DEPTH_TOPIC_OPTION,
-    info_topic: str | None = INFO_TOPIC_OPTION,
-    pose_topic: str | None = POSE_TOPIC_OPTION,
-    detections_topic: str | None = DETECTIONS_TOPIC_OPTION,
-    map_frame: str = MAP_FRAME_OPTION,
-    camera_frame: str | None = CAMERA_FRAME_OPTION,
+    log_flags: dict[str, Any] | None = None,
 ) -> None:
-    reader = open_log_from_flags(
-        log, poses=poses, camera=camera, preset=preset, fx=fx, fy=fy, cx=cx, cy=cy, width=width,
-        height=height, depth_scale=depth_scale, max_dt=max_dt, rgb_topic=rgb_topic,
-        depth_topic=depth_topic, info_topic=info_topic, pose_topic=pose_topic,
-        detections_topic=detections_topic, map_frame=map_frame, camera_frame=camera_frame,
-    )
+    reader = open_log_from_flags(log, **(log_flags or {}))
     summary = reader.info()
     data = summary.to_dict(frames=frames)
     if check:
@@ -127,4 +84,4 @@ def _render(data: dict[str, Any]) -> None:
 
 
 def register(app: typer.Typer) -> None:
-    app.command(name="info", help=HELP)(info)
+    app.command(name="info", help=HELP)(with_log_flags(info))

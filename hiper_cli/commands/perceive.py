@@ -8,27 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
-from hiper_cli.commands._log_options import (
-    CAMERA_FRAME_OPTION,
-    CAMERA_OPTION,
-    CX_OPTION,
-    CY_OPTION,
-    DEPTH_SCALE_OPTION,
-    DEPTH_TOPIC_OPTION,
-    DETECTIONS_TOPIC_OPTION,
-    FX_OPTION,
-    FY_OPTION,
-    HEIGHT_OPTION,
-    INFO_TOPIC_OPTION,
-    MAP_FRAME_OPTION,
-    MAX_DT_OPTION,
-    POSE_TOPIC_OPTION,
-    POSES_OPTION,
-    PRESET_OPTION,
-    RGB_TOPIC_OPTION,
-    WIDTH_OPTION,
-    open_log_from_flags,
-)
+from hiper_cli.commands._log_options import open_log_from_flags, with_log_flags
 from hiper_cli.commands._render import JSON_OPTION, console, print_json
 from hiper_cli.errors import ConfigError
 
@@ -85,24 +65,7 @@ def perceive_command(
         str | None, typer.Option("--env", help="Environment name (default: the log folder's name).")
     ] = None,
     as_json: bool = JSON_OPTION,
-    poses: Path | None = POSES_OPTION,
-    camera: Path | None = CAMERA_OPTION,
-    preset: str | None = PRESET_OPTION,
-    fx: float | None = FX_OPTION,
-    fy: float | None = FY_OPTION,
-    cx: float | None = CX_OPTION,
-    cy: float | None = CY_OPTION,
-    width: int | None = WIDTH_OPTION,
-    height: int | None = HEIGHT_OPTION,
-    depth_scale: float | None = DEPTH_SCALE_OPTION,
-    max_dt: float = MAX_DT_OPTION,
-    rgb_topic: str | None = RGB_TOPIC_OPTION,
-    depth_topic: str | None = DEPTH_TOPIC_OPTION,
-    info_topic: str | None = INFO_TOPIC_OPTION,
-    pose_topic: str | None = POSE_TOPIC_OPTION,
-    detections_topic: str | None = DETECTIONS_TOPIC_OPTION,
-    map_frame: str = MAP_FRAME_OPTION,
-    camera_frame: str | None = CAMERA_FRAME_OPTION,
+    log_flags: dict[str, Any] | None = None,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
@@ -123,12 +86,7 @@ def perceive_command(
     if mapping_hz is not None:
         options.setdefault("background", {})["keyframe_hz"] = mapping_hz
     names = None if stages is None else [s.strip() for s in stages.split(",") if s.strip()]
-    reader = open_log_from_flags(
-        log, poses=poses, camera=camera, preset=preset, fx=fx, fy=fy, cx=cx, cy=cy, width=width,
-        height=height, depth_scale=depth_scale, max_dt=max_dt, rgb_topic=rgb_topic,
-        depth_topic=depth_topic, info_topic=info_topic, pose_topic=pose_topic,
-        detections_topic=detections_topic, map_frame=map_frame, camera_frame=camera_frame,
-    )
+    reader = open_log_from_flags(log, **(log_flags or {}))
     if names is None:  # flags for stages that are not available are dropped, not errors
         from hiper_cli.pipeline import available_stages
 
@@ -190,4 +148,4 @@ def _render(out: Any, data: dict[str, Any]) -> None:
 
 
 def register(app: typer.Typer) -> None:
-    app.command("perceive")(perceive_command)
+    app.command("perceive")(with_log_flags(perceive_command))
