@@ -138,3 +138,40 @@ def test_documents_keep_non_finite_numbers_and_numpy_values():
     assert back["data"]["n"] == 3 and back["none"] is None
     finite = {"uuid": "v", "box": np.arange(3.0), "name": "é"}
     assert documents.loads(documents.dumps(finite)) == {"uuid": "v", "box": [0.0, 1.0, 2.0], "name": "é"}
+
+
+def test_moving_instances_are_found_where_they_are(tmp_path):
+    """Instance boxes are indexed with slack (small moves skip the R*Tree): box queries must
+    still answer exactly, before and after a reopen (which forgets the cached index rows)."""
+    rng = np.random.default_rng(11)
+    kb = open_kb(tmp_path / "kb")
+    env = kb.environment("lab")
+    session = kb.start_session(env, "/logs/walk", [])
+    size_m = np.array([0.5, 0.5, 1.7])
+    walkers = [Instance("foreground", "person", Box3D(rng.uniform(-3, 3, 3), size_m), 0.0, 0.0)
+               for _ in range(4)]
+
+    def check() -> None:
+        for _ in range(40):
+            lo = rng.uniform(-5, 5, 3)
+            hi = lo + rng.uniform(0.05, 1.5, 3)
+            truth = {w.uuid for w in walkers
+                     if np.all(w.box.aabb()[1] >= lo) and np.all(w.box.aabb()[0] <= hi)}
+            assert {d["uuid"] for d in kb.docs.in_box(lo.tolist(), hi.tolist(), type="instance")} == truth
+
+    for pose in range(60):
+        for w in walkers:  # small steps mostly, now and then a jump beyond the slack
+            step = rng.normal(0, 0.6 if pose % 10 == 0 else 0.04, 3)
+            w.box = Box3D(w.box.center_m + step, w.box.extent_m)
+            w.last_seen_s = float(pose)
+        kb.write_frame(session, FrameResult([], list(walkers)), pose_id=pose, stamp_s=float(pose))
+        if pose % 7 == 0:
+            check()
+    kb.close()
+    kb = open_kb(tmp_path / "kb")
+    check()
+    for w in walkers:  # after the reopen, one small step each: indexed anew, still exact
+        w.box = Box3D(w.box.center_m + 0.05, w.box.extent_m)
+    kb.write_frame(session, FrameResult([], list(walkers)), pose_id=60, stamp_s=60.0)
+    check()
+    kb.close()

@@ -40,6 +40,9 @@ PAGE_SIZE = 2048
 # tables (``obs_cells_new``, ``links_new``) and moved into their clustered tables once this many
 # rows wait, inside the transaction of the frame that reaches it; reads look at both.
 STAGED_ROWS = 4000
+# The R*Tree row of a moving document (an instance) is its box grown by this much; updates
+# inside it leave the index alone.
+BOX_SLACK_M = 0.25
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -54,7 +57,8 @@ CREATE TABLE IF NOT EXISTS docs (
     session_id INTEGER,
     env_uuid TEXT,
     seq INTEGER NOT NULL,
-    body TEXT NOT NULL
+    body TEXT NOT NULL,
+    created_seq INTEGER
 );
 DROP INDEX IF EXISTS docs_type_class_stamp;
 CREATE INDEX IF NOT EXISTS docs_type_stamp_class ON docs (type, stamp_s, class);
@@ -121,30 +125,25 @@ _ORJSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY | orjson.OPT_NON_STR_KEYS
 
 
 def dumps(doc: dict[str, Any]) -> str:
-    """Compact JSON for a document; numpy arrays become lists. orjson (JSON encoding was ~20 %
-    of the ingest time with the stdlib encoder); the stdlib encoder for what orjson refuses
-    (integers beyond 64 bits) or would change (NaN/inf, which the stdlib keeps)."""
+    """Compact JSON for a document; numpy arrays become lists. orjson (~10x the stdlib encoder
+    on an observation), which writes NaN and infinities as null where the stdlib writes NaN and
+    Infinity and reads them back: a body holding ``null`` is parsed back and compared with the
+    document (C-level, ~10 us), and the stdlib encodes it when they differ (a non-finite number,
+    or what orjson would change: tuples, numpy arrays, integer keys, integers beyond 64 bits)."""
     try:
-        if not _has_non_finite(doc):
-            return orjson.dumps(doc, default=_default, option=_ORJSON_OPTIONS).decode()
+        out = orjson.dumps(doc, default=_default, option=_ORJSON_OPTIONS)
+        if b"null" not in out or _same(orjson.loads(out), doc):
+            return out.decode()
     except (orjson.JSONEncodeError, TypeError):
         pass
     return json.dumps(doc, separators=(",", ":"), default=_default)
 
 
-def _has_non_finite(value: Any) -> bool:
-    """True when a NaN or an infinity sits anywhere in ``value`` (orjson would write null where
-    the stdlib writes NaN, which it reads back as NaN)."""
-    if isinstance(value, float):
-        return not math.isfinite(value)
-    if isinstance(value, dict):
-        return any(_has_non_finite(v) for v in value.values())
-    if isinstance(value, (list, tuple)):
-        return any(_has_non_finite(v) for v in value)
-    dtype = getattr(value, "dtype", None)
-    if dtype is not None and dtype.kind in "fc" and value.size:
-        return not bool((abs(value) < math.inf).all())  # False for NaN and for inf
-    return False
+def _same(a: Any, b: Any) -> bool:
+    try:
+        return bool(a == b)
+    except ValueError:  # numpy arrays compare element-wise
+        return False
 
 
 def loads(text: str | bytes) -> Any:
@@ -223,6 +222,21 @@ def _cell_key(ix: int, iy: int, iz: int) -> int:
     return ((ix + _GRID_OFFSET) * _GRID_SPAN + (iy + _GRID_OFFSET)) * _GRID_SPAN + (iz + _GRID_OFFSET)
 
 
+def _box_meets(doc: dict[str, Any], lo: Sequence[float], hi: Sequence[float]) -> bool:
+    """Whether the map-frame box of a document (``box``: centre, extent, rotation) meets the
+    axis-aligned box [lo, hi]; a document without a box passes."""
+    box = doc.get("box")
+    if not box:
+        return True
+    c, e = box["center_m"], box["extent_m"]
+    R = box.get("R") or [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    for k in range(3):
+        half = sum(abs(R[k][j]) * e[j] / 2.0 for j in range(3))
+        if c[k] + half < lo[k] or c[k] - half > hi[k]:
+            return False
+    return True
+
+
 class DocumentStore:
     """JSON documents in one SQLite file. Writes happen inside ``transaction()``."""
 
@@ -249,6 +263,9 @@ class DocumentStore:
                 self._db.execute("PRAGMA cache_size=-32768")
                 self._db.execute("PRAGMA wal_autocheckpoint=40000")
                 self._db.executescript(_SCHEMA)
+                columns = {str(r[1]) for r in self._db.execute("PRAGMA table_info(docs)")}
+                if "created_seq" not in columns:  # a store written before it existed: NULL = old
+                    self._db.execute("ALTER TABLE docs ADD COLUMN created_seq INTEGER")
                 self._db.execute(
                     "INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
                 )
@@ -275,6 +292,9 @@ class DocumentStore:
         self._link_counts: dict[str, int] = {}
         self._pending_link_counts: dict[str, int] = {}
         self._staged = -1  # rows in the staging tables, -1 = count them
+        # uuid -> the R*Tree row of a document's box as committed by this connection / pending
+        self._boxes: dict[str, tuple[float, ...]] = {}
+        self._pending_boxes: dict[str, tuple[float, ...]] = {}
 
     def _migrate_grid(self, cell: str | None, legacy: bool) -> None:
         """Stores written before the (cell, id) keyed ``obs_cells`` table (1 m cells in
@@ -313,19 +333,24 @@ class DocumentStore:
                 self._unstage()
         except BaseException:
             self._seq = None
-            self._pending_link_counts.clear()
-            self._staged = -1
+            self._forget_pending()
             self._db.execute("ROLLBACK")
             raise
         self._seq = None
         try:
             self._db.execute("COMMIT")
         except BaseException:
-            self._pending_link_counts.clear()
-            self._staged = -1
+            self._forget_pending()
             raise
         self._link_counts.update(self._pending_link_counts)
         self._pending_link_counts.clear()
+        self._boxes.update(self._pending_boxes)
+        self._pending_boxes.clear()
+
+    def _forget_pending(self) -> None:
+        self._pending_link_counts.clear()
+        self._pending_boxes.clear()
+        self._staged = -1
 
     def _staged_rows(self) -> int:
         if self._staged < 0:
@@ -380,10 +405,12 @@ class DocumentStore:
 
     _UPSERT = (
         "INSERT INTO docs (uuid, type, layer, class, stamp_s, instance_uuid, session_id, env_uuid, "
-        "seq, body) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT(uuid) DO UPDATE SET "
+        "seq, body, created_seq) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?9) ON CONFLICT(uuid) DO UPDATE SET "
         "class=excluded.class, stamp_s=excluded.stamp_s, seq=excluded.seq, body=excluded.body"
     )  # an update sets only what changes (each indexed column in SET costs an index rewrite);
-    # a document keeps its type, layer, instance link, session and environment
+    # a document keeps its type, layer, instance link, session, environment and creation seq
+
+    _INSERT_NEW = _UPSERT[: _UPSERT.index(" ON CONFLICT")] + " ON CONFLICT(uuid) DO NOTHING"
 
     def put_many(
         self,
@@ -412,25 +439,35 @@ class DocumentStore:
                          doc.get("instance_uuid"), session_id, env_uuid, seq, dumps(stored)))
             if box_map is not None:
                 lo, hi = box_map
-                bounds = (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"])
                 if doc["type"] == "observation":
                     c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
                     margin = max(margin, *(hi[k] - c[k] for k in range(3)))
-                    grid.append((_cell_key(*(_cell_index(v, cell_m) for v in c)), *bounds))
+                    grid.append((_cell_key(*(_cell_index(v, cell_m) for v in c)),
+                                 lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
                 else:
-                    boxes.append(bounds)
+                    boxes.append((lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
             if doc["type"] == "observation" and doc.get("instance_uuid"):
                 obs_links.append((doc["instance_uuid"], doc["uuid"], seq))
         db = self._db
-        obs_uuids = [r[0] for r in rows if r[1] == "observation"]
+        obs_rows = [r for r in rows if r[1] == "observation"]
         existing: set[str] = set()
-        if obs_uuids:  # observations written again (rare: an import, a re-anchoring)
-            marks = ",".join("?" * len(obs_uuids))
-            existing = {u for (u,) in db.execute(f"SELECT uuid FROM docs WHERE uuid IN ({marks})", obs_uuids)}
-        db.executemany(self._UPSERT, rows)
-        if boxes:
+        if obs_rows:
+            # observations are almost always new: insert them, and only when some uuid was
+            # there already (an import, a re-anchoring, a repeat) write them all again as
+            # updates, treating every one as a rewrite (cheaper than looking each up first)
+            before = db.total_changes
+            db.executemany(self._INSERT_NEW, obs_rows)
+            if db.total_changes - before < len(obs_rows):
+                existing = {r[0] for r in obs_rows}
+                db.executemany(self._UPSERT, obs_rows)
+        other = [r for r in rows if r[1] != "observation"] if obs_rows else rows
+        if other:
+            db.executemany(self._UPSERT, other)
+        index_rows = [r for r in map(self._index_box, boxes) if r is not None]
+        if index_rows:
             db.executemany(
-                "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?", boxes
+                "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?",
+                index_rows,
             )
         if grid:
             # a re-written observation may move to another cell: drop its old entry first
@@ -456,7 +493,31 @@ class DocumentStore:
             if doc["type"] == "instance":
                 self._link_instance(doc["uuid"], doc.get("observation_uuids", []), seq)
         if self._scalar("SELECT EXISTS (SELECT 1 FROM tombstones)"):
-            db.executemany("DELETE FROM tombstones WHERE uuid = ?", [(r[0],) for r in rows])
+            # a document written again after its deletion: no tombstone any more, and its
+            # creation is unknown (the graph may still hold the node of its earlier life)
+            uuids = [r[0] for r in rows]
+            marks = ",".join("?" * len(uuids))
+            found = db.execute(f"SELECT uuid FROM tombstones WHERE uuid IN ({marks})", uuids)
+            revived = [(u,) for (u,) in found]
+            if revived:
+                db.executemany("DELETE FROM tombstones WHERE uuid = ?", revived)
+                db.executemany("UPDATE docs SET created_seq = NULL WHERE uuid = ?", revived)
+
+    def _index_box(self, bounds: tuple[Any, ...]) -> tuple[Any, ...] | None:
+        """The R*Tree row for a document's box (min_x, max_x, ..., max_z, uuid), or None while
+        the box stays inside the row the index holds: rows are the box grown by
+        ``BOX_SLACK_M`` on every side. A tracked instance moves a little every frame, and
+        re-inserting it into the R*Tree each time was ~20 % of the ingest (measured); queries
+        test each document's own box after the index."""
+        uuid = bounds[6]
+        held = self._pending_boxes.get(uuid, self._boxes.get(uuid))
+        if held is not None and all(held[k] <= bounds[k] for k in (0, 2, 4)) and all(
+            held[k] >= bounds[k] for k in (1, 3, 5)
+        ):
+            return None
+        grown = tuple(bounds[k] + (BOX_SLACK_M if k % 2 else -BOX_SLACK_M) for k in range(6))
+        self._pending_boxes[uuid] = grown
+        return (*grown, uuid)
 
     def _link_instance(self, instance_uuid: str, observation_uuids: Sequence[str], seq: int) -> None:
         """Links of an instance to its observations. Observation lists usually only grow, so
@@ -504,6 +565,8 @@ class DocumentStore:
             return False
         self._db.execute("DELETE FROM docs WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM docs_box WHERE id = ?", (row[0],))
+        self._boxes.pop(uuid, None)
+        self._pending_boxes.pop(uuid, None)
         self._db.execute("DELETE FROM obs_cells WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM obs_cells_new WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM links WHERE instance_uuid = ?", (uuid,))
@@ -599,6 +662,12 @@ class DocumentStore:
             params.append(t1)
         return (" WHERE " + " AND ".join(clauses) if clauses else ""), params
 
+    def summaries(self, uuids: Sequence[str]) -> dict[str, tuple[str | None, float | None]]:
+        """uuid -> (class, stamp) of the documents among ``uuids``."""
+        marks = ",".join("?" * len(uuids))
+        rows = self._db.execute(f"SELECT uuid, class, stamp_s FROM docs WHERE uuid IN ({marks})", list(uuids))
+        return {str(u): (cls, stamp) for u, cls, stamp in rows}
+
     def observations_of(self, instance_uuid: str) -> list[dict[str, Any]]:
         """The observation documents an instance was formed from, in time order."""
         rows = self._db.execute(
@@ -626,9 +695,9 @@ class DocumentStore:
         if type is not None:
             sql += " AND d.type = ?"
             params.append(type)
-        if limit is not None:
-            sql += f" LIMIT {int(limit) - len(out)}"
-        return out + [self._decode(b) for (b,) in self._db.execute(sql, params)]
+        docs = (self._decode(b) for (b,) in self._db.execute(sql, params))
+        found = [d for d in docs if _box_meets(d, lo, hi)]
+        return out + (found if limit is None else found[: int(limit) - len(out)])
 
     def _grid_margin(self) -> float:
         value = self.meta("grid_margin_m")
@@ -671,20 +740,29 @@ class DocumentStore:
         return [(str(t), layer, cls, int(n)) for t, layer, cls, n in rows]
 
     def changed_docs(
-        self, after_seq: int, upto_seq: int, batch: int = 2000
-    ) -> Iterator[list[dict[str, Any]]]:
-        """Batches of documents changed in (after_seq, upto_seq], oldest change first."""
-        last_id = -1
-        while True:
-            rows = self._db.execute(
-                "SELECT id, body, env_uuid FROM docs WHERE seq > ? AND seq <= ? AND id > ? "
-                "ORDER BY id LIMIT ?",
-                (after_seq, upto_seq, last_id, batch),
-            ).fetchall()
-            if not rows:
-                return
-            last_id = int(rows[-1][0])
-            yield [self._stored(body, env) for _, body, env in rows]
+        self, after_seq: int, upto_seq: int, batch: int = 2000, *, observation_bodies: bool = True
+    ) -> Iterator[list[tuple[dict[str, Any], bool]]]:
+        """Batches of (document, created) changed in (after_seq, upto_seq], in change order;
+        ``created`` is true when the document was first written after ``after_seq`` (a graph
+        synchronised up to ``after_seq`` cannot hold its node yet). Without
+        ``observation_bodies`` observations come as stubs of their indexed columns (uuid, type,
+        layer, class, stamp_s, instance_uuid, env_uuid): no JSON to parse."""
+        cursor = self._db.execute(
+            "SELECT uuid, type, layer, class, stamp_s, instance_uuid, env_uuid, created_seq, "
+            "CASE WHEN ? OR type != 'observation' THEN body END FROM docs WHERE seq > ? AND seq <= ? "
+            "ORDER BY seq",
+            (int(observation_bodies), after_seq, upto_seq),
+        )
+        while rows := cursor.fetchmany(batch):
+            out = []
+            for uuid, kind, layer, cls, stamp, inst, env, created, body in rows:
+                if body is None:
+                    doc = {"uuid": uuid, "type": kind, "layer": layer, "class": cls, "stamp_s": stamp,
+                           "instance_uuid": inst, "env_uuid": env}
+                else:
+                    doc = self._stored(body, env)
+                out.append((doc, created is not None and created > after_seq))
+            yield out
 
     @staticmethod
     def _stored(body: str, env: str | None) -> dict[str, Any]:
@@ -710,13 +788,18 @@ class DocumentStore:
         "(SELECT layer FROM docs WHERE uuid = l.observation_uuid), 'foreground')"
     )
 
-    def changed_links(self, after_seq: int, upto_seq: int) -> list[tuple[str, str, str]]:
-        """(instance, observation, layer of the instance) links added in (after_seq, upto_seq]."""
-        return list(self._db.execute(
+    def changed_links(
+        self, after_seq: int, upto_seq: int, batch: int = 20000
+    ) -> Iterator[list[tuple[str, str, str]]]:
+        """Batches of (instance, observation, layer of the instance) links added in
+        (after_seq, upto_seq]."""
+        cursor = self._db.execute(
             f"SELECT DISTINCT l.instance_uuid, l.observation_uuid, {self._LINK_LAYER} FROM all_links l "
             "WHERE l.seq > ? AND l.seq <= ?",
             (after_seq, upto_seq),
-        ))
+        )
+        while rows := cursor.fetchmany(batch):
+            yield rows
 
     def link_counts_by_layer(self) -> dict[str, int]:
         rows = self._db.execute(f"SELECT {self._LINK_LAYER} AS layer, COUNT(*) FROM "

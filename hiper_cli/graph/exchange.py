@@ -53,7 +53,8 @@ def _layer_quads(kb: KnowledgeBase) -> list[ox.Quad]:
 
 
 def _with_layers(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:
-    """Add ``hiper:layer`` to nodes that lack it (summary observations), from their graph."""
+    """Add ``hiper:layer`` to nodes that lack it and, to "summary" observation nodes (the graph
+    holds only their type and provenance), their class and stamp from the documents."""
     graph_layer = {layer_graph(kb.kb_id, layer).value: layer for layer in LAYERS}
     has_layer = {q.subject for q in quads if q.predicate == h("layer")}
     extra = {
@@ -61,6 +62,21 @@ def _with_layers(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:
         for q in quads
         if q.predicate == RDF_TYPE and q.subject not in has_layer and isinstance(q.graph_name, ox.NamedNode)
     }
+    has_class = {q.subject for q in quads if q.predicate == h("className")}
+    bare = [q for q in quads if q.predicate == RDF_TYPE and q.object == h("Observation")
+            and q.subject not in has_class and isinstance(q.subject, ox.NamedNode)]
+    double = ox.NamedNode("http://www.w3.org/2001/XMLSchema#double")
+    for k in range(0, len(bare), 10000):
+        chunk = bare[k : k + 10000]
+        uuids = [str(getattr(q.subject, "value", "")).removeprefix("urn:uuid:") for q in chunk]
+        found = kb.docs.summaries(uuids)
+        for q, uuid in zip(chunk, uuids, strict=True):
+            cls, stamp = found.get(uuid, (None, None))
+            if cls is not None:
+                extra.add(ox.Quad(q.subject, h("className"), ox.Literal(cls), q.graph_name))
+            if stamp is not None:
+                extra.add(ox.Quad(q.subject, h("stampS"), ox.Literal(repr(float(stamp)), datatype=double),
+                                  q.graph_name))
     return quads + sorted(extra, key=str)
 
 

@@ -23,6 +23,11 @@ from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
 __all__ = ["GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
 
 _SYNCED = ox.NamedNode(HIPER + "syncedSeq")
+_DIRTY = ox.NamedNode(HIPER + "syncDirty")
+_TRUE = ox.Literal("true", datatype=ox.NamedNode("http://www.w3.org/2001/XMLSchema#boolean"))
+# Below this many bytes of N-Quads a transactional load is as fast as the bulk loader (which
+# writes new files on every call) and keeps the write atomic.
+BULK_MIN_BYTES = 1 << 20
 _INTEGER = ox.NamedNode("http://www.w3.org/2001/XMLSchema#integer")
 _PREFIXES = f"PREFIX hiper: <{HIPER}>\nPREFIX prov: <{PROV}>\nPREFIX sosa: <http://www.w3.org/ns/sosa/>\n"
 
@@ -43,11 +48,26 @@ class GraphBackend(Protocol):
         all triples of the subjects in ``drop``, then add ``quads``. Subjects are IRIs."""
         ...
 
+    def append_nquads(self, text: str) -> None:
+        """Add the quads of an N-Quads document; large ones through a bulk loader that is not
+        atomic (see ``begin_sync``)."""
+        ...
+
     def synced_seq(self, kb_id: str) -> int:
         """The high-water mark: the last document change the graph reflects (0 if none)."""
         ...
 
-    def set_synced_seq(self, kb_id: str, seq: int) -> None: ...
+    def sync_state(self, kb_id: str) -> tuple[int, bool]:
+        """The high-water mark and whether a sync after it was interrupted (dirty)."""
+        ...
+
+    def begin_sync(self, kb_id: str) -> None:
+        """Mark the graph dirty until ``set_synced_seq``: non-atomic writes follow."""
+        ...
+
+    def set_synced_seq(self, kb_id: str, seq: int) -> None:
+        """Move the mark to ``seq`` and mark the graph clean, in one atomic write."""
+        ...
 
     def clear(self, graphs: Sequence[ox.NamedNode]) -> None: ...
 
@@ -99,16 +119,43 @@ class LocalGraph:
             store.remove(q)
         store.extend(quads)
 
+    def append_nquads(self, text: str) -> None:
+        if not text:
+            return
+        data = text.encode("utf-8")
+        try:
+            if len(data) >= BULK_MIN_BYTES:
+                self._store.bulk_load(data, format=ox.RdfFormat.N_QUADS)
+            else:
+                self._store.load(data, format=ox.RdfFormat.N_QUADS)
+        except SyntaxError as err:
+            raise KnowledgeBaseError(f"{self.location}: a generated graph node does not parse ({err}); "
+                                     "a document uuid is not a plain uuid? run 'hiper kb check'") from err
+
     def synced_seq(self, kb_id: str) -> int:
-        for q in self._store.quads_for_pattern(_kb_node(kb_id), _SYNCED, None, meta_graph(kb_id)):
-            return int(str(getattr(q.object, "value", 0)))
-        return 0
+        return self.sync_state(kb_id)[0]
+
+    def sync_state(self, kb_id: str) -> tuple[int, bool]:
+        s, g = _kb_node(kb_id), meta_graph(kb_id)
+        seq = 0
+        for q in self._store.quads_for_pattern(s, _SYNCED, None, g):
+            seq = int(str(getattr(q.object, "value", 0)))
+        dirty = any(True for _ in self._store.quads_for_pattern(s, _DIRTY, None, g))
+        return seq, dirty
+
+    def begin_sync(self, kb_id: str) -> None:
+        self._store.add(ox.Quad(_kb_node(kb_id), _DIRTY, _TRUE, meta_graph(kb_id)))
+        self._store.flush()  # on disk before any bulk-loaded file
 
     def set_synced_seq(self, kb_id: str, seq: int) -> None:
         s, g = _kb_node(kb_id), meta_graph(kb_id)
-        for q in list(self._store.quads_for_pattern(s, _SYNCED, None, g)):
-            self._store.remove(q)
-        self._store.add(ox.Quad(s, _SYNCED, ox.Literal(str(seq), datatype=_INTEGER), g))
+        old = list(self._store.quads_for_pattern(s, _SYNCED, None, g))
+        old += self._store.quads_for_pattern(s, _DIRTY, None, g)
+        self._store.update(
+            "".join(f"DELETE DATA {{ GRAPH {q.graph_name} {{ {q.subject} {q.predicate} {q.object} }} }} ;\n"
+                    for q in old)
+            + f"INSERT DATA {{ GRAPH {g} {{ {s} {_SYNCED} {ox.Literal(str(seq), datatype=_INTEGER)} }} }}"
+        )
 
     def clear(self, graphs: Sequence[ox.NamedNode]) -> None:
         for g in graphs:
@@ -198,16 +245,31 @@ class SparqlGraph:
         if ops:
             self._update(" ;\n".join(ops))
 
+    def append_nquads(self, text: str) -> None:
+        if text:
+            quads = list(ox.parse(text.encode("utf-8"), format=ox.RdfFormat.N_QUADS))
+            for k in range(0, len(quads), 20000):
+                self.write("", [], [], quads[k : k + 20000])
+
     def synced_seq(self, kb_id: str) -> int:
-        rows = self.query(
-            f"SELECT ?n WHERE {{ GRAPH {meta_graph(kb_id)} {{ {_kb_node(kb_id)} hiper:syncedSeq ?n }} }}"
-        )
-        return int(rows[0]["n"].value) if rows else 0
+        return self.sync_state(kb_id)[0]
+
+    def sync_state(self, kb_id: str) -> tuple[int, bool]:
+        s, g = _kb_node(kb_id), meta_graph(kb_id)
+        rows = self.query(f"SELECT ?n ?d WHERE {{ GRAPH {g} {{ OPTIONAL {{ {s} hiper:syncedSeq ?n }} "
+                          f"OPTIONAL {{ {s} hiper:syncDirty ?d }} }} }}")
+        seq = int(rows[0]["n"].value) if rows and "n" in rows[0] else 0
+        return seq, bool(rows and "d" in rows[0])
+
+    def begin_sync(self, kb_id: str) -> None:
+        s, g = _kb_node(kb_id), meta_graph(kb_id)
+        self._update(f"INSERT DATA {{ GRAPH {g} {{ {s} hiper:syncDirty true }} }}")
 
     def set_synced_seq(self, kb_id: str, seq: int) -> None:
         s, g = _kb_node(kb_id), meta_graph(kb_id)
         self._update(
             f"DELETE WHERE {{ GRAPH {g} {{ {s} hiper:syncedSeq ?n }} }} ;\n"
+            f"DELETE WHERE {{ GRAPH {g} {{ {s} hiper:syncDirty ?d }} }} ;\n"
             f"INSERT DATA {{ GRAPH {g} {{ {s} hiper:syncedSeq {seq} }} }}"
         )
 

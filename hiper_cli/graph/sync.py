@@ -1,0 +1,109 @@
+"""Bringing the scene graph up to date with the documents: the high-water-mark replay.
+
+The documents are the source of truth. Every write transaction there takes the next change
+sequence number; the graph records the last one it reflects (``hiper:syncedSeq`` in the
+knowledge base's meta graph). ``sync_graph`` replays every document change after that mark:
+
+- a document first written after the mark has no node in the graph yet: its triples are only
+  added; any other changed document has its node replaced (its triples removed, except the
+  provenance links, then added again); deleted documents (tombstones) lose their node;
+- observations in the "summary" detail (the bulk of the data) and provenance links go in as
+  N-Quads text through the store's bulk loader (~2x the rate of a transactional insert,
+  measured), which is not atomic: the graph is marked dirty (``hiper:syncDirty``) before and
+  clean with the new mark after, and a sync that finds it dirty replaces every node it replays,
+  so an interrupted sync is repaired by the next one (``open_kb`` runs one);
+- the mark moves last, in one transaction with the clean flag.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from hiper_cli.graph.ontology import (
+    doc_quads,
+    link_nquads,
+    node,
+    observation_nquads,
+    session_node,
+    session_quads,
+)
+
+if TYPE_CHECKING:
+    from hiper_cli.graph.documents import DocumentStore
+    from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph
+
+__all__ = ["SyncReport", "sync_graph"]
+
+
+@dataclass
+class SyncReport:
+    documents: int = 0
+    links: int = 0
+    deleted: int = 0
+    sessions: int = 0
+    seconds: float = 0.0
+    rebuilt: bool = False
+
+
+def sync_graph(
+    docs: DocumentStore,
+    graph: LocalGraph | SparqlGraph,
+    kb_id: str,
+    graphs: Sequence[Any],
+    *,
+    detail: str = "summary",
+    batch: int = 20000,
+    rebuild: bool = False,
+) -> SyncReport:
+    """Replay the document changes after the graph's mark (all of them when ``rebuild``) into
+    ``graph``; ``graphs`` are the knowledge base's named graphs (cleared on a rebuild).
+    Idempotent and safe to interrupt."""
+    start = time.perf_counter()
+    report = SyncReport(rebuilt=rebuild)
+    upto = docs.seq
+    after, dirty = (0, False) if rebuild else graph.sync_state(kb_id)
+    if after > upto:  # the graph is ahead of the documents (restored backup): rebuild
+        after, report.rebuilt = 0, True
+    if after == upto and not dirty and not report.rebuilt:
+        return report
+    if after == 0:
+        graph.clear(graphs)  # the mark goes with the meta graph: an interrupted rebuild restarts
+    else:
+        graph.begin_sync(kb_id)
+    fast = detail == "summary"
+    for chunk in docs.changed_docs(after, upto, batch, observation_bodies=not fast):
+        refresh: list[str] = []
+        quads = []
+        lines: list[str] = []
+        for doc, created in chunk:
+            if after > 0 and (dirty or not created):
+                refresh.append(node(doc["uuid"]).value)
+            if fast and doc["type"] == "observation":
+                lines.append(observation_nquads(kb_id, doc["uuid"], doc.get("layer") or "foreground"))
+            else:
+                quads.extend(doc_quads(kb_id, doc, detail))
+        graph.write(kb_id, refresh, [], quads)
+        graph.append_nquads("".join(lines))
+        report.documents += len(chunk)
+    for links in docs.changed_links(after, upto, batch):
+        graph.append_nquads("".join(link_nquads(kb_id, i, o, layer) for i, o, layer in links))
+        report.links += len(links)
+    dead = [node(u).value for u, _, _ in docs.tombstones(after, upto)]
+    if dead and after > 0:
+        graph.write(kb_id, [], dead, [])
+    report.deleted = len(dead)
+    sessions = docs.sessions(after_seq=after, upto_seq=upto)
+    if sessions:
+        graph.write(kb_id, [session_node(kb_id, s.id).value for s in sessions], [],
+                    [q for s in sessions for q in session_quads(kb_id, s.to_dict())])
+    report.sessions = len(sessions)
+    graph.set_synced_seq(kb_id, upto)
+    # RocksDB keeps one write buffer per index in memory until flushed: flushing after each
+    # catch-up bounds the writer's memory (measured 355 -> 187 MB at 60 k observations)
+    graph.flush()
+    report.seconds = time.perf_counter() - start
+    return report
+
