@@ -1,5 +1,9 @@
 """A knowledge-base writer for the crash test: writes frames forever, printing each committed
-pose id; the test kills it with SIGKILL at random instants. Usage: kb_crash_writer.py KB_DIR."""
+pose id; the test kills it with SIGKILL at random instants.
+
+Usage: kb_crash_writer.py KB_DIR [inline|follower]. ``inline`` syncs the graph every 4 frames
+through the bulk loader (threshold 0: every sync is a non-atomic bulk load); ``follower`` leaves
+the graph to a ``GraphFollower`` process syncing every 20 ms."""
 
 from __future__ import annotations
 
@@ -7,15 +11,19 @@ import sys
 
 import numpy as np
 
-from hiper_cli.graph import open_kb
+from hiper_cli.graph import open_kb, scenegraph
+from hiper_cli.graph.follower import GraphFollower
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.stage import FrameResult
 
 OBS_PER_FRAME = 3
 
 
-def main(path: str) -> None:
+def main(path: str, mode: str = "inline") -> None:
+    scenegraph.BULK_MIN_BYTES = 0
     kb = open_kb(path)  # catches the graph up with the documents: the repair after a crash
+    if mode == "follower":
+        GraphFollower(kb, interval_s=0.02).start()
     env = kb.environment("crash")
     session = kb.resumable_session(env, "crashlog") or kb.start_session(env, "crashlog", ["writer"])
     world = kb.load_world(env)
@@ -33,9 +41,9 @@ def main(path: str) -> None:
         inst.last_seen_s = float(pose)
         kb.write_frame(session, FrameResult(obs, [inst]), pose_id=pose, stamp_s=float(pose), T_map_cam=T)
         print(pose, flush=True)
-        if pose % 4 == 0:
+        if pose % 4 == 0 and mode == "inline":
             kb.sync_graph()
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(*sys.argv[1:])

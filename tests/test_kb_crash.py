@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from hiper_cli.graph import open_kb
 from tests.kb_crash_writer import OBS_PER_FRAME
 
@@ -18,16 +20,16 @@ WRITER = Path(__file__).with_name("kb_crash_writer.py")
 KILLS = 20
 
 
-def _run_and_kill(kb_dir: Path, rng: random.Random, stderr_path: Path) -> int:
+def _run_and_kill(kb_dir: Path, rng: random.Random, stderr_path: Path, mode: str) -> int:
     """Start the writer, kill it at a random instant once it writes; the last printed pose id."""
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
     with stderr_path.open("w") as stderr:
-        proc = subprocess.Popen([sys.executable, str(WRITER), str(kb_dir)], stdout=subprocess.PIPE,
+        proc = subprocess.Popen([sys.executable, str(WRITER), str(kb_dir), mode], stdout=subprocess.PIPE,
                                 stderr=stderr, text=True, env=env)
         assert proc.stdout is not None
         first = proc.stdout.readline()
         assert first.startswith("ready"), stderr_path.read_text()
-        time.sleep(rng.uniform(0.0, 0.15))
+        time.sleep(rng.uniform(0.0, 0.15 if mode == "inline" else 0.4))
         proc.send_signal(signal.SIGKILL)
         # read through the same buffered file as readline (it may have read ahead)
         out = proc.stdout.read()
@@ -38,13 +40,14 @@ def _run_and_kill(kb_dir: Path, rng: random.Random, stderr_path: Path) -> int:
     return printed[-1] if printed else int(first.split()[1])
 
 
-def test_kill_minus_nine_at_random_instants(tmp_path):
+@pytest.mark.parametrize("mode", ["inline", "follower"])
+def test_kill_minus_nine_at_random_instants(tmp_path, mode):
     rng = random.Random(1234)
     kb_dir = tmp_path / "crash.hiper"
     committed = -1
     start = time.monotonic()
     for _ in range(KILLS):
-        printed = _run_and_kill(kb_dir, rng, tmp_path / "writer.err")
+        printed = _run_and_kill(kb_dir, rng, tmp_path / "writer.err", mode)
         with open_kb(kb_dir) as kb:
             report = kb.check(repair=False)
             assert report.ok, report.problems

@@ -277,7 +277,7 @@ def test_an_interrupted_sync_is_repaired_by_the_next(kb_location):
 
     location, docs = kb_location
     with open_kb(location, docs_dir=docs) as kb:
-        env, session, _ = _fill(kb)
+        env, _, _ = _fill(kb)
         kb.sync_graph()
         mark = kb.graph.synced_seq(kb.kb_id)
         walker = Instance("foreground", "person", Box3D(np.zeros(3), np.ones(3)), 30.0, 30.0)
@@ -296,3 +296,27 @@ def test_an_interrupted_sync_is_repaired_by_the_next(kb_location):
         assert report.ok, report.problems
         rows = kb.query(f"SELECT ?t WHERE {{ GRAPH ?g {{ <urn:uuid:{walker.uuid}> hiper:lastSeenS ?t }} }}")
         assert [float(r["t"].value) for r in rows] == [31.0]
+
+
+def test_a_follower_process_keeps_the_graph_up_to_date(kb_location):
+    from hiper_cli.graph.follower import GraphFollower
+
+    location, docs = kb_location
+    with open_kb(location, docs_dir=docs) as kb:
+        env = kb.environment("lab")
+        session = kb.start_session(env, "/logs/follow", [])
+        with GraphFollower(kb, interval_s=0.05) as follower:
+            if docs is None:  # the local store belongs to the follower meanwhile
+                with pytest.raises(KnowledgeBaseError, match="graph follower"):
+                    kb.query("SELECT * WHERE { ?s ?p ?o } LIMIT 1")
+            for pose in range(40):
+                obs = Observation("foreground", "cup", 0.5, float(pose), pose, Box3D(np.zeros(3), np.ones(3)))
+                kb.write_frame(session, FrameResult([obs]), pose_id=pose, stamp_s=float(pose),
+                               T_map_cam=np.eye(4))
+        report = follower.report
+        assert report.syncs >= 1 and report.documents >= 40 and not report.errors
+        assert report.peak_rss_mb > 0 and report.cpu_s > 0
+        assert kb.graph.synced_seq(kb.kb_id) == kb.docs.seq
+        assert kb.check(repair=False).ok
+        rows = kb.query("SELECT (COUNT(?o) AS ?n) WHERE { GRAPH ?g { ?o a hiper:Observation } }")
+        assert int(rows[0]["n"].value) == 40

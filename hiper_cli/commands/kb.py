@@ -105,9 +105,13 @@ def bench_command(
     ] = "summary",
     graph_sync_s: Annotated[
         float,
-        typer.Option("--graph-sync-s", help="Graph sync interval during ingest, as perceive (2 s); "
+        typer.Option("--graph-sync-s", help="Graph sync interval during ingest (2 s); with --inline-graph "
                      "0 = once after the ingest (shows the document side's memory alone)."),
     ] = 2.0,
+    inline_graph: Annotated[
+        bool, typer.Option("--inline-graph", help="Sync the graph in the writer process, as perceive "
+                           "does, instead of a graph follower process beside it.")
+    ] = False,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Ingest rate, p50/p95 query latencies and peak memory at several sizes (fresh KBs in /tmp).
@@ -124,17 +128,19 @@ def bench_command(
     if not counts or min(counts) <= 0:
         raise ConfigError(f"--sizes {sizes!r}: expected positive observation counts")
     config = BenchConfig(obs_per_frame=obs_per_frame, queries=queries, instance_updates=not no_instances,
-                         observation_detail=detail, graph_sync_s=graph_sync_s)
+                         observation_detail=detail, graph_sync_s=graph_sync_s, follower=not inline_graph)
     out = console()
 
     def show(r: dict[str, Any]) -> None:
         if as_json:
             return
         lat = "  ".join(f"{k} {v['p50_ms']:.2f}/{v['p95_ms']:.2f} ms" for k, v in r["latency"].items())
+        follower = (f" + follower {r['follower_peak_rss_mb']:.0f} MB" if r["follower_peak_rss_mb"] else "")
         out.print(
-            f"[bold]{r['observations']:>8}[/] obs: ingest {r['ingest_obs_per_s']:.0f}/s "
-            f"({r['ingest_obs_per_cpu_s']:.0f}/CPU-s), graph {r['graph_sync_obs_per_s']:.0f}/s, "
-            f"peak RSS {r['peak_rss_mb']:.0f} MB, load {r['load_average_1min']}\n    p50/p95: {lat}"
+            f"[bold]{r['observations']:>8}[/] obs: documents {r['ingest_obs_per_s']:.0f}/s "
+            f"({r['ingest_obs_per_cpu_s']:.0f}/CPU-s), graph {r['graph_sync_obs_per_s']:.0f}/s "
+            f"({r['graph']}), end to end {r['end_to_end_obs_per_s']:.0f}/s, peak RSS "
+            f"{r['peak_rss_mb']:.0f} MB{follower}, load {r['load_average_1min']}\n    p50/p95: {lat}"
         )
 
     results = run_bench(counts, config, on_result=show)

@@ -31,7 +31,7 @@ from hiper_cli.graph.ontology import (
     meta_graph,
     node,
 )
-from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph, open_graph
+from hiper_cli.graph.scenegraph import DetachedGraph, LocalGraph, SparqlGraph, open_graph
 from hiper_cli.graph.sync import SyncReport, sync_graph
 from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, Instance, Observation
 from hiper_cli.perceive.stage import FrameResult, World
@@ -121,7 +121,7 @@ class KnowledgeBase:
     def __init__(
         self,
         root: Path,
-        graph: LocalGraph | SparqlGraph,
+        graph: LocalGraph | SparqlGraph | DetachedGraph,
         docs: DocumentStore,
         config: KbConfig,
         read_only: bool = False,
@@ -151,10 +151,26 @@ class KnowledgeBase:
         return self.graph.location if isinstance(self.graph, SparqlGraph) else str(self.root)
 
     def close(self) -> None:
-        if not self.read_only:
+        if not self.read_only and not self.graph_detached:
             self.sync_graph()
         self.graph.close()
         self.docs.close()
+
+    @property
+    def graph_detached(self) -> bool:
+        return isinstance(self.graph, DetachedGraph)
+
+    def detach_graph(self) -> None:
+        """Close the local graph store so that another process (a ``GraphFollower``) can own
+        it; graph reads raise until ``attach_graph``."""
+        if not self.graph_detached:
+            location = self.graph.location
+            self.graph.close()
+            self.graph = DetachedGraph(location)
+
+    def attach_graph(self) -> None:
+        if self.graph_detached:
+            self.graph = open_graph(self.graph.location)
 
     def __enter__(self) -> KnowledgeBase:
         return self
@@ -249,6 +265,8 @@ class KnowledgeBase:
     def sync_graph(self, *, rebuild: bool = False) -> SyncReport:
         """Bring the scene graph up to date with the documents (everything after its high-water
         mark, or everything when ``rebuild``). Idempotent; safe to interrupt."""
+        if isinstance(self.graph, DetachedGraph):
+            raise self.graph.busy()
         return sync_graph(self.docs, self.graph, self.kb_id, self.graphs(),
                           detail=self.config.observation_detail, batch=self.config.sync_batch,
                           rebuild=rebuild)

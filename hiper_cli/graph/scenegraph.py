@@ -8,6 +8,7 @@ bring the graph up to date from its documents with a high-water mark.
 
 from __future__ import annotations
 
+import time
 import urllib.error
 import urllib.parse
 import urllib.request
@@ -20,7 +21,7 @@ import pyoxigraph as ox
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
 
-__all__ = ["GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
+__all__ = ["DetachedGraph", "GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
 
 _SYNCED = ox.NamedNode(HIPER + "syncedSeq")
 _DIRTY = ox.NamedNode(HIPER + "syncDirty")
@@ -90,6 +91,19 @@ def _solutions(result: Any) -> list[dict[str, Any]]:
     return [{n: sol[n] for n in names if sol[n] is not None} for sol in result]
 
 
+def _open_store(path: Path, wait_s: float = 3.0) -> ox.Store:
+    """The on-disk store, waiting up to ``wait_s`` for a lock that a dying process (a graph
+    follower killed with its writer) still holds."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return ox.Store(str(path))
+        except OSError as err:
+            if "lock" not in str(err).lower() or time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
+
+
 class LocalGraph:
     """The scene graph in an on-disk pyoxigraph (RocksDB) store, one process at a time."""
 
@@ -97,7 +111,7 @@ class LocalGraph:
         self.location = str(path)
         self.read_only = read_only
         try:
-            self._store = ox.Store.read_only(str(path)) if read_only else ox.Store(str(path))
+            self._store = ox.Store.read_only(str(path)) if read_only else _open_store(path)
         except OSError as err:
             raise KnowledgeBaseError(
                 f"{path}: cannot open the scene graph ({err}); is another hiper process writing "
@@ -291,6 +305,26 @@ class SparqlGraph:
 
     def flush(self) -> None:
         pass
+
+    def close(self) -> None:
+        pass
+
+
+class DetachedGraph:
+    """Stands in for a local graph store another process owns (a ``GraphFollower``)."""
+
+    def __init__(self, location: str) -> None:
+        self.location = location
+
+    def busy(self) -> KnowledgeBaseError:
+        return KnowledgeBaseError(
+            f"{self.location}: the scene graph is being written by the graph follower process; "
+            "read it after the follower stops (or open the knowledge base from another process "
+            "with open_kb_for_reading)"
+        )
+
+    def __getattr__(self, name: str) -> Any:
+        raise self.busy()
 
     def close(self) -> None:
         pass
