@@ -9,7 +9,7 @@ import pytest
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph import KbConfig, open_kb
 from hiper_cli.graph.ontology import layer_graph, ontology_turtle
-from hiper_cli.model import Analysis, Box3D, Observation
+from hiper_cli.model import Analysis, Box3D, Instance, Observation
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import FrameResult
 from tests import kb_helpers
@@ -47,8 +47,10 @@ def test_frames_become_documents_and_graph_nodes(kb_location):
         assert kb.docs.count(type="instance", layer="foreground") == 1
         counts = kb.graph_counts()
         assert counts == kb.document_counts()
-        assert counts["foreground/Observation"] == 12
-        assert counts["background/wasDerivedFrom"] == 12
+        # observations are summarised: one batch per instance, session and minute
+        assert "foreground/Observation" not in counts
+        assert counts["foreground/ObservationBatch"] == 1 == counts["foreground/wasDerivedFrom"]
+        assert counts["background/ObservationBatch"] == kb.docs.count(type="instance", layer="background")
         report = kb.check(repair=False)
         assert report.ok, report.problems
         assert kb.docs.session(session.id).frames == 12
@@ -69,9 +71,24 @@ def test_graph_nodes_carry_high_level_attributes(kb_location):
         assert rows[0]["cls"].value == "floor"
         assert float(rows[0]["last"].value) == pytest.approx(floor.last_seen_s)
         assert int(rows[0]["n"].value) == 12
+        derived = kb.query(f"SELECT (SUM(?k) AS ?n) WHERE {{ GRAPH ?g {{ <urn:uuid:{floor.uuid}> "
+                           "prov:wasDerivedFrom ?b . ?b a hiper:ObservationBatch ; "
+                           "hiper:observationCount ?k } }")
+        assert int(derived[0]["n"].value) == 12
+
+
+def test_summary_detail_keeps_a_node_per_observation(tmp_path):
+    with open_kb(tmp_path / "kb", config=KbConfig(observation_detail="summary")) as kb:
+        _, _, world = _fill(kb)
+        kb.sync_graph()
+        counts = kb.graph_counts()
+        assert counts == kb.document_counts()
+        assert counts["foreground/Observation"] == 12 and counts["background/wasDerivedFrom"] == 12
+        floor = next(iter(world.background.values()))
         derived = kb.query(f"SELECT (COUNT(?o) AS ?n) WHERE {{ GRAPH ?g {{ <urn:uuid:{floor.uuid}> "
                            "prov:wasDerivedFrom ?o . ?o a hiper:Observation } }")
         assert int(derived[0]["n"].value) == 12
+        assert kb.check(repair=False).ok
 
 
 def test_reopen_keeps_everything_and_world_reloads(kb_location):
@@ -124,7 +141,7 @@ def test_check_repairs_a_damaged_graph(kb_location):
         kb.graph.clear([layer_graph(kb.kb_id, "foreground")])  # lose a layer behind the KB's back
         report = kb.check(repair=False)
         assert not report.ok
-        assert any("foreground/Observation: graph 0 vs documents 12" in p for p in report.problems)
+        assert any("foreground/ObservationBatch: graph 0 vs documents 1" in p for p in report.problems)
         report = kb.check(repair=True)
         assert report.repaired and report.ok
         assert kb.check(repair=False).ok
@@ -158,12 +175,15 @@ def test_graph_catches_up_from_the_high_water_mark(kb_location):
         assert synced == kb.docs.seq
         env = kb.environment("lab")
         session = kb.start_session(env, "/logs/lab2", ["probe"])
-        obs = Observation("foreground", "book", 0.7, 20.0, 0, Box3D(np.zeros(3), np.ones(3)))
-        kb.write_frame(session, FrameResult([obs]), pose_id=0, stamp_s=20.0, T_map_cam=np.eye(4))
+        book = Instance("foreground", "book", Box3D(np.zeros(3), np.ones(3)), 20.0, 20.0)
+        obs = Observation("foreground", "book", 0.7, 20.0, 0, Box3D(np.zeros(3), np.ones(3)),
+                          instance_uuid=book.uuid)
+        book.observation_uuids.append(obs.uuid)
+        kb.write_frame(session, FrameResult([obs], [book]), pose_id=0, stamp_s=20.0, T_map_cam=np.eye(4))
         assert kb.graph.synced_seq(kb.kb_id) == synced  # the graph lags until the next sync
         assert not kb.check(repair=False).ok
         report = kb.sync_graph()
-        assert report.documents == 1 and report.sessions == 1
+        assert report.documents == 1 and report.links == 1 and report.sessions == 1  # instance, batch
         assert kb.check(repair=False).ok
 
 
@@ -191,7 +211,8 @@ def test_two_knowledge_bases_share_one_endpoint(sparql_url, tmp_path):
         kb2.sync_graph()
         assert kb1.kb_id != kb2.kb_id
         assert kb1.check(repair=False).ok and kb2.check(repair=False).ok
-        rows = kb1.query("SELECT (COUNT(?o) AS ?n) WHERE { GRAPH ?g { ?o a hiper:Observation } }")
+        rows = kb1.query("SELECT (SUM(?k) AS ?n) WHERE { GRAPH ?g { ?b a hiper:ObservationBatch ; "
+                         "hiper:observationCount ?k } }")
         assert int(rows[0]["n"].value) >= 18  # both robots' observations on one endpoint
 
 
@@ -273,7 +294,6 @@ def test_an_interrupted_sync_is_repaired_by_the_next(kb_location):
     cover, possibly of older document versions. The dirty flag makes the next sync replace
     every node it replays."""
     from hiper_cli.graph.ontology import doc_quads
-    from hiper_cli.model import Instance
 
     location, docs = kb_location
     with open_kb(location, docs_dir=docs) as kb:
@@ -309,14 +329,20 @@ def test_a_follower_process_keeps_the_graph_up_to_date(kb_location):
             if docs is None:  # the local store belongs to the follower meanwhile
                 with pytest.raises(KnowledgeBaseError, match="graph follower"):
                     kb.query("SELECT * WHERE { ?s ?p ?o } LIMIT 1")
+            cup = Instance("foreground", "cup", Box3D(np.zeros(3), np.ones(3)), 0.0, 0.0)
             for pose in range(40):
-                obs = Observation("foreground", "cup", 0.5, float(pose), pose, Box3D(np.zeros(3), np.ones(3)))
-                kb.write_frame(session, FrameResult([obs]), pose_id=pose, stamp_s=float(pose),
+                obs = Observation("foreground", "cup", 0.5, float(pose), pose, Box3D(np.zeros(3), np.ones(3)),
+                                  instance_uuid=cup.uuid)
+                cup.observation_uuids.append(obs.uuid)
+                cup.last_seen_s = float(pose)
+                kb.write_frame(session, FrameResult([obs], [cup]), pose_id=pose, stamp_s=float(pose),
                                T_map_cam=np.eye(4))
         report = follower.report
-        assert report.syncs >= 1 and report.documents >= 40 and not report.errors
+        assert report.syncs >= 1 and report.documents >= 1 and report.links >= 1 and not report.errors
         assert report.peak_rss_mb > 0 and report.cpu_s > 0
         assert kb.graph.synced_seq(kb.kb_id) == kb.docs.seq
         assert kb.check(repair=False).ok
-        rows = kb.query("SELECT (COUNT(?o) AS ?n) WHERE { GRAPH ?g { ?o a hiper:Observation } }")
+        g = layer_graph(kb.kb_id, "foreground")  # the endpoint may hold other tests' graphs
+        rows = kb.query(f"SELECT (SUM(?k) AS ?n) WHERE {{ GRAPH {g} {{ ?b a hiper:ObservationBatch ; "
+                        "hiper:observationCount ?k } }")
         assert int(rows[0]["n"].value) == 40

@@ -26,7 +26,8 @@ def export_command(
     kb_docs: KbDocsOption = None,
     fmt: FormatOption = None,
     observations: Annotated[
-        bool, typer.Option("--observations", help="JSON: include every observation document.")
+        bool, typer.Option("--observations", help="Include every observation: its document (JSON), "
+                           "its node and provenance link (RDF, GraphML; the scene graph holds batches).")
     ] = False,
     as_json: bool = JSON_OPTION,
 ) -> None:

@@ -28,7 +28,7 @@ import pyoxigraph as ox
 
 from hiper_cli.errors import DataError, KnowledgeBaseError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, h, layer_graph, speed_mps
+from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, doc_quads, h, layer_graph, link_quad, speed_mps
 from hiper_cli.model import LAYERS
 
 __all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_export"]
@@ -50,6 +50,19 @@ def guess_format(path: Path) -> str:
 def _layer_quads(kb: KnowledgeBase) -> list[ox.Quad]:
     kb.sync_graph() if not kb.read_only else None
     return kb.graph.quads([layer_graph(kb.kb_id, layer) for layer in LAYERS])
+
+
+def _with_observations(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:
+    """Add every observation as a node (class, stamp, pose, frame, confidence, box) with its
+    provenance link from its instance, from the documents (the scene graph may hold only
+    observation batches, see ``ontology.OBSERVATION_DETAIL``)."""
+    have = set(quads)
+    extra: list[ox.Quad] = []
+    for doc in kb.docs.find(type="observation"):
+        extra += (q for q in doc_quads(kb.kb_id, doc, "full") if q not in have)
+    for links in kb.docs.changed_links(0, kb.docs.seq):
+        extra += (q for q in (link_quad(kb.kb_id, i, o, layer) for i, o, layer in links) if q not in have)
+    return quads + extra
 
 
 def _with_layers(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:
@@ -111,7 +124,10 @@ def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = Fa
         keys = ("environments", "instances", "analyses", "observations")
         summary["counts"] = {k: len(data[k]) for k in keys}
         return summary
-    quads = _with_layers(kb, _layer_quads(kb))
+    quads = _layer_quads(kb)
+    if observations:
+        quads = _with_observations(kb, quads)
+    quads = _with_layers(kb, quads)
     summary["quads"] = len(quads)
     prefixes = {"hiper": HIPER, "prov": PROV, "sosa": "http://www.w3.org/ns/sosa/"}
     if fmt == "nquads":
@@ -223,7 +239,8 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[dict[str, A
     links: dict[str, list[str]] = defaultdict(list)
     for iri, p in props.items():
         for target in p.get("wasDerivedFrom", []):
-            links[iri].append(target.removeprefix("urn:uuid:"))
+            if target.startswith("urn:uuid:"):  # observations (not observation batches)
+                links[iri].append(target.removeprefix("urn:uuid:"))
 
     def one(p: dict[str, list[str]], key: str, default: Any = None) -> Any:
         values = p.get(key)

@@ -25,7 +25,10 @@ import numpy as np
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
 from hiper_cli.graph.ontology import (
+    OBSERVATION_BATCH_S,
     OBSERVATION_DETAIL,
+    WAS_DERIVED_FROM,
+    batch_quads,
     doc_quads,
     layer_graph,
     meta_graph,
@@ -53,12 +56,14 @@ GRAPH_DIR = "graph"
 
 @dataclass(frozen=True)
 class KbConfig:
-    """``observation_detail``: how much of each observation the graph holds ("summary": class,
-    stamp and provenance link; "full": also pose id, frame, confidence and box).
+    """``observation_detail``: how much of each observation the graph holds ("batch": nothing
+    per observation, instances derive from observation batches; "summary": a node and the
+    provenance link; "full": also class, stamp, pose id, frame, confidence and box); see
+    ``ontology.OBSERVATION_DETAIL``.
     ``sync_batch``: documents per graph write when catching up. ``check_sample``: documents
     whose graph nodes ``check`` compares triple by triple (beyond comparing all counts)."""
 
-    observation_detail: str = "summary"
+    observation_detail: str = "batch"
     sync_batch: int = 20000
     check_sample: int = 500
 
@@ -300,8 +305,15 @@ class KnowledgeBase:
         sessions = len(self.docs.sessions())
         if sessions:
             out["environment/Session"] = sessions
-        for layer, n in self.docs.link_counts_by_layer().items():
-            out[f"{layer}/wasDerivedFrom"] = n
+        if self.config.observation_detail == "batch":  # observations are summarised in batches
+            for layer in LAYERS:
+                out.pop(f"{layer}/Observation", None)
+            for layer, n in self.docs.batch_count(OBSERVATION_BATCH_S).items():
+                out[f"{layer}/ObservationBatch"] = n
+                out[f"{layer}/wasDerivedFrom"] = n
+        else:
+            for layer, n in self.docs.link_counts_by_layer().items():
+                out[f"{layer}/wasDerivedFrom"] = n
         return out
 
     def _compare_nodes(self, n: int) -> list[str]:
@@ -319,6 +331,26 @@ class KnowledgeBase:
             "FILTER(?p != prov:wasDerivedFrom) }"
         )
         actual = {(str(r["s"]), str(r["p"]), _value(r["o"]), str(r["g"])) for r in rows}
+        if detail == "batch":  # the batch nodes of the sampled instances, links included
+            instances = [d for d in docs if d["type"] == "instance"]
+            for d in instances:
+                layer = d.get("layer") or "foreground"
+                for session, window, count, first_s, last_s in self.docs.batches_of(
+                    d["uuid"], OBSERVATION_BATCH_S, -(1 << 62), 1 << 62
+                ):
+                    expected |= {(str(q.subject), str(q.predicate), _value(q.object), str(q.graph_name))
+                                 for q in batch_quads(self.kb_id, layer, d["uuid"], session, window, count,
+                                                      first_s, last_s)}
+            if instances:
+                subjects = " ".join(str(node(d["uuid"])) for d in instances)
+                rows = self.graph.query(
+                    f"SELECT ?i ?b ?p ?o ?g WHERE {{ VALUES ?i {{ {subjects} }} GRAPH ?g {{ "
+                    "?i prov:wasDerivedFrom ?b OPTIONAL { ?b ?p ?o } } }"
+                )
+                for r in rows:
+                    actual.add((str(r["i"]), f"<{WAS_DERIVED_FROM.value}>", _value(r["b"]), str(r["g"])))
+                    if "p" in r:
+                        actual.add((str(r["b"]), str(r["p"]), _value(r["o"]), str(r["g"])))
         if actual == expected:
             return []
         return [f"graph nodes differ from their documents: {len(expected - actual)} triples missing, "

@@ -54,6 +54,10 @@ class GraphBackend(Protocol):
         atomic (see ``begin_sync``)."""
         ...
 
+    def objects(self, subject: str, predicate: str) -> list[str]:
+        """The IRIs that ``subject predicate ?o`` points to, in any graph."""
+        ...
+
     def synced_seq(self, kb_id: str) -> int:
         """The high-water mark: the last document change the graph reflects (0 if none)."""
         ...
@@ -145,6 +149,10 @@ class LocalGraph:
         except SyntaxError as err:
             raise KnowledgeBaseError(f"{self.location}: a generated graph node does not parse ({err}); "
                                      "a document uuid is not a plain uuid? run 'hiper kb check'") from err
+
+    def objects(self, subject: str, predicate: str) -> list[str]:
+        found = self._store.quads_for_pattern(ox.NamedNode(subject), ox.NamedNode(predicate), None)
+        return [q.object.value for q in found if isinstance(q.object, ox.NamedNode)]
 
     def synced_seq(self, kb_id: str) -> int:
         return self.sync_state(kb_id)[0]
@@ -264,6 +272,10 @@ class SparqlGraph:
             quads = list(ox.parse(text.encode("utf-8"), format=ox.RdfFormat.N_QUADS))
             for k in range(0, len(quads), 20000):
                 self.write("", [], [], quads[k : k + 20000])
+
+    def objects(self, subject: str, predicate: str) -> list[str]:
+        rows = self.query(f"SELECT ?o WHERE {{ GRAPH ?g {{ <{subject}> <{predicate}> ?o }} }}")
+        return [r["o"].value for r in rows if isinstance(r.get("o"), ox.NamedNode)]
 
     def synced_seq(self, kb_id: str) -> int:
         return self.sync_state(kb_id)[0]

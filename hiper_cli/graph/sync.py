@@ -7,6 +7,8 @@ knowledge base's meta graph). ``sync_graph`` replays every document change after
 - a document first written after the mark has no node in the graph yet: its triples are only
   added; any other changed document has its node replaced (its triples removed, except the
   provenance links, then added again); deleted documents (tombstones) lose their node;
+- in the "batch" detail (the default) observations have no node: the nodes of the observation
+  batches that new links fall into are replaced, with counts over all their observations;
 - observations in the "summary" detail (the bulk of the data) and provenance links go in as
   N-Quads text through the store's bulk loader (~2x the rate of a transactional insert,
   measured), which is not atomic: the graph is marked dirty (``hiper:syncDirty``) before and
@@ -18,11 +20,16 @@ knowledge base's meta graph). ``sync_graph`` replays every document change after
 from __future__ import annotations
 
 import time
+from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from hiper_cli.graph.ontology import (
+    OBSERVATION_BATCH_S,
+    WAS_DERIVED_FROM,
+    batch_node,
+    batch_quads,
     doc_quads,
     link_nquads,
     node,
@@ -74,7 +81,9 @@ def sync_graph(
     else:
         graph.begin_sync(kb_id)
     fast = detail == "summary"
-    for chunk in docs.changed_docs(after, upto, batch, observation_bodies=not fast):
+    batched = detail == "batch"
+    chunks = docs.changed_docs(after, upto, batch, observation_bodies=not fast, observations=not batched)
+    for chunk in chunks:
         refresh: list[str] = []
         quads = []
         lines: list[str] = []
@@ -88,11 +97,16 @@ def sync_graph(
         graph.write(kb_id, refresh, [], quads)
         graph.append_nquads("".join(lines))
         report.documents += len(chunk)
-    for links in docs.changed_links(after, upto, batch):
-        graph.append_nquads("".join(link_nquads(kb_id, i, o, layer) for i, o, layer in links))
-        report.links += len(links)
+    if batched:
+        report.links = _sync_batches(docs, graph, kb_id, after, upto)
+    else:
+        for links in docs.changed_links(after, upto, batch):
+            graph.append_nquads("".join(link_nquads(kb_id, i, o, layer) for i, o, layer in links))
+            report.links += len(links)
     dead = [node(u).value for u, _, _ in docs.tombstones(after, upto)]
     if dead and after > 0:
+        if batched:  # an instance's batch nodes go with it
+            dead += [b for iri in dead for b in graph.objects(iri, WAS_DERIVED_FROM.value)]
         graph.write(kb_id, [], dead, [])
     report.deleted = len(dead)
     sessions = docs.sessions(after_seq=after, upto_seq=upto)
@@ -106,4 +120,31 @@ def sync_graph(
     graph.flush()
     report.seconds = time.perf_counter() - start
     return report
+
+
+def _sync_batches(docs: DocumentStore, graph: LocalGraph | SparqlGraph, kb_id: str, after: int,
+                  upto: int) -> int:
+    """Replace the nodes of the observation batches that links added in (after, upto] fall
+    into, with their counts and stamps over all their observations; the number of batches."""
+    windows: dict[str, list[int]] = defaultdict(list)
+    for instance_uuid, _session, window in docs.changed_batches(after, upto, OBSERVATION_BATCH_S):
+        windows[instance_uuid].append(window)
+    refresh: list[str] = []
+    quads = []
+    n = 0
+    for instance_uuid, ws in windows.items():
+        layer = docs.layer_of(instance_uuid) or "foreground"
+        for session, window, count, first_s, last_s in docs.batches_of(
+            instance_uuid, OBSERVATION_BATCH_S, min(ws), max(ws)
+        ):
+            if window not in ws:
+                continue
+            refresh.append(batch_node(instance_uuid, session, window).value)
+            quads += batch_quads(kb_id, layer, instance_uuid, session, window, count, first_s, last_s)
+            n += 1
+        if len(quads) >= 20000:
+            graph.write(kb_id, refresh, [], quads)
+            refresh, quads = [], []
+    graph.write(kb_id, refresh, [], quads)
+    return n
 
