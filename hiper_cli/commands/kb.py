@@ -101,8 +101,8 @@ def bench_command(
         bool, typer.Option("--no-instances", help="Observations only (no instance upsert per observation).")
     ] = False,
     detail: Annotated[
-        str, typer.Option("--detail", help="Observations in the graph: summary or full.")
-    ] = "summary",
+        str, typer.Option("--detail", help="Observations in the graph: batch, summary or full.")
+    ] = "batch",
     graph_sync_s: Annotated[
         float,
         typer.Option("--graph-sync-s", help="Graph sync interval during ingest (2 s); with --inline-graph "
