@@ -61,7 +61,7 @@ def sync_graph(
     kb_id: str,
     graphs: Sequence[Any],
     *,
-    detail: str = "summary",
+    detail: str = "batch",
     batch: int = 20000,
     rebuild: bool = False,
 ) -> SyncReport:
