@@ -23,7 +23,7 @@ def _default(value: Any) -> Any:
 _ORJSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY | orjson.OPT_NON_STR_KEYS
 
 
-def dumps(doc: dict[str, Any]) -> str:
+def dumps(doc: Any) -> str:
     """Compact JSON for a document; numpy arrays become lists. orjson (~10x the stdlib encoder
     on an observation), which writes NaN and infinities as null where the stdlib writes NaN and
     Infinity and reads them back: a body holding ``null`` is parsed back and compared with the

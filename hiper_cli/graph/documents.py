@@ -31,6 +31,8 @@ from typing import Any
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.graph.trajectories import SCHEMA as TRAJECTORIES_SCHEMA
+from hiper_cli.graph.trajectories import TrajectoryStore
 
 __all__ = ["SCHEMA_VERSION", "DocumentStore", "Session", "dumps"]
 
@@ -221,7 +223,7 @@ class DocumentStore(ChangeFeed):
                 # 4 KiB pages, another ~+6 % for 40,000 2 KiB pages at 100 k; memory stays bounded.
                 self._db.execute("PRAGMA cache_size=-32768")
                 self._db.execute("PRAGMA wal_autocheckpoint=40000")
-                self._db.executescript(_SCHEMA)
+                self._db.executescript(_SCHEMA + TRAJECTORIES_SCHEMA)
                 columns = {str(r[1]) for r in self._db.execute("PRAGMA table_info(docs)")}
                 if "created_seq" not in columns:  # a store written before it existed: NULL = old
                     self._db.execute("ALTER TABLE docs ADD COLUMN created_seq INTEGER")
@@ -254,6 +256,7 @@ class DocumentStore(ChangeFeed):
         # uuid -> the R*Tree row of a document's box as committed by this connection / pending
         self._boxes: dict[str, tuple[float, ...]] = {}
         self._pending_boxes: dict[str, tuple[float, ...]] = {}
+        self._traj = TrajectoryStore(self._db)
 
     def _migrate_grid(self, cell: str | None, legacy: bool) -> None:
         """Stores written before the (cell, id) keyed ``obs_cells`` table (1 m cells in
@@ -305,8 +308,10 @@ class DocumentStore(ChangeFeed):
         self._pending_link_counts.clear()
         self._boxes.update(self._pending_boxes)
         self._pending_boxes.clear()
+        self._traj.commit()
 
     def _forget_pending(self) -> None:
+        self._traj.rollback()
         self._pending_link_counts.clear()
         self._pending_boxes.clear()
         self._staged = -1
@@ -384,12 +389,15 @@ class DocumentStore(ChangeFeed):
         margin = 0.0
         cell_m = self._grid_cell_m
         obs_links = []
+        trajectories: list[tuple[str, list[Any] | None]] = []
         for doc, box_map in items:
             stamp = doc.get("stamp_s", doc.get("last_seen_s", doc.get("t_end_s")))
             stored = doc
             if doc["type"] == "instance":  # the observation list lives in ``links`` only
                 stored = {k: v for k, v in doc.items() if k != "observation_uuids"}
                 stored["observation_count"] = len(doc.get("observation_uuids", []))
+                stored, apart = self._traj.split(stored)  # long trajectories: see trajectories.py
+                trajectories.append((doc["uuid"], apart))
             rows.append((doc["uuid"], doc["type"], doc.get("layer"), doc.get("class"), stamp,
                          doc.get("instance_uuid"), session_id, env_uuid, seq, dumps(stored)))
             if box_map is not None:
@@ -447,6 +455,8 @@ class DocumentStore(ChangeFeed):
         for doc, _ in items:
             if doc["type"] == "instance":
                 self._link_instance(doc["uuid"], doc.get("observation_uuids", []), seq)
+        for uuid, apart in trajectories:
+            self._traj.write(uuid, apart)
         if self._scalar("SELECT EXISTS (SELECT 1 FROM tombstones)"):
             # a document written again after its deletion: no tombstone any more, and its
             # creation is unknown (the graph may still hold the node of its earlier life)
@@ -499,7 +509,7 @@ class DocumentStore(ChangeFeed):
 
     def _decode(self, body: str) -> dict[str, Any]:
         """A stored body as its ``to_dict`` form (instances get their observation list back,
-        oldest link first)."""
+        oldest link first, and a trajectory stored apart)."""
         doc: dict[str, Any] = loads(body)
         if doc.get("type") == "instance":
             doc.pop("observation_count", None)
@@ -510,6 +520,8 @@ class DocumentStore(ChangeFeed):
                     (doc["uuid"],),
                 )
             ]
+            if "trajectory_rows" in (doc.get("data") or {}):
+                TrajectoryStore.restore(doc, self._traj.read(doc["uuid"]))
         return doc
 
     def delete(self, uuid: str) -> bool:
@@ -522,6 +534,7 @@ class DocumentStore(ChangeFeed):
         self._db.execute("DELETE FROM docs_box WHERE id = ?", (row[0],))
         self._boxes.pop(uuid, None)
         self._pending_boxes.pop(uuid, None)
+        self._traj.delete(uuid)
         self._db.execute("DELETE FROM obs_cells WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM obs_cells_new WHERE id = ?", (row[0],))
         self._db.execute("DELETE FROM links WHERE instance_uuid = ?", (uuid,))

@@ -106,8 +106,13 @@ def _vec(values: Sequence[float]) -> ox.Literal:
 
 
 def speed_mps(doc: dict[str, Any]) -> float | None:
-    """Mean speed of an instance along ``data.trajectory`` rows [t, x, y, z, ...], if it has one."""
-    rows = (doc.get("data") or {}).get("trajectory") or []
+    """Mean speed of an instance along ``data.trajectory`` rows [t, x, y, z, ...], if it has one
+    (a document whose long trajectory is stored apart carries it as ``trajectory_speed_mps``)."""
+    data = doc.get("data") or {}
+    if "trajectory_speed_mps" in data and "trajectory" not in data:
+        speed = data["trajectory_speed_mps"]
+        return None if speed is None else float(speed)
+    rows = data.get("trajectory") or []
     if len(rows) < 2:
         return None
     dist = 0.0
