@@ -122,9 +122,16 @@ class ForegroundConfig:
     lost_max_s: float = 20.0
     """A track unseen for this long is closed even while out of view."""
     search_speed_mps: float = 0.6
-    """The gate of an unseen track widens by this much per second unseen ..."""
+    """The gate of an unseen track that was moving widens by this much per second unseen ..."""
     max_gate_m: float = 3.0
     """... up to this."""
+    moving_speed_mps: float = 0.3
+    """Only a track that was moving faster than this when last seen (filtered velocity and
+    displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
+    walk away, people walk at 0.5-1.4 m/s ..."""
+    moving_window_s: float = 1.0
+    min_moving_span_s: float = 0.5
+    """... and a track observed for less than this long is not known to move."""
     velocity_decay_s: float = 0.5
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
     velocity_decay_grace_s: float = 0.1

@@ -4,7 +4,10 @@
   between the tracks' predicted centres and the observed centres, with a gate: ``gate_m``, or
   the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
   analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
-  (up to ``max_gate_m``) so that a person who left the view is picked up again; a settled
+  (up to ``max_gate_m``) so that a person who left the view is picked up again; only a track
+  that was moving when last seen searches like that (a chair does not walk away while unseen:
+  a static track that widened its gate took a different object metres away when the robot
+  came back); a settled
   track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
   Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
   pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
@@ -153,6 +156,28 @@ def smooth_trajectory(track: Track) -> None:
         row[1:7] = x.tolist()
 
 
+def _was_moving(track: Track, config: ForegroundConfig) -> bool:
+    """Whether the track was moving when last updated: its filtered velocity then and its
+    filtered displacement over the last ``moving_window_s`` (at least ``min_moving_span_s`` of
+    history) both exceed ``moving_speed_mps``. Either alone is fooled: the velocity by noise,
+    the displacement by a blob that grew or lost a part; a track seen too briefly is not
+    known to move."""
+    rows = track.trajectory
+    if not rows or math.hypot(rows[-1][4], rows[-1][5]) <= config.moving_speed_mps:
+        return False
+    t_end = rows[-1][0]
+    start = rows[0]
+    for row in reversed(rows):
+        if t_end - row[0] >= config.moving_window_s:
+            start = row
+            break
+    span = t_end - start[0]
+    if span < config.min_moving_span_s:
+        return False
+    dx, dy = rows[-1][1] - start[1], rows[-1][2] - start[2]
+    return math.hypot(dx, dy) / span > config.moving_speed_mps
+
+
 def _compatible(track_class: str, meas_class: str) -> bool:
     return UNKNOWN in (track_class, meas_class) or track_class == meas_class
 
@@ -251,7 +276,7 @@ class Tracker:
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             return float(prior.cu_mps) * dt + cfg.gate_margin_m
-        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0)
+        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if _was_moving(track, cfg) else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
         P = np.asarray(track.kf.P, dtype=np.float64)[:3, :3]  # type: ignore[attr-defined]
