@@ -6,6 +6,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.foreground.classes import INDOOR_EXCLUDED
 
 __all__ = ["ForegroundConfig"]
 
@@ -26,6 +27,11 @@ class ForegroundConfig:
     """Detections below this score are ignored by the matching."""
     detector_threads: bool = True
     """Run the detector in a worker thread, concurrently with the point-cloud work."""
+    classes: tuple[str, ...] = ()
+    """Only these detector classes name blobs (empty: all); a per-environment class list."""
+    exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED
+    """Detector classes dropped before matching (the paper excluded classes not present, such as
+    boat and traffic light): outdoor COCO classes and ``dining table`` (tables are background)."""
 
     # --- segmentation (Algorithm 3) ---------------------------------------------------------
     background_filter: bool = True
@@ -107,7 +113,11 @@ class ForegroundConfig:
     min_gate_m (a chair does not take the bottle on the table beside it)."""
     min_class_observations: int = 2
     """A track takes a class only after at least this many observations of it (one confused
-    detection cannot name a track)."""
+    detection cannot name a track) ..."""
+    min_class_share: float = 0.6
+    """... and when that class holds at least this share of the track's (score-weighted)
+    known-class votes: a track whose detections keep swapping between two classes (a person
+    half of the time taken for a teddy bear) stays ``unknown`` instead of guessing."""
     class_mismatch_m: float = 0.5
     """Association cost added (inside the gate) when a track and an observation have
     different known classes: same-class pairs win, a confused detection still joins."""
@@ -125,6 +135,9 @@ class ForegroundConfig:
     """The gate of an unseen track that was moving widens by this much per second unseen ..."""
     max_gate_m: float = 3.0
     """... up to this."""
+    search_classes: tuple[str, ...] = ("person", "unknown")
+    """Classes whose lost tracks search (widen their gate while unseen) when they were moving:
+    the centre of a bed's or couch's blob slides as the view changes, which looks like motion."""
     moving_speed_mps: float = 0.3
     """Only a track that was moving faster than this when last seen (filtered velocity and
     displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
@@ -134,6 +147,9 @@ class ForegroundConfig:
     """... and a track observed for less than this long is not known to move."""
     velocity_decay_s: float = 0.5
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
+    velocity_prior_mps: float = 1.0
+    """While the velocity decays, its uncertainty relaxes towards this (walking speeds), so a
+    track picked up again learns its new velocity at once."""
     velocity_decay_grace_s: float = 0.1
     """No decay for this long after the last update (a missed detection must not slow a walker)."""
     accel_noise_mps2: float = 1.0
@@ -177,6 +193,11 @@ class ForegroundConfig:
             raise ConfigError(
                 f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
             )
+        for name in ("classes", "exclude_classes", "search_classes"):
+            value = getattr(self, name)
+            if isinstance(value, str):  # "a,b" from a command line
+                value = tuple(v.strip() for v in value.split(",") if v.strip())
+            object.__setattr__(self, name, tuple(str(v) for v in value))
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
 

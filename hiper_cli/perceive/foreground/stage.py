@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from hiper_cli.errors import PerceptionError
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
@@ -133,6 +134,7 @@ class ForegroundStage:
                 raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
         else:
             dets, detect_s = self._detect_timed(frame)
+        dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         t_det = time.perf_counter()
         if refine:
             usable = dets.xyxy[dets.scores >= cfg.min_detection_score] if len(dets) else np.zeros((0, 4))
