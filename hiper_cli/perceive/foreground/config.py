@@ -63,6 +63,11 @@ class ForegroundConfig:
     """A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
     fragment_distance_m: float = 0.3
     """... when its centre is this close to that cluster's box (grazing sides, heads)."""
+    support_gap_m: float = 0.1
+    """A blob whose base is at most the filter margin plus this above a floor or table top
+    stands on it: its box reaches down to the support (0.25 m, to catch chairs whose thin legs
+    lose their lowest samples, moved the centre away from what the sensor sees: worse on the
+    tuning logs)."""
     min_cluster_points: int = 15
     max_cluster_points: int = 8000
     max_cluster_extent_m: float = 3.0
