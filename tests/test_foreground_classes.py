@@ -18,7 +18,9 @@ def test_default_drops_outdoor_classes_and_tables_only():
     cfg = ForegroundConfig()
     assert {"fire hydrant", "boat", "traffic light", "dining table"} <= set(cfg.exclude_classes)
     assert not {"person", "chair", "couch", "bed", "bottle", "cup", "tv", "vase"} & set(INDOOR_EXCLUDED)
-    kept = filter_classes(dets("chair", "fire hydrant", "dining table", "person"), cfg.classes, cfg.exclude_classes)
+    kept = filter_classes(
+        dets("chair", "fire hydrant", "dining table", "person"), cfg.classes, cfg.exclude_classes
+    )
     assert kept.class_names == ("chair", "person") and kept.xyxy.shape == (2, 4) and len(kept.scores) == 2
 
 
