@@ -44,3 +44,22 @@ def test_stage_applies_the_lists_to_the_detections(options, expected):
     frame = make_frame([*room(), person(10, 3.0, 0.0)], pose_looking_x(), 0.0, 0)
     result = stage.process(frame, World(background=background_instances(room())))
     assert [o.class_name for o in result.observations] == [expected]
+
+
+def test_eval_reports_the_class_lists_it_applied(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+    from tests.fg_scene import write_sim_log
+
+    log = tmp_path / "log"
+    write_sim_log(log, seconds=1.0)
+    base = ["eval", "foreground", str(log), "--json", "--no-ablation", "--background", "truth",
+            "--set", "pixel_step=2"]
+    report = json.loads(CliRunner().invoke(app, [*base, "--exclude-classes", "person"]).output)
+    assert report["exclude_classes"] == ["person"] and report["classes"] == []
+    assert "person" not in report["ours"]["classification"]
+    report = json.loads(CliRunner().invoke(app, base).output)
+    assert "fire hydrant" in report["exclude_classes"] and "person" in report["ours"]["classification"]
