@@ -116,7 +116,7 @@ class ForegroundConfig:
     min_gate_m: float = 0.5
     """... and a settled track gates at gate_sigmas times its predicted position σ, at least
     min_gate_m (a chair does not take the bottle on the table beside it)."""
-    min_class_observations: int = 2
+    min_class_observations: int = 3
     """A track takes a class only after at least this many observations of it (one confused
     detection cannot name a track) ..."""
     min_class_share: float = 0.6
