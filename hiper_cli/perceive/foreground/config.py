@@ -53,6 +53,17 @@ class ForegroundConfig:
     table_leg_band_m: float = 0.0
     """Filter a band this wide under the edges of every background table top: its legs (0: off;
     needs accurate table boxes: with the background stage's table estimates it cut chairs)."""
+    table_leg_cell_m: float = 0.05
+    """Table legs leave the blobs (``legs.py``): points are binned horizontally in cells this
+    wide (0: off) ..."""
+    table_leg_reach_m: float = 0.1
+    """... near a background table (its footprint grown by this) ..."""
+    table_leg_min_height_m: float = 0.4
+    """... a cell whose points reach from this far below the table top ..."""
+    table_leg_top_band_m: float = 0.2
+    """... up to within this of the top ..."""
+    table_leg_above_m: float = 0.03
+    """... and no more than this above it is a leg."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04

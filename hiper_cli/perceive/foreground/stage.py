@@ -15,6 +15,7 @@ from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment, table_leg_boxes
@@ -125,6 +126,11 @@ class ForegroundStage:
             frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports,
             keep_fragments=cfg.detection_join,
         )
+        if cfg.background_filter:
+            tables = [inst.box for inst in world.background.values() if inst.class_name == "table"]
+            blobs = drop_table_legs(
+                blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
+            )
         t_seg = time.perf_counter()
         if future is not None:
             try:
