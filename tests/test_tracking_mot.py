@@ -193,3 +193,16 @@ def test_a_walker_picked_up_again_relearns_its_speed_at_once():
 
     assert speed_after_gap(1.0) == pytest.approx(0.6, abs=0.1)
     assert speed_after_gap(1e-3) < 0.45  # a decayed velocity that stays trusted: biased low
+
+
+def test_one_missed_frame_does_not_slow_a_track_at_4_hz():
+    rate = 4.0
+    tracker = Tracker(ForegroundConfig())
+    for k in range(12):
+        tracker.step(k / rate, [meas([1.0 + 0.6 * k / rate, 0, 0.9], k=k)])
+    (track,) = tracker.tracks
+    v0 = np.linalg.norm(track.velocity)
+    tracker.step(12 / rate, [])  # one missed frame (0.25 s, longer than velocity_decay_grace_s)
+    assert np.linalg.norm(track.velocity) == pytest.approx(v0, rel=1e-9)
+    tracker.step(13 / rate, [])  # the second one decays
+    assert np.linalg.norm(track.velocity) < v0 * 0.8

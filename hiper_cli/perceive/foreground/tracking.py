@@ -239,11 +239,16 @@ class Tracker:
         ``velocity_prior_mps``², so that a track picked up again learns its speed from the
         next observations at once instead of trusting the decayed (near zero) velocity.
         """
-        if stamp_s - track.last_update_s <= self.config.velocity_decay_grace_s or dt <= 0:
+        # The grace covers at least one missed frame at any frame rate (at 4 Hz one frame is
+        # 0.25 s, longer than the grace: every single miss decayed and unsettled the velocity).
+        grace = max(self.config.velocity_decay_grace_s, 1.5 * dt)
+        if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
         factor = math.exp(-dt / self.config.velocity_decay_s)
         kf = track.kf
         kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
+        if not _was_moving(track, self.config):
+            return  # a static track keeps its (small) velocity variance: nothing to relearn
         P = np.asarray(kf.P, dtype=np.float64).copy()  # type: ignore[attr-defined]
         P[:3, 3:] *= factor
         P[3:, :3] *= factor
