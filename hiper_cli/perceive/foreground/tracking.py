@@ -247,8 +247,6 @@ class Tracker:
         factor = math.exp(-dt / self.config.velocity_decay_s)
         kf = track.kf
         kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
-        if not _was_moving(track, self.config):
-            return  # a static track keeps its (small) velocity variance: nothing to relearn
         P = np.asarray(kf.P, dtype=np.float64).copy()  # type: ignore[attr-defined]
         P[:3, 3:] *= factor
         P[3:, :3] *= factor
