@@ -57,3 +57,24 @@ def test_boxes_behind_the_camera_are_skipped_and_cost_nothing():
     blobs, stats = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg + behind, cfg)
     blobs2, stats2 = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
     assert stats.after_background == stats2.after_background and len(blobs) == len(blobs2) == 1
+
+
+def test_background_filter_matches_inside_boxes_on_rotated_boxes():
+    from hiper_cli.perceive.foreground.segment import _filter_background, _rays
+
+    rng = np.random.default_rng(7)
+    step = 4
+    rx, ry, _, _ = _rays(CAMERA, step)
+    z = rng.uniform(0.5, 5.0, size=rx.shape)
+    T = pose_looking_x()
+    P_map = np.stack([rx * z, ry * z, z], axis=-1) @ T[:3, :3].T + T[:3, 3]
+    valid = rng.random(z.shape) > 0.1
+    boxes = []
+    for yaw in (0.0, 0.3, np.pi / 2, 1.0):
+        c, s = np.cos(yaw), np.sin(yaw)
+        R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        boxes.append(Box3D(rng.uniform([1.5, -1, 0.5], [4, 1, 1.5]), rng.uniform(0.3, 1.5, 3), R))
+    margin = np.full(z.shape, 0.05)
+    got = _filter_background(valid, P_map, margin, boxes, CAMERA, T, step, ForegroundConfig())
+    expected = valid & ~inside_boxes(P_map.reshape(-1, 3), boxes, 0.05).reshape(z.shape)
+    assert (got == expected).all() and (expected != valid).sum() > 20

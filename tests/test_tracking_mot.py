@@ -148,3 +148,61 @@ def test_one_confused_detection_does_not_name_a_track():
     tracker.step(2 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
     tracker.step(3 / RATE_HZ, [meas([1, 0, 0.5], "chair")])
     assert track.class_name == "chair"
+
+
+def test_two_classes_swapping_leave_a_track_unknown():
+    tracker = Tracker(ForegroundConfig(min_class_share=0.6))
+    for k in range(8):
+        tracker.step(k / RATE_HZ, [meas([1, 0, 0.9], "person" if k % 2 else "teddy bear", k=k)])
+    (track,) = tracker.tracks
+    assert track.class_name == "unknown"  # 50 % each: no class has the evidence
+    for k in range(8, 14):
+        tracker.step(k / RATE_HZ, [meas([1, 0, 0.9], "person", k=k)])
+    assert track.class_name == "person"  # 10 of 14 (71 %)
+    lenient = Tracker(ForegroundConfig(min_class_share=0.0))
+    for k in range(8):
+        lenient.step(k / RATE_HZ, [meas([1, 0, 0.9], "person" if k % 2 else "teddy bear", k=k)])
+    assert lenient.tracks[0].class_name != "unknown"
+
+
+def test_a_static_track_out_of_view_does_not_take_an_object_metres_away():
+    tracker = Tracker(ForegroundConfig())
+    for k in range(30):  # a chair seen for 1 s
+        tracker.step(k / RATE_HZ, [meas([2.0, 0.0, 0.45], "chair", k=k)])
+    (chair_track,) = tracker.tracks
+    for k in range(30, 150):  # 4 s out of view
+        tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
+    _, joined = tracker.step(150 / RATE_HZ, [meas([3.5, 0.5, 0.45], "chair", k=150)])
+    assert joined == [None] and chair_track in tracker.tracks  # a new track, the chair waits
+    _, joined = tracker.step(151 / RATE_HZ, [meas([2.05, 0.0, 0.45], "chair", k=151)])
+    assert joined == [chair_track.uuid]
+
+
+def test_a_walker_picked_up_again_relearns_its_speed_at_once():
+    def speed_after_gap(prior_mps):
+        cfg = ForegroundConfig(velocity_prior_mps=prior_mps)
+        tracker = Tracker(cfg)
+        for k in range(30):  # walks +x at 0.6 m/s
+            tracker.step(k / RATE_HZ, [meas([1.0 + 0.6 * k / RATE_HZ, 0, 0.9], k=k)])
+        for k in range(30, 90):  # 2 s out of view (keeps walking): the velocity decays
+            tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
+        for k in range(90, 96):  # seen again for 0.2 s
+            tracker.step(k / RATE_HZ, [meas([1.0 + 0.6 * k / RATE_HZ, 0, 0.9], k=k)])
+        (track,) = tracker.tracks
+        return float(np.linalg.norm(track.velocity[:2]))
+
+    assert speed_after_gap(1.0) == pytest.approx(0.6, abs=0.1)
+    assert speed_after_gap(1e-3) < 0.45  # a decayed velocity that stays trusted: biased low
+
+
+def test_one_missed_frame_does_not_slow_a_track_at_4_hz():
+    rate = 4.0
+    tracker = Tracker(ForegroundConfig())
+    for k in range(12):
+        tracker.step(k / rate, [meas([1.0 + 0.6 * k / rate, 0, 0.9], k=k)])
+    (track,) = tracker.tracks
+    v0 = np.linalg.norm(track.velocity)
+    tracker.step(12 / rate, [])  # one missed frame (0.25 s, longer than velocity_decay_grace_s)
+    assert np.linalg.norm(track.velocity) == pytest.approx(v0, rel=1e-9)
+    tracker.step(13 / rate, [])  # the second one decays
+    assert np.linalg.norm(track.velocity) < v0 * 0.8

@@ -27,6 +27,14 @@ def foreground(
         "auto", "--background", help="stage (hiper's background recognition), truth (ground-truth "
         "boxes) or auto (the stage when available)."
     ),
+    classes: str | None = typer.Option(
+        None, "--classes", help="Only these detector classes name objects, comma-separated (a per-"
+        "environment class list; default: all).",
+    ),
+    exclude_classes: str | None = typer.Option(
+        None, "--exclude-classes", help="Detector classes to drop, comma-separated (default: the "
+        "indoor exclusion list of docs/foreground.md; \"\" drops none).",
+    ),
     settings: list[str] = typer.Option(  # noqa: B008
         [], "--set", help="A foreground option KEY=VALUE (e.g. --set pixel_step=2); repeatable."
     ),
@@ -38,9 +46,14 @@ def foreground(
     """
     from hiper_cli.evaluate.foreground import evaluate_foreground
 
+    options = _parse_settings(settings)
+    if classes is not None:
+        options["classes"] = classes
+    if exclude_classes is not None:
+        options["exclude_classes"] = exclude_classes
     report = evaluate_foreground(
         log, detector=detector, background_filter=background_filter, ablation=ablation,
-        max_frames=max_frames or None, background=background, **_parse_settings(settings),
+        max_frames=max_frames or None, background=background, **options,
     )
     if json_out:
         print_json(report)
@@ -87,6 +100,10 @@ def _render(report: dict[str, Any]) -> None:
         f"Foreground, {report['world'] or report['log']} (seed {report['seed']}), "
         f"detector {report['detector']}, background: {report['background_source']}"
     )
+    if report.get("classes"):
+        title += f"; classes: {', '.join(report['classes'])}"
+    if report.get("exclude_classes"):
+        title += f"; {len(report['exclude_classes'])} classes excluded"
     table = Table(title=title)
     for name in ("metric", "ours", "paper house", "paper hospital", "paper office"):
         table.add_column(name)

@@ -52,6 +52,20 @@ def perceive_command(
     no_background_filter: Annotated[
         bool, typer.Option("--no-background-filter", help="Foreground: keep points of background instances.")
     ] = False,
+    classes: Annotated[
+        str | None,
+        typer.Option(
+            "--classes", help="Foreground: only these detector classes, comma-separated (default all)."
+        ),
+    ] = None,
+    exclude_classes: Annotated[
+        str | None,
+        typer.Option(
+            "--exclude-classes",
+            help="Foreground: detector classes to drop, comma-separated (default: outdoor COCO classes and "
+            "dining table; \"\" drops none).",
+        ),
+    ] = None,
     mapping_hz: Annotated[
         float | None, typer.Option("--mapping-hz", help="Background keyframe rate in Hz.")
     ] = None,
@@ -83,6 +97,10 @@ def perceive_command(
         options.setdefault("foreground", {})["detector"] = detector
     if no_background_filter:
         options.setdefault("foreground", {})["background_filter"] = False
+    if classes is not None:
+        options.setdefault("foreground", {})["classes"] = classes
+    if exclude_classes is not None:
+        options.setdefault("foreground", {})["exclude_classes"] = exclude_classes
     if mapping_hz is not None:
         options.setdefault("background", {})["keyframe_hz"] = mapping_hz
     names = None if stages is None else [s.strip() for s in stages.split(",") if s.strip()]

@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import Instance, Observation
+from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import FrameResult, Stage, World, make_stage
 from hiper_cli.sim.truth import Truth, load_truth
@@ -389,6 +390,7 @@ def evaluate_foreground(
     opts = {"detector": detector, "background_filter": background_filter, **options}
     dyn = float(options.get("dynamic_speed_mps", 0.15))
     main = _run(root, truth, opts, max_frames, background)
+    fg_config = ForegroundConfig.from_options(**opts)
     report: dict[str, Any] = {
         "log": str(root),
         "world": truth.world,
@@ -396,6 +398,8 @@ def evaluate_foreground(
         "detector": detector,
         "background_filter": background_filter,
         "background_source": main.background_source,
+        "classes": list(fg_config.classes),
+        "exclude_classes": list(fg_config.exclude_classes),
         "ours": _score(main, truth, dyn),
         "paper": PAPER_TABLE_III,
         "true_people_speed_mps": TRUE_PEOPLE_SPEED_MPS,

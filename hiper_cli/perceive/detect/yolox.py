@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -62,6 +63,7 @@ def find_yolox_model(
     )
 
 
+@lru_cache(maxsize=4)
 def _grids(size_hw: tuple[int, int]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Grid cell offsets (N, 2) and strides (N, 1) in the model's output order."""
     cells, strides = [], []
@@ -82,13 +84,18 @@ def decode_yolox(
     nms_iou: float,
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
     """Boxes (xyxy in original image pixels), class ids and scores from a raw YOLOX output."""
-    pred = np.asarray(output, dtype=np.float64).reshape(-1, output.shape[-1])
+    raw = np.asarray(output).reshape(-1, output.shape[-1])
     cells, strides = _grids(size_hw)
-    if len(cells) != len(pred):
+    if len(cells) != len(raw):
         raise ConfigError(
-            f"YOLOX output has {len(pred)} rows but a {size_hw[1]}x{size_hw[0]} input has "
+            f"YOLOX output has {len(raw)} rows but a {size_hw[1]}x{size_hw[0]} input has "
             f"{len(cells)} grid cells; is this a YOLOX model?"
         )
+    # score = objectness x class probability <= objectness: rows below the threshold cannot
+    # pass, so only the few others are decoded (most of the 3549 rows of a 416x416 input).
+    rows = np.flatnonzero(raw[:, 4] >= score_threshold)
+    pred = raw[rows].astype(np.float64)
+    cells, strides = cells[rows], strides[rows]
     cls_scores = pred[:, 5:]
     class_ids = np.argmax(cls_scores, axis=1)
     scores = pred[:, 4] * cls_scores[np.arange(len(pred)), class_ids]

@@ -6,6 +6,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.foreground.classes import INDOOR_EXCLUDED
 
 __all__ = ["ForegroundConfig"]
 
@@ -26,6 +27,11 @@ class ForegroundConfig:
     """Detections below this score are ignored by the matching."""
     detector_threads: bool = True
     """Run the detector in a worker thread, concurrently with the point-cloud work."""
+    classes: tuple[str, ...] = ()
+    """Only these detector classes name blobs (empty: all); a per-environment class list."""
+    exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED
+    """Detector classes dropped before matching (the paper excluded classes not present, such as
+    boat and traffic light): outdoor COCO classes and ``dining table`` (tables are background)."""
 
     # --- segmentation (Algorithm 3) ---------------------------------------------------------
     background_filter: bool = True
@@ -35,8 +41,10 @@ class ForegroundConfig:
     min_depth_m: float = 0.3
     max_depth_m: float = 5.0
     """The paper's point cloud range of 5 m."""
-    background_margin_m: float = 0.05
-    """Background boxes are grown by this much on every side before filtering ..."""
+    background_margin_m: float = 0.03
+    """Background boxes are grown by this much on every side before filtering (0.05 cut thin
+    parts that touch a wall or the floor, a bed's head board, from their objects; 0.02 let
+    more wall noise through as blobs) ..."""
     background_margin_per_m2: float = 0.005
     """... plus this times the squared depth (structured-light depth noise grows with z²)."""
     background_noise_along_ray: bool = True
@@ -47,6 +55,17 @@ class ForegroundConfig:
     table_leg_band_m: float = 0.0
     """Filter a band this wide under the edges of every background table top: its legs (0: off;
     needs accurate table boxes: with the background stage's table estimates it cut chairs)."""
+    table_leg_cell_m: float = 0.05
+    """Table legs leave the blobs (``legs.py``): points are binned horizontally in cells this
+    wide (0: off) ..."""
+    table_leg_reach_m: float = 0.1
+    """... near a background table (its footprint grown by this) ..."""
+    table_leg_min_height_m: float = 0.4
+    """... a cell whose points reach from this far below the table top ..."""
+    table_leg_top_band_m: float = 0.2
+    """... up to within this of the top ..."""
+    table_leg_above_m: float = 0.03
+    """... and no more than this above it is a leg."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04
@@ -57,6 +76,11 @@ class ForegroundConfig:
     """A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
     fragment_distance_m: float = 0.3
     """... when its centre is this close to that cluster's box (grazing sides, heads)."""
+    support_gap_m: float = 0.1
+    """A blob whose base is at most the filter margin plus this above a floor or table top
+    stands on it: its box reaches down to the support (0.25 m, to catch chairs whose thin legs
+    lose their lowest samples, moved the centre away from what the sensor sees: worse on the
+    tuning logs)."""
     min_cluster_points: int = 15
     max_cluster_points: int = 8000
     max_cluster_extent_m: float = 3.0
@@ -105,9 +129,13 @@ class ForegroundConfig:
     min_gate_m: float = 0.5
     """... and a settled track gates at gate_sigmas times its predicted position σ, at least
     min_gate_m (a chair does not take the bottle on the table beside it)."""
-    min_class_observations: int = 2
+    min_class_observations: int = 3
     """A track takes a class only after at least this many observations of it (one confused
-    detection cannot name a track)."""
+    detection cannot name a track) ..."""
+    min_class_share: float = 0.6
+    """... and when that class holds at least this share of the track's (score-weighted)
+    known-class votes: a track whose detections keep swapping between two classes (a person
+    half of the time taken for a teddy bear) stays ``unknown`` instead of guessing."""
     class_mismatch_m: float = 0.5
     """Association cost added (inside the gate) when a track and an observation have
     different known classes: same-class pairs win, a confused detection still joins."""
@@ -122,11 +150,24 @@ class ForegroundConfig:
     lost_max_s: float = 20.0
     """A track unseen for this long is closed even while out of view."""
     search_speed_mps: float = 0.6
-    """The gate of an unseen track widens by this much per second unseen ..."""
+    """The gate of an unseen track that was moving widens by this much per second unseen ..."""
     max_gate_m: float = 3.0
     """... up to this."""
+    search_classes: tuple[str, ...] = ("person", "unknown")
+    """Classes whose lost tracks search (widen their gate while unseen) when they were moving:
+    the centre of a bed's or couch's blob slides as the view changes, which looks like motion."""
+    moving_speed_mps: float = 0.3
+    """Only a track that was moving faster than this when last seen (filtered velocity and
+    displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
+    walk away, people walk at 0.5-1.4 m/s ..."""
+    moving_window_s: float = 1.0
+    min_moving_span_s: float = 0.5
+    """... and a track observed for less than this long is not known to move."""
     velocity_decay_s: float = 0.5
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
+    velocity_prior_mps: float = 1.0
+    """While the velocity decays, its uncertainty relaxes towards this (walking speeds), so a
+    track picked up again learns its new velocity at once."""
     velocity_decay_grace_s: float = 0.1
     """No decay for this long after the last update (a missed detection must not slow a walker)."""
     accel_noise_mps2: float = 1.0
@@ -170,6 +211,11 @@ class ForegroundConfig:
             raise ConfigError(
                 f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
             )
+        for name in ("classes", "exclude_classes", "search_classes"):
+            value = getattr(self, name)
+            if isinstance(value, str):  # "a,b" from a command line
+                value = tuple(v.strip() for v in value.split(",") if v.strip())
+            object.__setattr__(self, name, tuple(str(v) for v in value))
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
 

@@ -270,40 +270,57 @@ def _filter_background(
     noise moves a point along its viewing ray, so a floor seen at a grazing angle needs far less
     margin than a wall seen head-on), at least ``background_noise_min_cos`` of it.
     """
-    valid = valid.copy()
+    h, w = valid.shape
+    flat_valid = valid.ravel().copy()
     T_cam_map = np.asarray(np.linalg.inv(T_map_cam), dtype=np.float64)
     max_margin = float(margin.max()) if margin.size else 0.0
+    # Coordinates as contiguous columns: a box axis along a map axis (the usual case: walls,
+    # floors, tables) then costs one gather and one subtraction per candidate point.
+    cols_map = [np.ascontiguousarray(P_map[..., k].ravel()) for k in range(3)]
+    M = margin.ravel()
+    N: FloatArray | None = None
+    ray_cols: list[FloatArray] = []
     if noise is not None and noise.size:
         max_margin += float(noise.max())
-        rays = P_map - T_map_cam[:3, 3]
+        N = noise.ravel()
+        rays = P_map.reshape(-1, 3) - T_map_cam[:3, 3]
         rays /= np.maximum(np.linalg.norm(rays, axis=-1, keepdims=True), 1e-9)
-    for box in boxes:
-        roi = _box_roi(box, max_margin, camera, T_cam_map, step, valid.shape, config)
+        ray_cols = [np.ascontiguousarray(rays[:, k]) for k in range(3)]
+
+    def along(columns: list[FloatArray], idx: NDArray[np.int64], direction: FloatArray) -> FloatArray:
+        main = int(np.argmax(np.abs(direction)))
+        if abs(direction[main]) > 1.0 - 1e-9:
+            return np.asarray(columns[main][idx] * np.sign(direction[main]), dtype=np.float64)
+        out = np.zeros(len(idx))
+        for k in range(3):
+            if direction[k] != 0.0:
+                out += columns[k][idx] * direction[k]
+        return out
+
+    # Largest boxes first (floor, walls): they remove most points, the others test fewer.
+    for box in sorted(boxes, key=lambda b: -b.volume_m3):
+        roi = _box_roi(box, max_margin, camera, T_cam_map, step, (h, w), config)
         if roi is None:
             continue
-        block = valid[roi]
-        cand = np.flatnonzero(block)
-        if len(cand) == 0:
+        rows, cols = roi
+        local_idx = np.flatnonzero(flat_valid.reshape(h, w)[rows, cols])
+        if len(local_idx) == 0:
             continue
-        pts = P_map[roi].reshape(-1, 3)
-        m = margin[roi].ravel()
-        if noise is not None:
-            n_roi, r_roi = noise[roi].ravel(), rays[roi].reshape(-1, 3)
+        width = cols.stop - cols.start
+        cand = (local_idx // width + rows.start) * w + local_idx % width + cols.start
         # Thinnest axis first (walls, floors): few points survive it, the others test fewer.
         for axis in np.argsort(box.extent_m):
-            d = (pts[cand] - box.center_m) @ box.R[:, axis]
-            m_c = m[cand]
-            if noise is not None:
-                cos = np.maximum(np.abs(r_roi[cand] @ box.R[:, axis]), config.background_noise_min_cos)
-                m_c = m_c + n_roi[cand] * cos
-            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= m_c]
+            direction = box.R[:, axis]
+            d = along(cols_map, cand, direction) - float(box.center_m @ direction)
+            allowed = M[cand]
+            if N is not None:
+                cos = np.maximum(np.abs(along(ray_cols, cand, direction)), config.background_noise_min_cos)
+                allowed = allowed + N[cand] * cos
+            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= allowed]
             if len(cand) == 0:
                 break
-        if len(cand):
-            flat = block.ravel()
-            flat[cand] = False
-            valid[roi] = flat.reshape(block.shape)
-    return valid
+        flat_valid[cand] = False
+    return flat_valid.reshape(h, w)
 
 
 def table_leg_boxes(top: Box3D, band_m: float, height_m: float = 1.2) -> list[Box3D]:
@@ -333,7 +350,9 @@ def table_leg_boxes(top: Box3D, band_m: float, height_m: float = 1.2) -> list[Bo
 
 
 def support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
-    """Top height of the support the blob stands on, if its base is within the filter margin."""
+    """Top height of the support the blob stands on, if its base is within the filter margin
+    plus ``support_gap_m`` above it (thin legs and feet lose their lowest samples to the margin
+    and to the subsampling)."""
     lo = blob.points_map.min(axis=0)
     hi = blob.points_map.max(axis=0)
     depth = float(np.median(blob.points_cam[:, 2]))
@@ -344,7 +363,7 @@ def support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfi
         if b_lo[0] > hi[0] or b_hi[0] < lo[0] or b_lo[1] > hi[1] or b_hi[1] < lo[1]:
             continue  # not under the blob
         top = float(b_hi[2])
-        if 0.0 <= lo[2] - top <= margin + config.cluster_tolerance_m and (best is None or top > best):
+        if 0.0 <= lo[2] - top <= margin + config.support_gap_m and (best is None or top > best):
             best = top
     return best
 

@@ -13,7 +13,9 @@ from numpy.typing import NDArray
 from hiper_cli.errors import PerceptionError
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment, table_leg_boxes
@@ -124,6 +126,11 @@ class ForegroundStage:
             frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports,
             keep_fragments=cfg.detection_join,
         )
+        if cfg.background_filter:
+            tables = [inst.box for inst in world.background.values() if inst.class_name == "table"]
+            blobs = drop_table_legs(
+                blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
+            )
         t_seg = time.perf_counter()
         if future is not None:
             try:
@@ -133,6 +140,7 @@ class ForegroundStage:
                 raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
         else:
             dets, detect_s = self._detect_timed(frame)
+        dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         t_det = time.perf_counter()
         if refine:
             usable = dets.xyxy[dets.scores >= cfg.min_detection_score] if len(dets) else np.zeros((0, 4))

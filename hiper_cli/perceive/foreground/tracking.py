@@ -4,7 +4,11 @@
   between the tracks' predicted centres and the observed centres, with a gate: ``gate_m``, or
   the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
   analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
-  (up to ``max_gate_m``) so that a person who left the view is picked up again; a settled
+  (up to ``max_gate_m``) so that a person who left the view is picked up again; only a track
+  of a class in ``search_classes`` (people, and ``unknown``) that was moving when last seen
+  searches like that (a chair or a bed does not walk away while unseen:
+  a static track that widened its gate took a different object metres away when the robot
+  came back); a settled
   track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
   Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
   pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
@@ -79,6 +83,7 @@ class Track:
     class_votes: dict[str, float] = field(default_factory=dict)
     class_counts: dict[str, int] = field(default_factory=dict)
     min_class_observations: int = 1
+    min_class_share: float = 0.0
     score_sum: float = 0.0
     observation_uuids: list[str] = field(default_factory=list)
     trajectory: list[list[float]] = field(default_factory=list)
@@ -96,14 +101,19 @@ class Track:
 
     @property
     def class_name(self) -> str:
-        """The vote winner among classes seen at least ``min_class_observations`` times."""
-        eligible = [
-            k for k in sorted(self.class_votes)
-            if k == UNKNOWN or self.class_counts.get(k, 0) >= self.min_class_observations
-        ]
+        """The vote winner among the known classes seen at least ``min_class_observations``
+        times, when it holds at least ``min_class_share`` of all known-class votes (two
+        classes that keep swapping leave the track ``unknown``) and outweighs ``unknown``."""
+        known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
+        eligible = [k for k in sorted(known) if self.class_counts.get(k, 0) >= self.min_class_observations]
         if not eligible:
             return UNKNOWN
-        return max(eligible, key=lambda k: self.class_votes[k])
+        best = max(eligible, key=lambda k: known[k])
+        if known[best] < self.min_class_share * sum(known.values()):
+            return UNKNOWN
+        if self.class_votes.get(UNKNOWN, 0.0) > known[best]:
+            return UNKNOWN
+        return best
 
     @property
     def confidence(self) -> float:
@@ -153,6 +163,28 @@ def smooth_trajectory(track: Track) -> None:
         row[1:7] = x.tolist()
 
 
+def _was_moving(track: Track, config: ForegroundConfig) -> bool:
+    """Whether the track was moving when last updated: its filtered velocity then and its
+    filtered displacement over the last ``moving_window_s`` (at least ``min_moving_span_s`` of
+    history) both exceed ``moving_speed_mps``. Either alone is fooled: the velocity by noise,
+    the displacement by a blob that grew or lost a part; a track seen too briefly is not
+    known to move."""
+    rows = track.trajectory
+    if not rows or math.hypot(rows[-1][4], rows[-1][5]) <= config.moving_speed_mps:
+        return False
+    t_end = rows[-1][0]
+    start = rows[0]
+    for row in reversed(rows):
+        if t_end - row[0] >= config.moving_window_s:
+            start = row
+            break
+    span = t_end - start[0]
+    if span < config.min_moving_span_s:
+        return False
+    dx, dy = rows[-1][1] - start[1], rows[-1][2] - start[2]
+    return math.hypot(dx, dy) / span > config.moving_speed_mps
+
+
 def _compatible(track_class: str, meas_class: str) -> bool:
     return UNKNOWN in (track_class, meas_class) or track_class == meas_class
 
@@ -200,11 +232,29 @@ class Tracker:
         track.last_time_s = stamp_s
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
-        """Shrink the velocity of a track that got no update (after a grace of two frames)."""
-        if stamp_s - track.last_update_s <= self.config.velocity_decay_grace_s or dt <= 0:
+        """Shrink the velocity of a track that got no update (after a grace of two frames).
+
+        The decay is a mean-reverting (Ornstein-Uhlenbeck) velocity: the estimate shrinks by
+        a = exp(-dt / velocity_decay_s) and its variance relaxes towards the prior
+        ``velocity_prior_mps``², so that a track picked up again learns its speed from the
+        next observations at once instead of trusting the decayed (near zero) velocity.
+        """
+        # The grace covers at least one missed frame at any frame rate (at 4 Hz one frame is
+        # 0.25 s, longer than the grace: every single miss decayed and unsettled the velocity).
+        grace = max(self.config.velocity_decay_grace_s, 1.5 * dt)
+        if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
         factor = math.exp(-dt / self.config.velocity_decay_s)
-        track.kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
+        kf = track.kf
+        kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
+        P = np.asarray(kf.P, dtype=np.float64).copy()  # type: ignore[attr-defined]
+        P[:3, 3:] *= factor
+        P[3:, :3] *= factor
+        prior = self.config.velocity_prior_mps**2
+        ratio = self.config.vertical_noise_ratio**2
+        P[3:, 3:] *= factor**2
+        P[3:, 3:] += (1.0 - factor**2) * np.diag([prior, prior, prior * ratio])
+        kf.P = P  # type: ignore[attr-defined]
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
         kf = track.kf
@@ -251,7 +301,8 @@ class Tracker:
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             return float(prior.cu_mps) * dt + cfg.gate_margin_m
-        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0)
+        searching = track.class_name in cfg.search_classes and _was_moving(track, cfg)
+        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
         P = np.asarray(track.kf.P, dtype=np.float64)[:3, :3]  # type: ignore[attr-defined]
@@ -347,6 +398,7 @@ class Tracker:
             extent_m=np.asarray(m.extent_map, dtype=np.float64).copy(),
             first_center=np.asarray(m.center_map, dtype=np.float64).copy(),
             min_class_observations=self.config.min_class_observations,
+            min_class_share=self.config.min_class_share,
         )
         self._vote(track, m)
         track.confirmed = self.config.confirm_hits <= 1

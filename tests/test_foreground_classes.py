@@ -1,0 +1,65 @@
+"""Which detector classes name blobs: the indoor exclusion list, per-environment allow-lists."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.perceive.foreground import ForegroundConfig, ForegroundStage
+from hiper_cli.perceive.foreground.classes import INDOOR_EXCLUDED, filter_classes
+from hiper_cli.perceive.stage import World
+from hiper_cli.types import Detections
+from tests.fg_scene import background_instances, make_frame, person, pose_looking_x, room
+
+
+def dets(*names):
+    return Detections(np.tile([0.0, 0.0, 10.0, 10.0], (len(names), 1)), names, np.full(len(names), 0.9))
+
+
+def test_default_drops_outdoor_classes_and_tables_only():
+    cfg = ForegroundConfig()
+    assert {"fire hydrant", "boat", "traffic light", "dining table"} <= set(cfg.exclude_classes)
+    assert not {"person", "chair", "couch", "bed", "bottle", "cup", "tv", "vase"} & set(INDOOR_EXCLUDED)
+    kept = filter_classes(
+        dets("chair", "fire hydrant", "dining table", "person"), cfg.classes, cfg.exclude_classes
+    )
+    assert kept.class_names == ("chair", "person") and kept.xyxy.shape == (2, 4) and len(kept.scores) == 2
+
+
+def test_allow_list_and_empty_lists():
+    d = dets("chair", "bed", "person")
+    assert filter_classes(d, ("person", "chair")).class_names == ("chair", "person")
+    assert filter_classes(d) is d  # nothing to filter: unchanged
+    assert len(filter_classes(d, exclude=("chair", "bed", "person"))) == 0
+
+
+def test_command_line_lists_are_split_on_commas():
+    cfg = ForegroundConfig.from_options(classes="person, chair", exclude_classes="")
+    assert cfg.classes == ("person", "chair") and cfg.exclude_classes == ()
+    assert ForegroundConfig.from_options(classes=["cup"]).classes == ("cup",)
+
+
+@pytest.mark.parametrize(("options", "expected"), [({}, "person"), ({"exclude_classes": "person"}, "unknown"),
+                                                  ({"classes": "chair,bed"}, "unknown")])
+def test_stage_applies_the_lists_to_the_detections(options, expected):
+    stage = ForegroundStage(detector="log", pixel_step=2, **options)
+    frame = make_frame([*room(), person(10, 3.0, 0.0)], pose_looking_x(), 0.0, 0)
+    result = stage.process(frame, World(background=background_instances(room())))
+    assert [o.class_name for o in result.observations] == [expected]
+
+
+def test_eval_reports_the_class_lists_it_applied(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+    from tests.fg_scene import write_sim_log
+
+    log = tmp_path / "log"
+    write_sim_log(log, seconds=1.0)
+    base = ["eval", "foreground", str(log), "--json", "--no-ablation", "--background", "truth",
+            "--set", "pixel_step=2"]
+    report = json.loads(CliRunner().invoke(app, [*base, "--exclude-classes", "person"]).output)
+    assert report["exclude_classes"] == ["person"] and report["classes"] == []
+    assert "person" not in report["ours"]["classification"]
+    report = json.loads(CliRunner().invoke(app, base).output)
+    assert "fire hydrant" in report["exclude_classes"] and "person" in report["ours"]["classification"]

@@ -1,0 +1,26 @@
+"""Golden Table III numbers on the committed fixture log: a foreground regression fails loudly.
+
+fixtures/house_small (house, seed 4, 4 Hz, 256x192, one person), truth detector, ground-truth
+background boxes (so that a change of the background stage does not move these numbers).
+Main before branch fg3 gave TP 5 (a potted plant named from 2 observations, now below
+``min_class_observations``), FP 0, localisation 0.0328 m.
+"""
+
+from pathlib import Path
+
+import pytest
+
+from hiper_cli.evaluate.foreground import evaluate_foreground
+
+FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "house_small"
+
+
+def test_golden_table_iii_on_the_fixture():
+    report = evaluate_foreground(FIXTURE, detector="truth", ablation=False, background="truth")
+    ours = report["ours"]
+    assert ours["classification"] == {"chair": {"tp": 3, "fp": 0}, "person": {"tp": 1, "fp": 0}}
+    assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (3, 7, 98)
+    assert ours["identity_switches"] == 0 and ours["truth_instances_seen"] == 7
+    assert ours["localisation_classified_m"][0] == pytest.approx(0.0282, abs=0.003)
+    assert ours["localisation_visible_median_m"] == pytest.approx(0.0237, abs=0.003)
+    assert ours["localisation_box_centre_m"][0] == pytest.approx(0.265, abs=0.05)
