@@ -115,10 +115,11 @@ def speed_mps(doc: dict[str, Any]) -> float | None:
     rows = data.get("trajectory") or []
     if len(rows) < 2:
         return None
-    dist = 0.0
-    for a, b in itertools.pairwise(rows):
-        dist += math.dist(a[1:4], b[1:4])
-    dt = float(rows[-1][0]) - float(rows[0][0])
+    try:
+        dist = sum(math.dist(a[1:4], b[1:4]) for a, b in itertools.pairwise(rows))
+        dt = float(rows[-1][0]) - float(rows[0][0])
+    except (TypeError, ValueError, IndexError):  # not [t, x, y, z, ...] rows: no speed
+        return None
     return dist / dt if dt > 0 else None
 
 

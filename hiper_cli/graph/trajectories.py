@@ -34,10 +34,14 @@ CREATE TABLE IF NOT EXISTS trajectories (
 
 
 def _speed_mps(rows: list[Any]) -> float | None:
-    """Mean speed along the rows (path length over duration), as ``ontology.speed_mps``."""
-    xyz = np.asarray([r[1:4] for r in rows], dtype=np.float64)
-    dt = float(rows[-1][0]) - float(rows[0][0])
-    if len(rows) < 2 or dt <= 0:
+    """Mean speed along the rows (path length over duration), as ``ontology.speed_mps``; None
+    for rows that are not [t, x, y, z, ...] numbers."""
+    try:
+        xyz = np.asarray([r[1:4] for r in rows], dtype=np.float64)
+        dt = float(rows[-1][0]) - float(rows[0][0])
+    except (TypeError, ValueError, IndexError):
+        return None
+    if len(rows) < 2 or dt <= 0 or xyz.shape != (len(rows), 3):
         return None
     return float(np.linalg.norm(np.diff(xyz, axis=0), axis=1).sum() / dt)
 
