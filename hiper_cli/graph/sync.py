@@ -10,7 +10,7 @@ knowledge base's meta graph). ``sync_graph`` replays every document change after
 - in the "batch" detail (the default) observations have no node: the nodes of the observation
   batches that new links fall into are replaced, with counts over all their observations;
 - observations in the "summary" detail (the bulk of the data) and provenance links go in as
-  N-Quads text through the store's bulk loader (~2x the rate of a transactional insert,
+  N-Quads text through the store's bulk loader (~3x the rate of a transactional insert,
   measured), which is not atomic: the graph is marked dirty (``hiper:syncDirty``) before and
   clean with the new mark after, and a sync that finds it dirty replaces every node it replays,
   so an interrupted sync is repaired by the next one (``open_kb`` runs one);
