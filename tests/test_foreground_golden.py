@@ -3,7 +3,8 @@
 fixtures/house_small (house, seed 4, 4 Hz, 256x192, one person), truth detector, ground-truth
 background boxes (so that a change of the background stage does not move these numbers).
 Main before branch fg3 gave TP 5 (a potted plant named from 2 observations, now below
-``min_class_observations``), FP 0, localisation 0.0328 m.
+``min_class_observations``), FP 0, localisation 0.0328 m; fg3 0.0282 m (median 0.0237 m).
+Trimming that keeps what a jittered box cut at the blob's depth: 0.0262 m (median 0.0187 m).
 """
 
 from pathlib import Path
@@ -21,6 +22,6 @@ def test_golden_table_iii_on_the_fixture():
     assert ours["classification"] == {"chair": {"tp": 3, "fp": 0}, "person": {"tp": 1, "fp": 0}}
     assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (3, 7, 98)
     assert ours["identity_switches"] == 0 and ours["truth_instances_seen"] == 7
-    assert ours["localisation_classified_m"][0] == pytest.approx(0.0282, abs=0.003)
-    assert ours["localisation_visible_median_m"] == pytest.approx(0.0237, abs=0.003)
+    assert ours["localisation_classified_m"][0] == pytest.approx(0.0262, abs=0.003)
+    assert ours["localisation_visible_median_m"] == pytest.approx(0.0187, abs=0.003)
     assert ours["localisation_box_centre_m"][0] == pytest.approx(0.265, abs=0.05)

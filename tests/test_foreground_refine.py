@@ -139,3 +139,33 @@ def test_a_leg_beside_a_chair_is_trimmed_to_the_chair_detection():
     assert len(trimmed.points_cam) == int(np.sum(ids[blob.pixels_uv[:, 1], blob.pixels_uv[:, 0]] == 11))
     (kept,) = _refine([blob], chair_box, ForegroundConfig(pixel_step=2, trim_iou=1.0))  # off
     assert len(kept.points_cam) == len(blob.points_cam)
+
+
+def test_a_detection_box_jittered_smaller_does_not_cut_the_head_off():
+    boxes = [*room(), person(10, 3.0, 0.0)]
+    cfg = ForegroundConfig(pixel_step=2)
+    frame, (blob,) = _segment(boxes, cfg)
+    x0, y0, x1, y1 = frame.detections.xyxy[0]
+    short = [[x0, y0 + 0.05 * (y1 - y0), x1, y1]]  # the top edge 5 % of the height too low
+    (kept,) = _refine([blob], short, cfg)
+    assert len(kept.points_cam) == len(blob.points_cam)
+    (cut,) = _refine([blob], short, ForegroundConfig(pixel_step=2, trim_margin_frac=0.0))
+    assert len(cut.points_cam) < len(blob.points_cam)
+    assert kept.points_map[:, 2].max() - cut.points_map[:, 2].max() > 0.05
+
+
+def test_a_pole_behind_the_chair_just_outside_its_box_is_trimmed():
+    # beside the chair, 0.35 m behind it
+    pole = SceneBox(12, np.array([3.6, 0.45, 0.4]), np.array([0.05, 0.05, 0.8]), "leg")
+    boxes = [*room(), chair(11, 3.0, 0.0), pole]
+    cfg = ForegroundConfig(pixel_step=2, cluster_tolerance_m=0.8)  # one cluster with the pole
+    frame, (blob,) = _segment(boxes, cfg)
+    ids = frame.extras["ids"]
+    assert np.any(ids[blob.pixels_uv[:, 1], blob.pixels_uv[:, 0]] == 12)
+    ys, xs = np.nonzero(ids == 11)
+    (trimmed,) = _refine([blob], [[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]], cfg)
+    assert not np.any(ids[trimmed.pixels_uv[:, 1], trimmed.pixels_uv[:, 0]] == 12)
+    # without the depth test the grown box would keep it
+    (kept,) = _refine([blob], [[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]],
+                      ForegroundConfig(pixel_step=2, cluster_tolerance_m=0.8, trim_depth_m=1.0))
+    assert np.any(ids[kept.pixels_uv[:, 1], kept.pixels_uv[:, 0]] == 12)

@@ -132,3 +132,21 @@ def test_every_option_is_documented():
     doc = (Path(__file__).resolve().parents[1] / "docs" / "foreground.md").read_text()
     missing = [f.name for f in fields(ForegroundConfig) if f"`{f.name}`" not in doc]
     assert not missing, f"docs/foreground.md does not mention {missing}"
+
+
+def test_objects_rest_on_the_fitted_floor_plane_not_on_the_top_of_its_box():
+    from hiper_cli.model import Box3D, Instance
+    from hiper_cli.perceive.foreground.stage import support_boxes
+
+    # The background stage's floor box is 2 cm thick around its plane (the points' noise).
+    floor_box = Box3D(np.array([2.0, 0.0, 0.0]), np.array([4.0, 4.0, 0.02]))
+    floor = Instance("background", "floor", floor_box, 0.0, 0.0)
+    floor.data["plane_map"] = [0.0, 0.0, 1.0, 0.004]  # z = -0.004 m
+    wall_box = Box3D(np.array([4.0, 0.0, 1.0]), np.array([0.02, 4.0, 2.0]))
+    wall = Instance("background", "wall", wall_box, 0.0, 0.0)
+    (box,) = support_boxes([floor, wall])
+    lo, hi = box.aabb()
+    assert hi[2] == pytest.approx(-0.004) and lo[2] == pytest.approx(-0.01)
+    floor.data.pop("plane_map")  # no plane: the box as it is
+    (box,) = support_boxes([floor])
+    assert box.aabb()[1][2] == pytest.approx(0.01)

@@ -119,7 +119,7 @@ def _split(
 
 
 def _trim(
-    blob: Blob, boxes: FloatArray, grown: FloatArray, config: ForegroundConfig
+    blob: Blob, boxes: FloatArray, grown: FloatArray, step_pad: FloatArray, config: ForegroundConfig
 ) -> NDArray[np.int64] | None:
     """The points of ``blob`` inside the (grown) box of the detection it overlaps best, when
     that IoU reaches ``trim_iou`` and the points outside are at most ``trim_max_share``."""
@@ -129,7 +129,12 @@ def _trim(
     k = int(np.argmax(iou))
     if iou[k] < config.trim_iou:
         return None
-    inside = _inside(blob.pixels_uv, grown[k : k + 1])[:, 0]
+    inside = _inside(blob.pixels_uv, boxes[k : k + 1] + step_pad)[:, 0]
+    near = _inside(blob.pixels_uv, grown[k : k + 1])[:, 0] & ~inside
+    if near.any() and inside.any():
+        # Just outside the box at the depth of what is inside: the box was jittered smaller.
+        z = blob.points_cam[:, 2]
+        inside |= near & (np.abs(z - float(np.median(z[inside]))) <= config.trim_depth_m)
     n_out = int((~inside).sum())
     if n_out == 0 or n_out > config.trim_max_share * len(inside):
         return None
@@ -204,10 +209,13 @@ def refine_blobs(
     pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
     grown = boxes + pad
     if config.trim_iou < 1.0:
+        sign = np.array([-1.0, -1.0, 1.0, 1.0])
+        trim_pad = np.tile(size * config.trim_margin_frac + step, 2) * sign
+        step_pad = step * sign
         for i, blob in enumerate(out):
             if blob.fragment:
                 continue
-            keep = _trim(blob, boxes, grown, config)
+            keep = _trim(blob, boxes, boxes + trim_pad, step_pad, config)
             if keep is not None:
                 out[i] = _sub_blob(blob, keep, step, width, height)
                 changed[i] = True

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -27,6 +28,30 @@ __all__ = ["ForegroundStage"]
 
 FloatArray = NDArray[np.float64]
 SUPPORT_CLASSES = ("floor", "table")
+
+
+def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
+    """The floors and table tops objects stand on, map frame: axis-aligned, their top at the
+    fitted plane's height (``data["plane_map"]``) where there is one. The box of a plane
+    instance is thicker than the plane by the depth noise of its points; an object's base
+    rests on the plane itself."""
+    out: list[Box3D] = []
+    for inst in background:
+        if inst.class_name not in SUPPORT_CLASSES:
+            continue
+        lo, hi = inst.box.aabb()
+        plane = inst.data.get("plane_map")
+        if plane is not None and len(plane) == 4 and abs(float(plane[2])) > 0.9:
+            a, b, c, d = (float(v) for v in plane)
+            cx, cy = (lo[:2] + hi[:2]) / 2.0
+            top = -(a * cx + b * cy + d) / c
+            if lo[2] - 0.05 <= top <= hi[2]:
+                hi = hi.copy()
+                hi[2] = top
+                lo = lo.copy()
+                lo[2] = min(lo[2], top)
+        out.append(Box3D((lo + hi) / 2.0, hi - lo))
+    return out
 
 
 class ForegroundStage:
@@ -114,9 +139,7 @@ class ForegroundStage:
             future = self._pool.submit(self._detect_timed, frame)
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
-        supports = [
-            inst.box for inst in world.background.values() if inst.class_name in SUPPORT_CLASSES
-        ]
+        supports = support_boxes(world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
             for inst in world.background.values():
                 if inst.class_name == "table":
