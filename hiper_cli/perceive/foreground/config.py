@@ -41,10 +41,11 @@ class ForegroundConfig:
     min_depth_m: float = 0.3
     max_depth_m: float = 5.0
     """The paper's point cloud range of 5 m."""
-    background_margin_m: float = 0.03
+    background_margin_m: float = 0.02
     """Background boxes are grown by this much on every side before filtering (0.05 cut thin
-    parts that touch a wall or the floor, a bed's head board, from their objects; 0.02 let
-    more wall noise through as blobs) ..."""
+    parts that touch a wall or the floor, a bed's head board, from their objects; 0.015 let
+    more wall noise through as blobs: false positives and identity switches on the tuning
+    logs) ..."""
     background_margin_per_m2: float = 0.005
     """... plus this times the squared depth (structured-light depth noise grows with z²)."""
     background_noise_along_ray: bool = True
