@@ -434,7 +434,7 @@ def _hospital(seed: int) -> World:
             "bed",
             "foreground",
             fu.bed(2.0, 1.0, (0.8, 0.8, 0.82), B.color((0.6, 0.75, 0.85)), (0.95, 0.95, 0.95)),
-            x0 + room_w - 1.05,
+            x0 + room_w - 1.05 - WALL_THICKNESS_M / 2,  # head board against the wall's face
             cw + band / 2,
             180.0,
         )

@@ -154,7 +154,12 @@ def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundC
 def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
     from scipy.spatial import cKDTree
 
-    if abs(float(np.median(a.points_cam[:, 2])) - float(np.median(b.points_cam[:, 2]))) > config.join_depth_m:
+    # Depth ranges (10th to 90th percentile), not medians: a chair's back legs lie 0.4 m
+    # behind the middle of its front.
+    za, zb = a.points_cam[:, 2], b.points_cam[:, 2]
+    a_lo, a_hi = np.percentile(za, [10, 90])
+    b_lo, b_hi = np.percentile(zb, [10, 90])
+    if max(a_lo - b_hi, b_lo - a_hi) > config.join_depth_m:
         return False
     small, large = (a, b) if len(a.points_cam) <= len(b.points_cam) else (b, a)
     dist, _ = cKDTree(large.points_cam).query(small.points_cam, distance_upper_bound=config.join_gap_m)
