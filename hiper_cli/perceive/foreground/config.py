@@ -67,6 +67,18 @@ class ForegroundConfig:
     """... up to within this of the top ..."""
     table_leg_above_m: float = 0.03
     """... and no more than this above it is a leg."""
+    unseen_table_min_side_m: float = 0.4
+    """A table the background layer has not mapped yet (its top seen at a grazing angle in the
+    first seconds) merges the chairs around it into one blob. When such a blob overlaps a
+    detection (IoU >= ``trim_iou``) and holds a horizontal slab between
+    ``unseen_table_min_height_m`` and ``unseen_table_max_height_m`` whose footprint spans this
+    much along both map axes, the slab and its legs leave the blob and the rest is clustered
+    again (``legs.py``, ``refine.py``; 0: off) ..."""
+    unseen_table_min_height_m: float = 0.6
+    unseen_table_max_height_m: float = 1.2
+    unseen_table_skip_classes: tuple[str, ...] = ("couch", "bed", "bench", "dining table", "toilet")
+    """... except in blobs matched to these detector classes: furniture with tops of its own (a
+    couch's arms and back are such a slab)."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04
@@ -220,7 +232,7 @@ class ForegroundConfig:
             raise ConfigError(
                 f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
             )
-        for name in ("classes", "exclude_classes", "search_classes"):
+        for name in ("classes", "exclude_classes", "search_classes", "unseen_table_skip_classes"):
             value = getattr(self, name)
             if isinstance(value, str):  # "a,b" from a command line
                 value = tuple(v.strip() for v in value.split(",") if v.strip())

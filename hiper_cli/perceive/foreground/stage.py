@@ -20,6 +20,7 @@ from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment, table_leg_boxes
+from hiper_cli.perceive.foreground.tables import drop_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
@@ -165,8 +166,12 @@ class ForegroundStage:
             dets, detect_s = self._detect_timed(frame)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         t_det = time.perf_counter()
+        ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
+        usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
+        if cfg.background_filter:
+            names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
+            blobs = drop_unseen_tables(blobs, usable, names, cfg, frame.camera.width, frame.camera.height)
         if refine:
-            usable = dets.xyxy[dets.scores >= cfg.min_detection_score] if len(dets) else np.zeros((0, 4))
             blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports)
         t_refine = time.perf_counter()
         matches = assign_classes(

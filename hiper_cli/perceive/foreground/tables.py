@@ -1,0 +1,199 @@
+"""Tables the foreground finds before the background layer has mapped them.
+
+In the first seconds of a log the background stage may not know a table yet (its top is seen
+at a grazing angle, a band of pixels too thin for its plane cells); the Euclidean clustering
+then joins the chairs around it, the table and what stands on it into one blob, whose centre
+is 0.1-0.5 m off each chair's. ``drop_unseen_tables`` finds such a table in a blob that a
+detection names (not furniture with tops of its own: ``unseen_table_skip_classes``): a
+horizontal slab at table height whose footprint spans ``unseen_table_min_side_m`` along both
+map axes. The slab and the legs under it (``legs.leg_points``) leave the blob, and what
+remains is clustered again as the segmentation does. Once the background layer maps the
+table, its filter removes the top and ``legs.py`` the legs before this step.
+
+Each frame decides anew. Remembering a table found once and removing it from every blob that
+reached it later was tried: on the tuning logs it cut chair backs that cross the top's height
+and doubled the identity switches.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.legs import leg_points
+from hiper_cli.perceive.foreground.match import iou_matrix
+from hiper_cli.perceive.foreground.segment import Blob
+
+__all__ = ["drop_unseen_tables", "grid_components", "table_points", "unseen_table_top"]
+
+FloatArray = NDArray[np.float64]
+SLAB_BIN_M = 0.02  # height bins of the search for a table top
+TOP_THICKNESS_M = 0.04
+
+
+def _column_tops(points_map: FloatArray, cell_m: float) -> FloatArray:
+    """For each point (N, 3), the highest point of its horizontal cell (``cell_m`` wide)."""
+    keys = np.floor(points_map[:, :2] / cell_m).astype(np.int64)
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    tops = np.full(int(inverse.max()) + 1, -np.inf)
+    np.maximum.at(tops, inverse, points_map[:, 2])
+    return np.asarray(tops[inverse])
+
+
+def unseen_table_top(points_map: FloatArray, config: ForegroundConfig) -> Box3D | None:
+    """The top of a table the background layer has not mapped yet, if the points (N, 3) of a
+    blob hold one: the most populated horizontal slab between ``unseen_table_min_height_m``
+    and ``unseen_table_max_height_m``, of the columns (``table_leg_cell_m`` cells) that end
+    there (a person or a chair's back beside the table rises above it), whose footprint spans
+    ``unseen_table_min_side_m`` along its minor axis. Its box, 4 cm thick, top at the slab's
+    middle."""
+    if len(points_map) < config.min_cluster_points:
+        return None
+    z = points_map[:, 2]
+    reach = 2 * SLAB_BIN_M + config.table_leg_above_m
+    ending = _column_tops(points_map, config.table_leg_cell_m) <= z + reach
+    sel = np.flatnonzero(
+        (z >= config.unseen_table_min_height_m) & (z <= config.unseen_table_max_height_m) & ending
+    )
+    if len(sel) < config.min_cluster_points:
+        return None
+    bins = np.floor(z[sel] / SLAB_BIN_M).astype(np.int64)
+    mode = (int(np.argmax(np.bincount(bins - bins.min()))) + int(bins.min()) + 0.5) * SLAB_BIN_M
+    slab = sel[np.abs(z[sel] - mode) <= SLAB_BIN_M]
+    if len(slab) < config.min_cluster_points:
+        return None
+    if _minor_extent_m(points_map[slab, :2]) < config.unseen_table_min_side_m:
+        return None
+    lo = np.percentile(points_map[slab, :2], 5, axis=0)
+    hi = np.percentile(points_map[slab, :2], 95, axis=0)
+    top = float(np.median(z[slab]))
+    return Box3D(
+        np.array([(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, top - TOP_THICKNESS_M / 2.0]),
+        np.array([hi[0] - lo[0], hi[1] - lo[1], TOP_THICKNESS_M]),
+    )
+
+
+def _minor_extent_m(points_xy: FloatArray) -> float:
+    """The width (5th to 95th percentile) of horizontal points along their minor principal
+    axis: a table top is wide both ways, a chair's back or a shelf board is not."""
+    centred = points_xy - points_xy.mean(axis=0)
+    _, vectors = np.linalg.eigh(centred.T @ centred)
+    along = centred @ vectors[:, 0]  # eigh sorts ascending: the minor axis first
+    return float(np.percentile(along, 95) - np.percentile(along, 5))
+
+
+def table_points(points_map: FloatArray, top: Box3D, config: ForegroundConfig) -> NDArray[np.bool_]:
+    """Which points (N, 3) are the table's top (within its footprint grown by
+    ``table_leg_reach_m``, two slab bins of its top height, in columns that end there) or its
+    legs (``leg_points``)."""
+    lo, hi = top.aabb()
+    reach = 2 * SLAB_BIN_M + config.table_leg_above_m
+    ending = _column_tops(points_map, config.table_leg_cell_m) <= hi[2] + reach
+    on_top = (
+        np.all(points_map[:, :2] >= lo[:2] - config.table_leg_reach_m, axis=1)
+        & np.all(points_map[:, :2] <= hi[:2] + config.table_leg_reach_m, axis=1)
+        & (np.abs(points_map[:, 2] - hi[2]) <= 2 * SLAB_BIN_M) & ending
+    )
+    return np.asarray(on_top | leg_points(points_map, [top], config))
+
+
+def grid_components(
+    blob: Blob, sel: NDArray[np.int64], step: int, config: ForegroundConfig
+) -> list[NDArray[np.int64]]:
+    """The connected parts of the points ``sel`` of ``blob`` (indices into ``sel``), linked
+    as the segmentation links points: neighbours on the sampling grid (8-neighbourhood plus
+    straight jumps of up to ``cluster_neighbour_cells``) closer than the cluster tolerance."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(sel)
+    if n == 0:
+        return []
+    grid = (blob.pixels_uv[sel] // step).astype(np.int64)
+    grid -= grid.min(axis=0)
+    width, height = int(grid[:, 0].max()) + 1, int(grid[:, 1].max()) + 1
+    index = np.full((height, width), -1, dtype=np.int64)
+    index[grid[:, 1], grid[:, 0]] = np.arange(n)
+    pts = blob.points_cam[sel]
+    tol = config.cluster_tolerance_m + config.cluster_tolerance_per_m * pts[:, 2]
+    cells = config.cluster_neighbour_cells
+    offsets = [(0, 1), (1, -1), (1, 0), (1, 1)] + [(0, k) for k in range(2, cells + 1)]
+    offsets += [(k, 0) for k in range(2, cells + 1)]
+    rows, cols = [], []
+    for dy, dx in offsets:
+        ny, nx = grid[:, 1] + dy, grid[:, 0] + dx
+        src = np.flatnonzero((ny < height) & (nx >= 0) & (nx < width))
+        nb = index[ny[src], nx[src]]
+        src, nb = src[nb >= 0], nb[nb >= 0]
+        close = np.linalg.norm(pts[src] - pts[nb], axis=1) <= tol[src]
+        rows.append(src[close])
+        cols.append(nb[close])
+    r, c = np.concatenate(rows), np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    return [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
+
+
+
+def _sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:
+    uv = blob.pixels_uv[sel]
+    half = step / 2.0
+    box = np.array(
+        [
+            max(0.0, uv[:, 0].min() - half),
+            max(0.0, uv[:, 1].min() - half),
+            min(float(width), uv[:, 0].max() + half),
+            min(float(height), uv[:, 1].max() + half),
+        ]
+    )
+    return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box, blob.support_z_m, blob.fragment)
+
+
+def drop_unseen_tables(
+    blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: ForegroundConfig,
+    width: int, height: int,
+) -> list[Blob]:
+    """``blobs`` without the tops and legs of tables found in them (see the module docstring);
+    ``boxes_xyxy`` (K, 4) and ``classes`` are this frame's detections."""
+    if config.unseen_table_min_side_m <= 0 or not blobs:
+        return blobs
+    boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
+    if len(boxes) == 0:
+        return blobs
+    out: list[Blob] = []
+    for blob in blobs:
+        top = None
+        if not blob.fragment:
+            iou = iou_matrix(blob.image_box_xyxy.reshape(1, 4), boxes)[0]
+            k = int(np.argmax(iou))
+            if iou[k] >= config.trim_iou and classes[k] not in config.unseen_table_skip_classes:
+                top = unseen_table_top(blob.points_map, config)
+        if top is None:
+            out.append(blob)
+            continue
+        rest = np.flatnonzero(~table_points(blob.points_map, top, config))
+        for part in grid_components(blob, rest, config.pixel_step, config):
+            if len(part) >= config.min_cluster_points:
+                out.append(_part(blob, rest[part], top, config, width, height))
+    return out
+
+
+def _part(
+    blob: Blob, sel: NDArray[np.int64], top: Box3D, config: ForegroundConfig, width: int, height: int
+) -> Blob:
+    """A part of ``blob`` as a blob of its own, standing on the floor below the blob (as the
+    segmentation found it), on the table top, or on nothing known."""
+    part = _sub_blob(blob, sel, config.pixel_step, width, height)
+    base = float(part.points_map[:, 2].min())
+    depth = float(np.median(part.points_cam[:, 2]))
+    reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    part.support_z_m = None
+    for support in (blob.support_z_m, float(top.aabb()[1][2])):
+        if support is not None and 0.0 <= base - support <= reach + config.support_gap_m:
+            part.support_z_m = support
+    return part
