@@ -169,3 +169,26 @@ def test_a_pole_behind_the_chair_just_outside_its_box_is_trimmed():
     (kept,) = _refine([blob], [[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]],
                       ForegroundConfig(pixel_step=2, cluster_tolerance_m=0.8, trim_depth_m=1.0))
     assert np.any(ids[kept.pixels_uv[:, 1], kept.pixels_uv[:, 0]] == 12)
+
+
+def _synthetic_blob(depths_m, u0, v0):
+    """A blob of points at these depths, one pixel column per point starting at (u0, v0)."""
+    from hiper_cli.perceive.foreground.segment import Blob
+
+    z = np.asarray(depths_m, dtype=np.float64)
+    uv = np.stack([np.full(len(z), u0), v0 + 2 * np.arange(len(z))], axis=1).astype(np.int32)
+    x = (uv[:, 0] - CAMERA.cx) * z / CAMERA.fx
+    pts = np.stack([x, (uv[:, 1] - CAMERA.cy) * z / CAMERA.fy, z], axis=1)
+    box = np.array([uv[:, 0].min() - 1.0, uv[:, 1].min() - 1.0, uv[:, 0].max() + 1.0, uv[:, 1].max() + 1.0])
+    return Blob(pts, pts.copy(), uv, box)
+
+
+def test_a_chair_back_leg_deeper_than_the_chair_median_joins_it():
+    cfg = ForegroundConfig(pixel_step=2, trim_iou=1.0)
+    front = _synthetic_blob(np.linspace(2.5, 2.9, 30), 80, 20)  # seat and back: 2.5-2.9 m deep
+    leg = _synthetic_blob(np.full(20, 3.0), 81, 80)  # a back leg 0.4 m behind the front's median
+    box = [[70.0, 10.0, 95.0, 125.0]]
+    (joined,) = _refine([front, leg], box, cfg)
+    assert len(joined.points_cam) == 50
+    far = _synthetic_blob(np.full(20, 3.3), 81, 80)  # 0.4 m behind the deepest point: apart
+    assert len(_refine([front, far], box, ForegroundConfig(pixel_step=2, trim_iou=1.0, join_gap_m=1.0))) == 2
