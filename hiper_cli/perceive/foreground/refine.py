@@ -7,9 +7,11 @@ middle. The detector sees those cases from the image; this step uses its boxes b
 IoU matching of Algorithm 4:
 
 0. **Trim**: a blob whose image box overlaps a detection box with IoU at least ``trim_iou``
-   loses the points outside that box (grown by ``detection_margin_frac`` of its size and one
-   sample step), when they are at most ``trim_max_share`` of it: a table leg or a wall corner
-   that the clustering attached to a chair.
+   loses the points outside that box (grown by one sample step), when they are at most
+   ``trim_max_share`` of it: a table leg or a wall corner that the clustering attached to a
+   chair. Points within ``trim_margin_frac`` of the box's size outside it stay when their
+   depth is within ``trim_depth_m`` of the median depth of the points inside: a box jittered
+   smaller cut the head of a person or the top of a chair's back.
 1. **Split**: a blob whose pixels fall into two or more detection boxes (each holding at least
    ``min_cluster_points`` of them) is divided. Every point goes to the smallest box it lies in
    (the specific object in front of a larger one); a point inside several boxes then goes to
