@@ -5,9 +5,11 @@ at a grazing angle, a band of pixels too thin for its plane cells); the Euclidea
 then joins the chairs around it, the table and what stands on it into one blob, whose centre
 is 0.1-0.5 m off each chair's. ``drop_unseen_tables`` finds such a table in a blob that a
 detection names (not furniture with tops of its own: ``unseen_table_skip_classes``): a
-horizontal slab at table height whose footprint spans ``unseen_table_min_side_m`` along both
-map axes. The slab and the legs under it (``legs.leg_points``) leave the blob, and what
-remains is clustered again as the segmentation does. Once the background layer maps the
+horizontal slab at table height, of columns that end there (a person or a chair's back beside
+the table rises above it), whose footprint spans ``unseen_table_min_side_m`` along its minor
+axis (a chair's back or a shelf board is narrow). The slab and the legs under it
+(``legs.leg_points``) leave the blob, and what remains is clustered again as the segmentation
+does; parts smaller than ``min_cluster_points`` are dropped. Once the background layer maps the
 table, its filter removes the top and ``legs.py`` the legs before this step.
 
 Each frame decides anew. Remembering a table found once and removing it from every blob that
