@@ -206,3 +206,40 @@ def test_one_missed_frame_does_not_slow_a_track_at_4_hz():
     assert np.linalg.norm(track.velocity) == pytest.approx(v0, rel=1e-9)
     tracker.step(13 / rate, [])  # the second one decays
     assert np.linalg.norm(track.velocity) < v0 * 0.8
+
+
+def _walker_ending_in_a_fragment(cfg):
+    """A person at 0.9 m/s along +y for 1 s; the last two blobs are a fragment left behind at the
+    image border (small extent, centre 0.2 m behind). Returns the closed track's speeds."""
+    rng = np.random.default_rng(5)
+    tracker = Tracker(cfg)
+    for k in range(32):
+        t = k / RATE_HZ
+        center, extent = np.array([3.0, 0.9 * t, 0.9]) + rng.normal(0, 0.01, 3), np.array([0.5, 0.3, 1.7])
+        if k >= 30:
+            center, extent = np.array([3.0, 0.9 * 29 / RATE_HZ - 0.2, 0.8]), np.array([0.1, 0.05, 0.3])
+        tracker.step(t, [Measurement(center, extent, "person", 0.9, f"o{k}")])
+    (track,) = tracker.close_all()
+    assert len(track.trajectory) == 32  # the fragment joined the track
+    rows = np.array(track.trajectory)
+    return np.hypot(rows[:, 4], rows[:, 5])
+
+
+def test_a_fragment_at_the_end_of_a_walk_does_not_slow_the_track():
+    speeds = _walker_ending_in_a_fragment(ForegroundConfig())
+    assert speeds.min() > 0.8 and abs(speeds.mean() - 0.9) < 0.05
+    # without the extent-dependent measurement noise the smoother spreads the fragment back
+    plain = _walker_ending_in_a_fragment(ForegroundConfig(extent_change_noise=0.0))
+    assert plain[-3:].max() < 0.6
+
+
+def test_extent_noise_only_for_the_listed_classes():
+    cfg = ForegroundConfig()
+    tracker = Tracker(cfg)
+    full, frag = np.array([0.5, 0.3, 1.7]), np.array([0.1, 0.05, 0.3])
+    for cls, expect_inflated in (("person", True), ("chair", False)):
+        tracker.step(0.0, [Measurement(np.zeros(3), full, cls, 0.9, "a")])
+        (track,) = tracker.tracks
+        R = tracker._measurement_noise(track, Measurement(np.zeros(3), frag, cls, 0.9, "b"))
+        assert (R[0, 0] > 10 * cfg.measurement_noise_m**2) == expect_inflated
+        tracker.tracks = []

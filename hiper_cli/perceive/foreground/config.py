@@ -191,13 +191,21 @@ class ForegroundConfig:
     velocity_decay_grace_s: float = 0.1
     """No decay for this long after the last update (a missed detection must not slow a walker)."""
     accel_noise_mps2: float = 1.0
-    """Process noise: standard deviation of the white acceleration of the constant-velocity model."""
+    """Process noise: standard deviation of the white acceleration of the constant-velocity model ..."""
+    walker_accel_noise_mps2: float = 1.0
+    """... and for tracks of a class in ``walker_classes`` (people start, stop and turn sharply)."""
     vertical_noise_ratio: float = 0.3
     """Vertical process noise relative to horizontal (objects mostly move on the floor)."""
     prior_accel_time_s: float = 0.5
     """With a learned speed spread sigma, the acceleration noise is sigma / this time."""
     measurement_noise_m: float = 0.03
     """Measurement noise: standard deviation of an observed centre."""
+    extent_change_noise: float = 0.5
+    """An observed centre's standard deviation grows by this times how much the blob's extent
+    differs from the track's (horizontal diagonal; height): a partly seen or merged blob's
+    centre is off by up to half the difference (0: off) ..."""
+    walker_classes: tuple[str, ...] = ("person",)
+    """... for tracks or blobs of these classes (a static object's extent changes with the view)."""
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
@@ -232,7 +240,7 @@ class ForegroundConfig:
             raise ConfigError(
                 f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
             )
-        for name in ("classes", "exclude_classes", "search_classes", "unseen_table_skip_classes"):
+        for name in ("classes", "exclude_classes", "search_classes", "unseen_table_skip_classes", "walker_classes"):
             value = getattr(self, name)
             if isinstance(value, str):  # "a,b" from a command line
                 value = tuple(v.strip() for v in value.split(",") if v.strip())
