@@ -12,8 +12,12 @@
   track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
   Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
   pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
+  A track of a walker class (``walker_classes``) does not take a blob smaller than
+  ``walker_min_size_ratio`` of the largest blob it took (a junk blob, a cup or a border fragment
+  is not the person: such rows collapsed the person's speed).
 - Filter: a constant-velocity Kalman filter (filterpy) over position and velocity with white
-  acceleration noise (class-specific from the learned ``sigma_mps`` when known). A track's
+  acceleration noise (class-specific from the learned ``sigma_mps`` when known, else
+  ``walker_accel_noise_mps2`` for walkers and ``accel_noise_mps2`` for the rest). A track's
   velocity is initialised from its first two observations (the paper started at zero, which
   biased the speeds low) with the matching covariance.
 - Unseen tracks: their velocity decays exponentially to zero (time constant
@@ -74,6 +78,7 @@ class Track:
     last_update_s: float
     last_time_s: float
     extent_m: FloatArray
+    max_size_m: float = 0.0  # the largest blob seen (``_size_m``: footprint diagonal or height)
     hits: int = 1
     unseen_in_view_s: float = 0.0
     confirmed: bool = False
@@ -185,6 +190,11 @@ def _was_moving(track: Track, config: ForegroundConfig) -> bool:
     return math.hypot(dx, dy) / span > config.moving_speed_mps
 
 
+def _size_m(extent_m: FloatArray) -> float:
+    """How big a box is: the larger of its footprint diagonal and its height."""
+    return max(math.hypot(float(extent_m[0]), float(extent_m[1])), float(extent_m[2]))
+
+
 def _compatible(track_class: str, meas_class: str) -> bool:
     return UNKNOWN in (track_class, meas_class) or track_class == meas_class
 
@@ -260,7 +270,6 @@ class Tracker:
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
         kf = track.kf
-        R = self._measurement_noise(track, m)
         if not track.velocity_initialised and track.hits == 1:
             dt = stamp_s - track.last_update_s
             if dt > 1e-6:
@@ -268,17 +277,16 @@ class Tracker:
                 v = (m.center_map - track.first_center) / dt
                 r = self.config.measurement_noise_m**2
                 kf.x = np.r_[m.center_map, v].reshape(6, 1)  # type: ignore[attr-defined]
-                var_z = np.diag(R)
-                var_v = (r + var_z) / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
-                kf.P = np.diag(np.r_[var_z, var_v])  # type: ignore[attr-defined]
+                var_v = 2.0 * r / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
+                kf.P = np.diag([r, r, r, var_v, var_v, var_v])  # type: ignore[attr-defined]
                 track.velocity_initialised = True
                 if track.trajectory:  # the first row gets the velocity it could not know yet
                     track.trajectory[0][4:7] = v.tolist()
                     track.covariances[0] = np.array(kf.P, dtype=np.float64)  # type: ignore[attr-defined]
             else:
-                kf.update(m.center_map.reshape(3, 1), R=R)  # type: ignore[attr-defined]
+                kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
         else:
-            kf.update(m.center_map.reshape(3, 1), R=R)  # type: ignore[attr-defined]
+            kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
@@ -287,35 +295,12 @@ class Tracker:
         if not track.confirmed and track.hits >= self.config.confirm_hits:
             track.confirmed = True
 
-    def _measurement_noise(self, track: Track, m: Measurement) -> FloatArray:
-        """R of one observed centre: ``measurement_noise_m``² plus, for a track or blob of a
-        class in ``walker_classes``, per direction the square of ``extent_change_noise``
-        times how much the blob's extent differs from the track's (horizontally the footprint
-        diagonal, vertically the height).
-
-        A blob that shows only part of its object (cut by the image border, half hidden, a
-        fragment) or more than it (merged with a neighbour) has its centre off by up to half
-        the difference; such a centre must not pull the velocity (a border-cut walker's blob
-        centre lags the walker; a 26-point fragment at the end of a track slowed it from 0.9
-        to 0.4 m/s). Only for movers: the extents of chairs and bottles change with the view
-        and their tracks, given that freedom, swapped identities more often (house 901: 79 → 89).
-        """
-        cfg = self.config
-        r = cfg.measurement_noise_m**2
-        classes = cfg.walker_classes
-        if cfg.extent_change_noise <= 0 or (track.class_name not in classes and m.class_name not in classes):
-            return np.eye(3) * r
-        ext_t, ext_m = track.extent_m, np.asarray(m.extent_map, dtype=np.float64)
-        d_h = abs(math.hypot(ext_t[0], ext_t[1]) - math.hypot(ext_m[0], ext_m[1]))
-        d_v = abs(float(ext_t[2] - ext_m[2]))
-        k2 = cfg.extent_change_noise**2
-        return np.diag([r + k2 * d_h**2, r + k2 * d_h**2, r + k2 * d_v**2])
-
     def _vote(self, track: Track, m: Measurement) -> None:
         weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, 1e-3)
         track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
         track.score_sum += m.score
+        track.max_size_m = max(track.max_size_m, _size_m(m.extent_map))
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
         q = self._accel_noise(track.class_name) ** 2
@@ -349,11 +334,14 @@ class Tracker:
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         gates = np.array([self._gate(t, stamp_s) for t in self.tracks])
         allowed = cost <= gates[:, None]
+        walkers, min_ratio = self.config.walker_classes, self.config.walker_min_size_ratio
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             for j, m in enumerate(measurements):
                 if not _compatible(cls, m.class_name):
                     cost[i, j] += self.config.class_mismatch_m
+                if cls in walkers and _size_m(m.extent_map) < min_ratio * t.max_size_m:
+                    allowed[i, j] = False
         big = 1e6
         rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
         return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
