@@ -262,3 +262,50 @@ def test_a_sharply_turning_walker_keeps_its_speed():
 
     assert mean_speed(ForegroundConfig()) == pytest.approx(0.9, abs=0.1)
     assert mean_speed(ForegroundConfig(walker_accel_noise_mps2=1.0)) < mean_speed(ForegroundConfig()) - 0.03
+
+
+def _lost_person_track(cfg):
+    """A person walking +x at 0.8 m/s for 1 s, then 1 s out of view: its gate has widened."""
+    tracker = Tracker(cfg)
+    for k in range(30):
+        tracker.step(k / RATE_HZ, [meas([1.0 + 0.8 * k / RATE_HZ, 0, 0.9], k=k)])
+    for k in range(30, 60):
+        tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
+    (track,) = tracker.tracks
+    assert track.class_name == "person"
+    tracker._predict(track, 2.0)
+    return tracker, track
+
+
+def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate():
+    tracker, track = _lost_person_track(ForegroundConfig())
+    far = track.position + np.array([1.2, 0.5, 0.0])  # 1.3 m from the prediction
+    base, widened = tracker._gate(track, 2.0)
+    assert base < 1.3 < widened  # beyond the normal gate, inside the widened one
+    chair = Measurement(far, np.array([0.45, 0.45, 0.8]), "unknown", 0.0, "c")
+    _, joined = tracker.step(2.0, [chair])
+    assert joined == [None]  # an unmatched chair-sized blob there is not the person
+    tracker, track = _lost_person_track(ForegroundConfig())
+    _, joined = tracker.step(2.0, [meas(far, "person", k=60)])
+    assert joined == [track.uuid]
+    tracker, track = _lost_person_track(ForegroundConfig())
+    _, joined = tracker.step(2.0, [meas(far, "unknown", k=60)])
+    assert joined == [track.uuid]  # unmatched but person-sized: the person coming back
+    tracker, track = _lost_person_track(ForegroundConfig(search_same_class=()))
+    _, joined = tracker.step(2.0, [chair])
+    assert joined == [track.uuid]
+
+
+def test_one_missed_frame_at_4_hz_is_not_lost_yet():
+    rate = 4.0
+    tracker = Tracker(ForegroundConfig())
+    for k in range(8):
+        tracker.step(k / rate, [meas([1.0 + 0.8 * k / rate, 0, 0.9], k=k)])
+    tracker.step(8 / rate, [])  # one missed frame: the gate widens a little (0.25 s > 0.1 s)
+    (track,) = tracker.tracks
+    tracker._predict(track, 9 / rate)
+    base, widened = tracker._gate(track, 9 / rate)
+    assert base < widened
+    near = track.position + np.array([0.0, (base + widened) / 2, 0.0])
+    _, joined = tracker.step(9 / rate, [meas(near, "unknown", k=9)])
+    assert joined == [track.uuid]  # an unmatched blob of the person after one miss still joins

@@ -176,6 +176,12 @@ class ForegroundConfig:
     search_classes: tuple[str, ...] = ("person", "unknown")
     """Classes whose lost tracks search (widen their gate while unseen) when they were moving:
     the centre of a bed's or couch's blob slides as the view changes, which looks like motion."""
+    search_same_class: tuple[str, ...] = ("person",)
+    """Beyond its normal gate a searching track of these classes only takes an observation of
+    its own class: a lost person track otherwise took a chair or junk blob metres away."""
+    search_min_size_ratio: float = 0.5
+    """... or an ``unknown`` one at least this share of the track's largest blob (a person coming
+    back cut by the image border, unmatched; 0.75 split the fixture's person; above 1: never)."""
     moving_speed_mps: float = 0.3
     """Only a track that was moving faster than this when last seen (filtered velocity and
     displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
@@ -243,7 +249,11 @@ class ForegroundConfig:
             raise ConfigError(
                 f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
             )
-        for name in ("classes", "exclude_classes", "search_classes", "unseen_table_skip_classes", "walker_classes"):
+        tuples = (
+            "classes", "exclude_classes", "search_classes", "unseen_table_skip_classes", "walker_classes",
+            "search_same_class",
+        )
+        for name in tuples:
             value = getattr(self, name)
             if isinstance(value, str):  # "a,b" from a command line
                 value = tuple(v.strip() for v in value.split(",") if v.strip())

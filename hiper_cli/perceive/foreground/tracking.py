@@ -211,6 +211,7 @@ class Tracker:
         self.priors = priors or (lambda _name: ClassPrior())
         self.tracks: list[Track] = []  # live (tentative or confirmed)
         self.last_stamp_s: float | None = None
+        self._frame_dt_s = 0.0
 
     # --- Kalman pieces ----------------------------------------------------------------------
     def _accel_noise(self, class_name: str) -> float:
@@ -308,12 +309,14 @@ class Tracker:
         track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
-    def _gate(self, track: Track, stamp_s: float) -> float:
+    def _gate(self, track: Track, stamp_s: float) -> tuple[float, float]:
+        """(base gate, gate): the gate is the base widened while a moving track searches."""
         cfg = self.config
         dt = stamp_s - track.last_update_s
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
-            return float(prior.cu_mps) * dt + cfg.gate_margin_m
+            learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
+            return learned, learned
         searching = track.class_name in cfg.search_classes and _was_moving(track, cfg)
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
@@ -321,7 +324,7 @@ class Tracker:
         P = np.asarray(track.kf.P, dtype=np.float64)[:3, :3]  # type: ignore[attr-defined]
         sigma = float(np.sqrt(np.linalg.eigvalsh(P).max() + cfg.measurement_noise_m**2))
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
-        return min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
+        return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated Hungarian assignment."""
@@ -332,8 +335,13 @@ class Tracker:
         pred = np.array([t.position for t in self.tracks])
         obs = np.array([m.center_map for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
-        gates = np.array([self._gate(t, stamp_s) for t in self.tracks])
-        allowed = cost <= gates[:, None]
+        gates = np.array([self._gate(t, stamp_s) for t in self.tracks]).reshape(-1, 2)
+        allowed = cost <= gates[:, 1:2]
+        searched = cost > gates[:, 0:1]
+        same_class = self.config.search_same_class
+        # lost: more than one frame missed (picked up again after one miss, the gap is 2 frames)
+        grace = max(self.config.velocity_decay_grace_s, 2.5 * self._frame_dt_s)
+        lost = [stamp_s - t.last_update_s > grace for t in self.tracks]
         walkers, min_ratio = self.config.walker_classes, self.config.walker_min_size_ratio
         for i, t in enumerate(self.tracks):
             cls = t.class_name
@@ -342,6 +350,11 @@ class Tracker:
                     cost[i, j] += self.config.class_mismatch_m
                 if cls in walkers and _size_m(m.extent_map) < min_ratio * t.max_size_m:
                     allowed[i, j] = False
+                if same_class and searched[i, j] and lost[i] and cls in same_class and m.class_name != cls:
+                    # an unmatched blob as big as the person may be the person (cut by the border)
+                    person_sized = _size_m(m.extent_map) >= self.config.search_min_size_ratio * t.max_size_m
+                    if not (m.class_name == UNKNOWN and person_sized):
+                        allowed[i, j] = False
         big = 1e6
         rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
         return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
@@ -362,6 +375,7 @@ class Tracker:
         """
         dt_frame = 0.0 if self.last_stamp_s is None else max(stamp_s - self.last_stamp_s, 0.0)
         self.last_stamp_s = stamp_s
+        self._frame_dt_s = dt_frame
         for t in self.tracks:
             self._predict(t, stamp_s)
         pairs = self.associate(measurements, stamp_s)
