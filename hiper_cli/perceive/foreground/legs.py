@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import Blob
+from hiper_cli.perceive.foreground.segment import Blob, sub_blob
 
 __all__ = ["drop_table_legs", "leg_points"]
 
@@ -74,7 +74,6 @@ def drop_table_legs(
     if not tables or config.table_leg_cell_m <= 0:
         return blobs
     out: list[Blob] = []
-    half = step / 2.0
     for blob in blobs:
         legs = leg_points(blob.points_map, tables, config)
         if not legs.any():
@@ -83,16 +82,5 @@ def drop_table_legs(
         keep = np.flatnonzero(~legs)
         if len(keep) < 3 or (len(keep) < config.min_cluster_points and not blob.fragment):
             continue
-        uv = blob.pixels_uv[keep]
-        box = np.array(
-            [
-                max(0.0, uv[:, 0].min() - half),
-                max(0.0, uv[:, 1].min() - half),
-                min(float(width), uv[:, 0].max() + half),
-                min(float(height), uv[:, 1].max() + half),
-            ]
-        )
-        out.append(
-            Blob(blob.points_cam[keep], blob.points_map[keep], uv, box, blob.support_z_m, blob.fragment)
-        )
+        out.append(sub_blob(blob, keep, step, width, height))
     return out

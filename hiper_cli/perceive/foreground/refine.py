@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import Blob, support_below
+from hiper_cli.perceive.foreground.segment import Blob, sub_blob, support_below
 
 __all__ = ["refine_blobs"]
 
@@ -50,20 +50,6 @@ def _inside(uv: NDArray[np.int32], boxes: FloatArray) -> NDArray[np.bool_]:
     v = uv[:, 1:2].astype(np.float64) + 0.5
     in_u = (u >= boxes[None, :, 0]) & (u <= boxes[None, :, 2])
     return np.asarray(in_u & (v >= boxes[None, :, 1]) & (v <= boxes[None, :, 3]))
-
-
-def _sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:
-    uv = blob.pixels_uv[sel]
-    half = step / 2.0
-    box = np.array(
-        [
-            max(0.0, uv[:, 0].min() - half),
-            max(0.0, uv[:, 1].min() - half),
-            min(float(width), uv[:, 0].max() + half),
-            min(float(height), uv[:, 1].max() + half),
-        ]
-    )
-    return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box)
 
 
 def _nearest_label(
@@ -175,7 +161,7 @@ def _concat(blobs: Sequence[Blob], step: int, width: int, height: int) -> Blob:
         np.concatenate([b.pixels_uv for b in blobs]),
         np.zeros(4),
     )
-    return _sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
+    return sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
 
 
 def refine_blobs(
@@ -208,7 +194,7 @@ def refine_blobs(
                 out.append(blob)
                 changed.append(False)
             else:
-                out.extend(_sub_blob(blob, g, step, width, height) for g in groups)
+                out.extend(sub_blob(blob, g, step, width, height) for g in groups)
                 changed.extend([True] * len(groups))
     else:
         out, changed = list(blobs), [False] * len(blobs)
@@ -224,7 +210,7 @@ def refine_blobs(
                 continue
             keep = _trim(blob, boxes, boxes + trim_pad, step_pad, config)
             if keep is not None:
-                out[i] = _sub_blob(blob, keep, step, width, height)
+                out[i] = sub_blob(blob, keep, step, width, height)
                 changed[i] = True
     if config.detection_join and len(out) >= 2:
         owners = [_owner(b, grown, areas, config) for b in out]

@@ -31,7 +31,10 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["Blob", "SegmentStats", "inside_boxes", "segment", "support_below", "table_leg_boxes"]
+__all__ = [
+    "Blob", "SegmentStats", "image_box", "inside_boxes", "segment", "sub_blob", "support_below",
+    "table_leg_boxes",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -72,6 +75,27 @@ class Blob:
         z_lo, z_hi = self._z_range()
         extent[2] = z_hi - z_lo
         return np.asarray(extent, dtype=np.float64)
+
+
+def image_box(uv: NDArray[np.int32], step: int, width: int, height: int) -> FloatArray:
+    """The image box (xyxy pixels) of sampled pixels ``uv`` (N, 2): each sample covers
+    ``step`` pixels, clipped to the image."""
+    half = step / 2.0
+    return np.array(
+        [
+            max(0.0, uv[:, 0].min() - half),
+            max(0.0, uv[:, 1].min() - half),
+            min(float(width), uv[:, 0].max() + half),
+            min(float(height), uv[:, 1].max() + half),
+        ]
+    )
+
+
+def sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:
+    """The points ``sel`` of ``blob`` as a blob of their own (its support and fragment flag)."""
+    uv = blob.pixels_uv[sel]
+    box = image_box(uv, step, width, height)
+    return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box, blob.support_z_m, blob.fragment)
 
 
 @dataclass
@@ -425,7 +449,6 @@ def segment(
         ends = np.r_[starts[1:], len(lab)]
         sizes = ends - starts
         U_flat, V_flat = U.ravel(), V.ravel()
-        half = step / 2.0
         groups = [member[s:e] for s, e, size in zip(starts, ends, sizes, strict=True) if size >= 3]
         groups = _merge_fragments(groups, map_full, valid.shape[1], config)
         for sel in groups:
@@ -441,14 +464,7 @@ def segment(
                 stats.rejected_clusters += 1
                 continue
             uv = np.stack([U_flat[sel], V_flat[sel]], axis=1).astype(np.int32)
-            box = np.array(
-                [
-                    max(0.0, uv[:, 0].min() - half),
-                    max(0.0, uv[:, 1].min() - half),
-                    min(float(camera.width), uv[:, 0].max() + half),
-                    min(float(camera.height), uv[:, 1].max() + half),
-                ]
-            )
+            box = image_box(uv, step, camera.width, camera.height)
             blob = Blob(P_flat[sel], pm, uv, box, fragment=fragment)
             if config.background_filter and support_boxes_map:
                 blob.support_z_m = support_below(blob, support_boxes_map, config)

@@ -28,7 +28,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import leg_points
 from hiper_cli.perceive.foreground.match import iou_matrix
-from hiper_cli.perceive.foreground.segment import Blob
+from hiper_cli.perceive.foreground.segment import Blob, sub_blob
 
 __all__ = ["drop_unseen_tables", "grid_components", "table_points", "unseen_table_top"]
 
@@ -142,20 +142,6 @@ def grid_components(
 
 
 
-def _sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:
-    uv = blob.pixels_uv[sel]
-    half = step / 2.0
-    box = np.array(
-        [
-            max(0.0, uv[:, 0].min() - half),
-            max(0.0, uv[:, 1].min() - half),
-            min(float(width), uv[:, 0].max() + half),
-            min(float(height), uv[:, 1].max() + half),
-        ]
-    )
-    return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box, blob.support_z_m, blob.fragment)
-
-
 def drop_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: ForegroundConfig,
     width: int, height: int,
@@ -190,7 +176,7 @@ def _part(
 ) -> Blob:
     """A part of ``blob`` as a blob of its own, standing on the floor below the blob (as the
     segmentation found it), on the table top, or on nothing known."""
-    part = _sub_blob(blob, sel, config.pixel_step, width, height)
+    part = sub_blob(blob, sel, config.pixel_step, width, height)
     base = float(part.points_map[:, 2].min())
     depth = float(np.median(part.points_cam[:, 2]))
     reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
