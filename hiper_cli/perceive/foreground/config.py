@@ -67,7 +67,7 @@ class ForegroundConfig:
     """... up to within this of the top ..."""
     table_leg_above_m: float = 0.03
     """... and no more than this above it is a leg."""
-    unseen_table_min_side_m: float = 0.4
+    unseen_table_min_side_m: float = 0.3
     """A table the background layer has not mapped yet (its top seen at a grazing angle in the
     first seconds) merges the chairs around it into one blob. When such a blob overlaps a
     detection (IoU >= ``trim_iou``) and holds a horizontal slab between
