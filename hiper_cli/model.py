@@ -32,6 +32,7 @@ __all__ = [
     "Layer",
     "Observation",
     "State",
+    "json_default",
     "new_uuid",
 ]
 
@@ -49,6 +50,15 @@ def new_uuid() -> str:
     rand = int.from_bytes(os.urandom(10), "big")
     value = (ms & 0xFFFF_FFFF_FFFF) << 80 | 0x7 << 76 | (rand >> 62 & 0xFFF) << 64 | 0b10 << 62
     return str(_uuid.UUID(int=value | rand & ((1 << 62) - 1)))
+
+
+def json_default(value: Any) -> Any:
+    """``default=`` for JSON encoders: arrays as lists, model objects as their ``to_dict()``."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if hasattr(value, "to_dict"):
+        return value.to_dict()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 @dataclass(frozen=True)

@@ -9,16 +9,9 @@ from typing import Any
 
 import orjson
 
+from hiper_cli.model import json_default
+
 __all__ = ["dumps", "loads"]
-
-
-def _default(value: Any) -> Any:
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    if hasattr(value, "to_dict"):
-        return value.to_dict()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
 
 _ORJSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY | orjson.OPT_NON_STR_KEYS
 
@@ -30,12 +23,12 @@ def dumps(doc: Any) -> str:
     document (C-level, ~10 us), and the stdlib encodes it when they differ (a non-finite number,
     or what orjson would change: tuples, numpy arrays, integer keys, integers beyond 64 bits)."""
     try:
-        out = orjson.dumps(doc, default=_default, option=_ORJSON_OPTIONS)
+        out = orjson.dumps(doc, default=json_default, option=_ORJSON_OPTIONS)
         if b"null" not in out or _same(orjson.loads(out), doc):
             return out.decode()
     except (orjson.JSONEncodeError, TypeError):
         pass
-    return json.dumps(doc, separators=(",", ":"), default=_default)
+    return json.dumps(doc, separators=(",", ":"), default=json_default)
 
 
 def _same(a: Any, b: Any) -> bool:
