@@ -5,7 +5,7 @@ import pytest
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import inside_boxes, segment
+from hiper_cli.perceive.foreground.segment import inside_boxes, segment, support_below
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 
@@ -78,3 +78,15 @@ def test_background_filter_matches_inside_boxes_on_rotated_boxes():
     got = _filter_background(valid, P_map, margin, boxes, CAMERA, T, step, ForegroundConfig())
     expected = valid & ~inside_boxes(P_map.reshape(-1, 3), boxes, 0.05).reshape(z.shape)
     assert (got == expected).all() and (expected != valid).sum() > 20
+
+
+def test_a_blob_cut_by_the_lower_image_edge_stands_on_nothing_known():
+    boxes = [*room(), person(10, 3.0, 0.0)]
+    frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
+    bg = background_instances(boxes)
+    floor = [i.box for i in bg.values() if i.class_name == "floor"]
+    cfg = ForegroundConfig(pixel_step=2)
+    (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg, floor)
+    assert support_below(blob, floor, cfg, CAMERA.height) == pytest.approx(0.0)
+    blob.image_box_xyxy = np.array([*blob.image_box_xyxy[:3], float(CAMERA.height)])  # its feet out of view
+    assert support_below(blob, floor, cfg, CAMERA.height) is None

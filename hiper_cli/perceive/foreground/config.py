@@ -40,19 +40,30 @@ class ForegroundConfig:
     """Downscale: keep every n-th pixel of the depth image in both directions."""
     min_depth_m: float = 0.3
     max_depth_m: float = 5.0
-    """The paper's point cloud range of 5 m."""
+    """The paper's point cloud range of 5 m: blobs whose median depth is beyond it are dropped
+    ..."""
+    max_depth_slack_m: float = 0.3
+    """... and points up to this much farther are kept, so that an object standing across the
+    limit keeps its far side (a hard cut at 5 m moved a far chair's centre towards the camera)."""
     background_margin_m: float = 0.02
     """Background boxes are grown by this much on every side before filtering (0.05 cut thin
     parts that touch a wall or the floor, a bed's head board, from their objects; 0.015 let
     more wall noise through as blobs: false positives and identity switches on the tuning
     logs) ..."""
-    background_margin_per_m2: float = 0.005
+    background_margin_per_m2: float = 0.0015
     """... plus this times the squared depth (structured-light depth noise grows with z²)."""
     background_noise_along_ray: bool = True
     """The z² part grows a box face by the noise projected on the face's normal (depth noise
     lies along the viewing ray: a floor seen at a grazing angle needs little of it) ..."""
     background_noise_min_cos: float = 0.25
     """... at least this share of it (edges, flying pixels)."""
+    background_block_mean: bool = True
+    """The filter tests each sample at the mean point of its ``pixel_step`` × ``pixel_step``
+    pixel block (the pixels on the sample's own surface: within ``background_block_tolerance``
+    filter margins of its depth). Sixteen pixels average the depth noise down about four times,
+    so a bed's head board or a chair's feet stand out from the wall or floor behind them; the
+    points themselves keep their own depth."""
+    background_block_tolerance: float = 2.0
     table_leg_band_m: float = 0.0
     """Filter a band this wide under the edges of every background table top: its legs (0: off;
     needs accurate table boxes: with the background stage's table estimates it cut chairs)."""

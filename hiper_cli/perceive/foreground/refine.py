@@ -246,5 +246,5 @@ def refine_blobs(
     if config.background_filter and support_boxes_map:
         for blob, was_changed in zip(out, changed, strict=True):
             if was_changed:
-                blob.support_z_m = support_below(blob, support_boxes_map, config)
+                blob.support_z_m = support_below(blob, support_boxes_map, config, height)
     return out

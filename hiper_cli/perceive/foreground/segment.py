@@ -123,6 +123,39 @@ def _rays(
     return rx, ry, U, V
 
 
+def _block_mean_points(
+    depth_m: NDArray[np.float32], camera: CameraIntrinsics, step: int, z: FloatArray, tol_m: FloatArray
+) -> FloatArray:
+    """Each grid sample's mean camera-frame point over its ``step`` × ``step`` pixel block, from
+    the block's pixels within ``tol_m`` (h, w) of the sample's depth (the sample's own surface,
+    not the one behind an edge); (h, w, 3), NaN where no pixel qualifies (invalid samples).
+
+    The mean of a planar patch's points lies on the plane, so the mean is as close to a wall or
+    floor as the sample is, with the depth noise averaged over up to ``step``² pixels.
+    """
+    h, w = z.shape
+    full = np.zeros((h * step, w * step), dtype=np.float32)
+    rows, cols = min(depth_m.shape[0], h * step), min(depth_m.shape[1], w * step)
+    full[:rows, :cols] = depth_m[:rows, :cols]
+    blocks = full.reshape(h, step, w, step)
+    near = np.abs(blocks - z[:, None, :, None].astype(np.float32)) <= tol_m[:, None, :, None]
+    kept = np.where(near, blocks, np.float32(0.0))
+    by_col = kept.sum(axis=1, dtype=np.float64)  # (h, w, step): summed over the block's rows
+    by_row = kept.sum(axis=3, dtype=np.float64)  # (h, step, w): summed over its columns
+    count = near.sum(axis=(1, 3))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = np.where(count > 0, count, np.nan)
+        sum_z = by_col.sum(axis=2)
+        offsets = np.arange(step, dtype=np.float64)
+        u0 = (np.arange(w) * step)[None, :].astype(np.float64)
+        v0 = (np.arange(h) * step)[:, None].astype(np.float64)
+        sum_zu = by_col @ offsets + u0 * sum_z
+        sum_zv = np.einsum("isj,s->ij", by_row, offsets) + v0 * sum_z
+        x = (sum_zu - camera.cx * sum_z) / (camera.fx * n)
+        y = (sum_zv - camera.cy * sum_z) / (camera.fy * n)
+        return np.stack([x, y, sum_z / n], axis=-1)
+
+
 def inside_boxes(
     points: FloatArray, boxes: Sequence[Box3D], margin_m: float | FloatArray
 ) -> NDArray[np.bool_]:
@@ -258,7 +291,8 @@ def _box_roi(
     if np.all(z < config.min_depth_m):
         return None  # behind the camera
     lo_c, hi_c = corners.min(axis=0), corners.max(axis=0)
-    if np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0)) > config.max_depth_m:
+    reach_m = config.max_depth_m + config.max_depth_slack_m
+    if np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0)) > reach_m:
         return None  # farther than the sensor sees
     if np.any(z < 0.05):
         return slice(0, h), slice(0, w)  # straddles the image plane: take the whole image
@@ -373,10 +407,15 @@ def table_leg_boxes(top: Box3D, band_m: float, height_m: float = 1.2) -> list[Bo
     return out
 
 
-def support_below(blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig) -> float | None:
+def support_below(
+    blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig, image_height: int | None = None
+) -> float | None:
     """Top height of the support the blob stands on, if its base is within the filter margin
     plus ``support_gap_m`` above it (thin legs and feet lose their lowest samples to the margin
-    and to the subsampling)."""
+    and to the subsampling). None for a blob that reaches the lower edge of the image
+    (``image_height``): its base is out of view, and its box stays what the camera sees."""
+    if image_height is not None and blob.image_box_xyxy[3] >= image_height - config.pixel_step:
+        return None
     lo = blob.points_map.min(axis=0)
     hi = blob.points_map.max(axis=0)
     depth = float(np.median(blob.points_cam[:, 2]))
@@ -417,7 +456,7 @@ def segment(
     rx, ry, U, V = _rays(camera, step)
     off = step // 2
     z = depth_m[off::step, off::step].astype(np.float64)
-    valid = (z >= config.min_depth_m) & (z <= config.max_depth_m) & np.isfinite(z)
+    valid = (z >= config.min_depth_m) & (z <= config.max_depth_m + config.max_depth_slack_m) & np.isfinite(z)
     P = np.stack([rx * z, ry * z, z], axis=-1)  # (h, w, 3) camera frame
     stats.points = int(valid.sum())
     P_flat = P.reshape(-1, 3)
@@ -430,9 +469,14 @@ def segment(
             margin, along = np.full(z.shape, config.background_margin_m), noise
         else:
             margin, along = config.background_margin_m + noise, None
+        test_map = map_full.reshape(P.shape)
+        if config.background_block_mean and step > 1:
+            tol = config.background_block_tolerance * (config.background_margin_m + noise)
+            mean_cam = _block_mean_points(depth_m, camera, step, np.where(valid, z, np.nan), tol)
+            mean_cam = np.where(np.isfinite(mean_cam), mean_cam, P)
+            test_map = (mean_cam.reshape(-1, 3) @ R.T + t).reshape(P.shape)
         valid = _filter_background(
-            valid, map_full.reshape(P.shape), margin, background_boxes_map, camera, T_map_cam, step, config,
-            along,
+            valid, test_map, margin, background_boxes_map, camera, T_map_cam, step, config, along,
         )
     stats.after_background = int(valid.sum())
     t2 = time.perf_counter()
@@ -459,6 +503,8 @@ def segment(
             if size > config.max_cluster_points:
                 stats.rejected_clusters += 1
                 continue
+            if config.max_depth_slack_m > 0 and np.median(P_flat[sel, 2]) > config.max_depth_m:
+                continue  # beyond the range: the slack only keeps the far side of nearer objects
             pm = map_full[sel]
             if np.any(pm.max(axis=0) - pm.min(axis=0) > config.max_cluster_extent_m):
                 stats.rejected_clusters += 1
@@ -467,7 +513,7 @@ def segment(
             box = image_box(uv, step, camera.width, camera.height)
             blob = Blob(P_flat[sel], pm, uv, box, fragment=fragment)
             if config.background_filter and support_boxes_map:
-                blob.support_z_m = support_below(blob, support_boxes_map, config)
+                blob.support_z_m = support_below(blob, support_boxes_map, config, camera.height)
             blobs.append(blob)
     stats.clusters = sum(1 for b in blobs if not b.fragment)
     t3 = time.perf_counter()
