@@ -218,3 +218,26 @@ def test_a_chair_back_leg_deeper_than_the_chair_median_joins_it():
     assert len(joined.points_cam) == 50
     far = _synthetic_blob(np.full(20, 3.3), 81, 80)  # 0.4 m behind the deepest point: apart
     assert len(_refine([front, far], box, ForegroundConfig(pixel_step=2, trim_iou=1.0, join_gap_m=1.0))) == 2
+
+
+def _flat_blob(x0, y0, x1, y1, depth_m, step=4):
+    from hiper_cli.perceive.foreground.segment import Blob, image_box
+
+    us, vs = np.meshgrid(np.arange(x0 + 2, x1, step), np.arange(y0 + 2, y1, step))
+    uv = np.stack([us.ravel(), vs.ravel()], axis=1).astype(np.int32)
+    z = np.full(len(uv), depth_m)
+    cam = np.stack([(uv[:, 0] - 320.0) * z / 525.0, (uv[:, 1] - 240.0) * z / 525.0, z], axis=1)
+    return Blob(cam, cam.copy(), uv, image_box(uv, step, 640, 480))
+
+
+def test_a_piece_that_makes_the_blob_fit_its_detection_worse_is_not_joined():
+    chair = _flat_blob(424, 244, 560, 444, 2.5)
+    table_piece = _flat_blob(410, 232, 488, 280, 2.6)  # inside the grown box, beside the chair
+    detection = [[425.0, 252.0, 567.0, 451.0]]
+    cfg = ForegroundConfig()
+    kept = refine_blobs([chair, table_piece], np.asarray(detection), cfg, 640, 480)
+    sizes = sorted([len(table_piece.points_cam), len(chair.points_cam)])
+    assert sorted(len(b.points_cam) for b in kept) == sizes
+    loose = replace(cfg, join_max_iou_loss=1.0)
+    (joined,) = refine_blobs([chair, table_piece], np.asarray(detection), loose, 640, 480)
+    assert len(joined.points_cam) == len(chair.points_cam) + len(table_piece.points_cam)

@@ -144,6 +144,9 @@ class ForegroundConfig:
     """... their median depths at most this far apart ..."""
     join_gap_m: float = 0.3
     """... and their nearest points at most this far apart."""
+    join_max_iou_loss: float = 0.05
+    """... unless the joined image box's IoU with the detection box is lower than before by
+    more than this (a piece of an unmapped table top beside a chair's box)."""
 
     # --- matching (Algorithm 4) -------------------------------------------------------------
     iou_threshold: float = 0.5

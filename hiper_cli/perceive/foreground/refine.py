@@ -23,7 +23,9 @@ IoU matching of Algorithm 4:
    their pixels, the box grown by ``detection_margin_frac`` of its size for detector jitter;
    the smallest such box owns them), whose median depths differ by at most ``join_depth_m``
    and whose nearest points are at most ``join_gap_m`` apart become one blob (a person
-   behind a table: the torso above it, the legs below it).
+   behind a table: the torso above it, the legs below it), unless the joined image box fits
+   the detection box worse than before (IoU lower by more than ``join_max_iou_loss``: a piece
+   of an unmapped table beside a chair).
 
 No detection, no change: with a low-recall detector the step costs almost nothing.
 """
@@ -37,6 +39,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import Blob, sub_blob, support_below
 
 __all__ = ["refine_blobs"]
@@ -154,6 +157,18 @@ def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
     return bool(np.isfinite(dist).any())
 
 
+def _fits_better(group: Sequence[Blob], blob: Blob, box_xyxy: FloatArray, config: ForegroundConfig) -> bool:
+    """Whether adding ``blob`` to ``group`` keeps the group's image box at least as close to the
+    detection box (IoU, up to ``join_max_iou_loss``): the torso and legs of a person cut by a
+    table fill the person's box together, a piece of a table beside a chair's box does not."""
+    before = np.array([b.image_box_xyxy for b in group])
+    union = np.r_[before[:, :2].min(axis=0), before[:, 2:].max(axis=0)]
+    box = blob.image_box_xyxy
+    joined = np.r_[np.minimum(union[:2], box[:2]), np.maximum(union[2:], box[2:])]
+    iou = iou_matrix(np.stack([union, joined]), box_xyxy.reshape(1, 4))[:, 0]
+    return bool(iou[1] >= iou[0] - config.join_max_iou_loss)
+
+
 def _concat(blobs: Sequence[Blob], step: int, width: int, height: int) -> Blob:
     whole = Blob(
         np.concatenate([b.points_cam for b in blobs]),
@@ -220,14 +235,16 @@ def refine_blobs(
                 by_owner.setdefault(k, []).append(i)
         drop: set[int] = set()
         extra: list[Blob] = []
-        for members in by_owner.values():
+        for k, members in by_owner.items():
             if len(members) < 2:
                 continue
             members = sorted(members, key=lambda i: -len(out[i].points_cam))
             merged: list[list[int]] = []
             for i in members:  # greedy: join the first group with a close member
                 for group in merged:
-                    if any(_close(out[i], out[j], config) for j in group):
+                    if any(_close(out[i], out[j], config) for j in group) and _fits_better(
+                        [out[j] for j in group], out[i], boxes[k], config
+                    ):
                         group.append(i)
                         break
                 else:
