@@ -123,37 +123,33 @@ def _rays(
     return rx, ry, U, V
 
 
-def _block_mean_points(
-    depth_m: NDArray[np.float32], camera: CameraIntrinsics, step: int, z: FloatArray, tol_m: FloatArray
+def _block_mean_depth(
+    depth_m: NDArray[np.float32], step: int, z: FloatArray, tol_m: FloatArray
 ) -> FloatArray:
-    """Each grid sample's mean camera-frame point over its ``step`` × ``step`` pixel block, from
-    the block's pixels within ``tol_m`` (h, w) of the sample's depth (the sample's own surface,
-    not the one behind an edge); (h, w, 3), NaN where no pixel qualifies (invalid samples).
+    """Each grid sample's depth replaced by the mean depth of its ``step`` × ``step`` pixel
+    block (valid pixels only), where that mean is within ``tol_m`` (h, w) of the sample's own
+    depth; the sample's depth where it is not (the block straddles an edge) or has no valid
+    pixel. (h, w) metres; the mean belongs to the block's centre pixel.
 
-    The mean of a planar patch's points lies on the plane, so the mean is as close to a wall or
-    floor as the sample is, with the depth noise averaged over up to ``step``² pixels.
+    The block mean of a planar patch lies on the plane, so it is as close to a wall or floor as
+    the sample is, with the depth noise averaged over ``step``² pixels. One OpenCV area resize:
+    well under a millisecond at 640×480.
     """
+    import cv2
+
     h, w = z.shape
     full = np.zeros((h * step, w * step), dtype=np.float32)
     rows, cols = min(depth_m.shape[0], h * step), min(depth_m.shape[1], w * step)
     full[:rows, :cols] = depth_m[:rows, :cols]
-    blocks = full.reshape(h, step, w, step)
-    near = np.abs(blocks - z[:, None, :, None].astype(np.float32)) <= tol_m[:, None, :, None]
-    kept = np.where(near, blocks, np.float32(0.0))
-    by_col = kept.sum(axis=1, dtype=np.float64)  # (h, w, step): summed over the block's rows
-    by_row = kept.sum(axis=3, dtype=np.float64)  # (h, step, w): summed over its columns
-    count = near.sum(axis=(1, 3))
+    if not np.isfinite(full).all():
+        full = np.nan_to_num(full, nan=0.0, posinf=0.0, neginf=0.0)
+    valid = (full > 0).astype(np.float32)
+    sum_z = cv2.resize(full, (w, h), interpolation=cv2.INTER_AREA).astype(np.float64)
+    count = cv2.resize(valid, (w, h), interpolation=cv2.INTER_AREA).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
-        n = np.where(count > 0, count, np.nan)
-        sum_z = by_col.sum(axis=2)
-        offsets = np.arange(step, dtype=np.float64)
-        u0 = (np.arange(w) * step)[None, :].astype(np.float64)
-        v0 = (np.arange(h) * step)[:, None].astype(np.float64)
-        sum_zu = by_col @ offsets + u0 * sum_z
-        sum_zv = np.einsum("isj,s->ij", by_row, offsets) + v0 * sum_z
-        x = (sum_zu - camera.cx * sum_z) / (camera.fx * n)
-        y = (sum_zv - camera.cy * sum_z) / (camera.fy * n)
-        return np.stack([x, y, sum_z / n], axis=-1)
+        mean = sum_z / count
+    use = (count > 0) & (np.abs(mean - z) <= tol_m)
+    return np.where(use, mean, z)
 
 
 def inside_boxes(
@@ -472,9 +468,11 @@ def segment(
         test_map = map_full.reshape(P.shape)
         if config.background_block_mean and step > 1:
             tol = config.background_block_tolerance * (config.background_margin_m + noise)
-            mean_cam = _block_mean_points(depth_m, camera, step, np.where(valid, z, np.nan), tol)
-            mean_cam = np.where(np.isfinite(mean_cam), mean_cam, P)
-            test_map = (mean_cam.reshape(-1, 3) @ R.T + t).reshape(P.shape)
+            z_test = _block_mean_depth(depth_m, step, z, tol)
+            centre = (step - 1) / 2.0 - step // 2  # the block's centre, from its sample's pixel
+            ray_x, ray_y = rx + centre / camera.fx, ry + centre / camera.fy
+            test_cam = np.stack([ray_x * z_test, ray_y * z_test, z_test], axis=-1)
+            test_map = (test_cam.reshape(-1, 3) @ R.T + t).reshape(P.shape)
         valid = _filter_background(
             valid, test_map, margin, background_boxes_map, camera, T_map_cam, step, config, along,
         )
