@@ -58,11 +58,13 @@ class ForegroundConfig:
     background_noise_min_cos: float = 0.25
     """... at least this share of it (edges, flying pixels)."""
     background_block_mean: bool = True
-    """The filter tests each sample at the mean point of its ``pixel_step`` × ``pixel_step``
-    pixel block (the pixels on the sample's own surface: within ``background_block_tolerance``
-    filter margins of its depth). Sixteen pixels average the depth noise down about four times,
-    so a bed's head board or a chair's feet stand out from the wall or floor behind them; the
-    points themselves keep their own depth."""
+    """The filter tests each sample at the mean depth of its ``pixel_step`` × ``pixel_step``
+    pixel block, on the block centre's ray, where that mean is within
+    ``background_block_tolerance`` filter margins of the sample's own depth (elsewhere the block
+    straddles an edge and the sample itself is tested). Sixteen pixels average the depth noise
+    down about four times, so a bed's head board or a chair's feet stand out from the wall or
+    floor behind them; the points themselves keep their own depth. Where a foot meets the floor
+    the block mixes both, and a floor sample may stay with the object."""
     background_block_tolerance: float = 2.0
     table_leg_band_m: float = 0.0
     """Filter a band this wide under the edges of every background table top: its legs (0: off;

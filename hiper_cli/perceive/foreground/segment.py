@@ -125,11 +125,10 @@ def _rays(
 
 def _block_mean_depth(
     depth_m: NDArray[np.float32], step: int, z: FloatArray, tol_m: FloatArray
-) -> FloatArray:
-    """Each grid sample's depth replaced by the mean depth of its ``step`` × ``step`` pixel
-    block (valid pixels only), where that mean is within ``tol_m`` (h, w) of the sample's own
-    depth; the sample's depth where it is not (the block straddles an edge) or has no valid
-    pixel. (h, w) metres; the mean belongs to the block's centre pixel.
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The mean depth of each grid sample's ``step`` × ``step`` pixel block (valid pixels
+    only; it belongs to the block's centre pixel), and where to use it: where it is within
+    ``tol_m`` (h, w) of the sample's own depth (elsewhere the block straddles an edge).
 
     The block mean of a planar patch lies on the plane, so it is as close to a wall or floor as
     the sample is, with the depth noise averaged over ``step``² pixels. One OpenCV area resize:
@@ -149,7 +148,7 @@ def _block_mean_depth(
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = sum_z / count
     use = (count > 0) & (np.abs(mean - z) <= tol_m)
-    return np.where(use, mean, z)
+    return np.where(use, mean, z), use
 
 
 def inside_boxes(
@@ -468,10 +467,11 @@ def segment(
         test_map = map_full.reshape(P.shape)
         if config.background_block_mean and step > 1:
             tol = config.background_block_tolerance * (config.background_margin_m + noise)
-            z_test = _block_mean_depth(depth_m, step, z, tol)
+            z_mean, use = _block_mean_depth(depth_m, step, z, tol)
             centre = (step - 1) / 2.0 - step // 2  # the block's centre, from its sample's pixel
             ray_x, ray_y = rx + centre / camera.fx, ry + centre / camera.fy
-            test_cam = np.stack([ray_x * z_test, ray_y * z_test, z_test], axis=-1)
+            mean_cam = np.stack([ray_x * z_mean, ray_y * z_mean, z_mean], axis=-1)
+            test_cam = np.where(use[..., None], mean_cam, P)
             test_map = (test_cam.reshape(-1, 3) @ R.T + t).reshape(P.shape)
         valid = _filter_background(
             valid, test_map, margin, background_boxes_map, camera, T_map_cam, step, config, along,
