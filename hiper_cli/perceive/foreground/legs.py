@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import Blob, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, sub_blob
 
 __all__ = ["drop_table_legs", "leg_points"]
 
@@ -39,9 +39,7 @@ def leg_points(
     if len(points_map) == 0 or not tables:
         return legs
     cell = config.table_leg_cell_m
-    keys = np.floor(points_map[:, :2] / cell).astype(np.int64)
-    _, inverse = np.unique(keys, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    inverse = cell_inverse(points_map[:, :2], cell)
     n_cells = int(inverse.max()) + 1
     z = points_map[:, 2]
     z_lo = np.full(n_cells, np.inf)

@@ -32,8 +32,8 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
-    "Blob", "SegmentStats", "image_box", "inside_boxes", "segment", "sub_blob", "support_below",
-    "table_leg_boxes",
+    "Blob", "SegmentStats", "cell_inverse", "image_box", "inside_boxes", "segment", "sub_blob",
+    "support_below", "table_leg_boxes",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -149,6 +149,17 @@ def _block_mean_depth(
         mean = sum_z / count
     use = (count > 0) & (np.abs(mean - z) <= tol_m)
     return np.where(use, mean, z), use
+
+
+def cell_inverse(points_xy: FloatArray, cell_m: float) -> NDArray[np.int64]:
+    """The index of each point's horizontal cell (``cell_m`` wide) among the occupied cells,
+    numbered in (x, y) order: ``np.unique(cells, axis=0, return_inverse=True)`` on one integer
+    key per point, several times faster."""
+    cells = np.floor(points_xy / cell_m).astype(np.int64)
+    cells -= cells.min(axis=0)
+    flat = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
+    _, inverse = np.unique(flat, return_inverse=True)
+    return np.asarray(inverse.reshape(-1), dtype=np.int64)
 
 
 def inside_boxes(

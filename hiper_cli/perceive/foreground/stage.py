@@ -228,9 +228,10 @@ class ForegroundStage:
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
         cfg = self.config
         n = len(blob.points_cam)
-        # Evenly spread subsamples over the organised grid order (deterministic, cheap).
-        pts_idx = np.unique(np.linspace(0, n - 1, min(n, cfg.points_per_observation)).astype(np.int64))
-        pix_idx = np.unique(np.linspace(0, n - 1, min(n, cfg.pixels_per_observation)).astype(np.int64))
+        # Evenly spread subsamples over the organised grid order (deterministic, cheap; at
+        # most n of them, at least one index apart: no duplicates).
+        pts_idx = np.linspace(0, n - 1, min(n, cfg.points_per_observation)).astype(np.int64)
+        pix_idx = np.linspace(0, n - 1, min(n, cfg.pixels_per_observation)).astype(np.int64)
         detection = None
         if match.detection_index is not None:
             k = match.detection_index

@@ -28,7 +28,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import leg_points
 from hiper_cli.perceive.foreground.match import iou_matrix
-from hiper_cli.perceive.foreground.segment import Blob, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, sub_blob
 
 __all__ = ["drop_unseen_tables", "grid_components", "table_points", "unseen_table_top"]
 
@@ -39,9 +39,7 @@ TOP_THICKNESS_M = 0.04
 
 def _column_tops(points_map: FloatArray, cell_m: float) -> FloatArray:
     """For each point (N, 3), the highest point of its horizontal cell (``cell_m`` wide)."""
-    keys = np.floor(points_map[:, :2] / cell_m).astype(np.int64)
-    _, inverse = np.unique(keys, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    inverse = cell_inverse(points_map[:, :2], cell_m)
     tops = np.full(int(inverse.max()) + 1, -np.inf)
     np.maximum.at(tops, inverse, points_map[:, 2])
     return np.asarray(tops[inverse])
