@@ -10,7 +10,7 @@ log stayed ``unknown``; joining blobs by depth range instead of median depth bri
 (its back legs join it): 0.0249 m (median 0.0147 m). The background test at each sample's
 pixel-block mean with a margin of 0.0015 m per m² (was 0.005), no support below a blob cut by
 the image's lower edge, and 0.3 m of range slack: 0.0177 m (median 0.0110 m); the fourth chair
-is classified, and the tracker switches identity 3 times (a chair seen whole, then in parts).
+is classified, and the tracker switches identity 3 times.
 """
 
 from pathlib import Path

@@ -5,7 +5,7 @@ import pytest
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import inside_boxes, segment, support_below
+from hiper_cli.perceive.foreground.segment import cell_inverse, inside_boxes, segment, support_below
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 
@@ -91,3 +91,11 @@ def test_a_blob_cut_by_the_lower_image_edge_stands_on_nothing_known():
     assert support_below(blob, floor, cfg, CAMERA.height) == pytest.approx(0.0)
     blob.image_box_xyxy = np.array([*blob.image_box_xyxy[:3], float(CAMERA.height)])  # its feet out of view
     assert support_below(blob, floor, cfg, CAMERA.height) is None
+
+
+def test_cell_inverse_numbers_cells_like_unique_rows():
+    rng = np.random.default_rng(5)
+    for n in (1, 7, 300):
+        xy = rng.normal(0.0, 2.0, (n, 2))
+        _, expected = np.unique(np.floor(xy / 0.05).astype(np.int64), axis=0, return_inverse=True)
+        assert np.array_equal(cell_inverse(xy, 0.05), expected.reshape(-1))

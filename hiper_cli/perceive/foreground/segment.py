@@ -5,6 +5,9 @@
 2. Filter the background: drop the points inside the background instances' boxes (map frame,
    grown by a margin that grows with the squared depth like the sensor noise); the points
    are moved into the map frame once and each box tests only the grid block it projects to.
+   Each sample is tested at the mean depth of its pixel block (``background_block_mean``):
+   a quarter of the noise, so a tight margin. Points up to ``max_depth_slack_m`` beyond the
+   range are kept for objects that stand across it.
 3. Euclidean cluster extraction: two points join one cluster when they are at most
    grid neighbours (8-neighbourhood, or up to ``cluster_neighbour_cells`` apart along a row or
    a column, which bridges missing samples) and closer than
