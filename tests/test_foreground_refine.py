@@ -9,7 +9,7 @@ from hiper_cli.errors import ConfigError
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.segment import segment, table_leg_boxes
+from hiper_cli.perceive.foreground.segment import Blob, image_box, segment, table_leg_boxes
 from tests.fg_scene import (
     CAMERA,
     SceneBox,
@@ -222,8 +222,6 @@ def test_a_chair_back_leg_deeper_than_the_chair_median_joins_it():
 
 
 def _flat_blob(x0, y0, x1, y1, depth_m, step=4):
-    from hiper_cli.perceive.foreground.segment import Blob, image_box
-
     us, vs = np.meshgrid(np.arange(x0 + 2, x1, step), np.arange(y0 + 2, y1, step))
     uv = np.stack([us.ravel(), vs.ravel()], axis=1).astype(np.int32)
     z = np.full(len(uv), depth_m)
