@@ -200,8 +200,6 @@ def test_a_pole_behind_the_chair_just_outside_its_box_is_trimmed():
 
 def _synthetic_blob(depths_m, u0, v0):
     """A blob of points at these depths, one pixel column per point starting at (u0, v0)."""
-    from hiper_cli.perceive.foreground.segment import Blob
-
     z = np.asarray(depths_m, dtype=np.float64)
     uv = np.stack([np.full(len(z), u0), v0 + 2 * np.arange(len(z))], axis=1).astype(np.int32)
     x = (uv[:, 0] - CAMERA.cx) * z / CAMERA.fx
