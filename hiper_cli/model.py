@@ -12,6 +12,7 @@ knowledge base. Units: metres, seconds, radians.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 import uuid as _uuid
@@ -61,6 +62,10 @@ def json_default(value: Any) -> Any:
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
+# The corners of the unit cube [-1, 1]³, in ``Box3D.corners`` order.
+CORNER_SIGNS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+
+
 @dataclass(frozen=True)
 class Box3D:
     """An oriented box: centre (3,) and full extent (3,) in metres, axes ``R`` (3×3) in its frame.
@@ -80,9 +85,13 @@ class Box3D:
             raise DataError(
                 f"box: expected centre (3,), extent (3,), R (3, 3); got {c.shape}, {e.shape}, {R.shape}"
             )
-        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(e)) and np.all(np.isfinite(R))):
+        # Boxes are made per observation and per frame: one sum first (NaN or inf when a value
+        # is, or on overflow), the element-wise test only then.
+        total = float(c.sum() + e.sum() + R.sum())
+        finite = math.isfinite(total) or all(np.isfinite(a).all() for a in (c, e, R))
+        if not finite:
             raise DataError("box: centre, extent and R must be finite")
-        if np.any(e < 0):
+        if e.min() < 0:
             raise DataError(f"box: extent must be non-negative, got {e.tolist()}")
         object.__setattr__(self, "center_m", c)
         object.__setattr__(self, "extent_m", e)
@@ -99,8 +108,7 @@ class Box3D:
 
     def corners(self) -> NDArray[np.float64]:
         """The 8 corners (8, 3) in the box's frame."""
-        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
-        return self.center_m + (signs * (self.extent_m / 2.0)) @ self.R.T
+        return self.center_m + (CORNER_SIGNS * (self.extent_m / 2.0)) @ self.R.T
 
     def transformed(self, T_b_a: NDArray[np.float64]) -> Box3D:
         """This box (given in frame a) expressed in frame b."""

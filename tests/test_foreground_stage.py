@@ -150,3 +150,47 @@ def test_objects_rest_on_the_fitted_floor_plane_not_on_the_top_of_its_box():
     floor.data.pop("plane_map")  # no plane: the box as it is
     (box,) = support_boxes([floor])
     assert box.aabb()[1][2] == pytest.approx(0.01)
+
+
+class _RecordingDetector:
+    """The ``log`` detector, recording which frames it saw and on which thread."""
+
+    name = "recording"
+
+    def __init__(self):
+        from hiper_cli.perceive.detect.recorded import LogDetector
+
+        self.inner = LogDetector()
+        self.seen = []
+
+    def detect(self, frame):
+        import threading
+
+        self.seen.append((frame.pose_id, threading.current_thread().name))
+        return self.inner.detect(frame)
+
+
+def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker():
+    detector = _RecordingDetector()
+    stage = ForegroundStage(detector_instance=detector, pixel_step=2)
+    calls = []
+    prepare, process = stage.prepare, stage.process
+    stage.prepare = lambda frame: (calls.append(("prepare", frame.pose_id)), prepare(frame))[1]
+    stage.process = lambda frame, world: (calls.append(("process", frame.pose_id)), process(frame, world))[1]
+    frames = walker_frames(n=4)
+    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+    # the next frame goes to the detector before the current one is processed
+    assert calls == [
+        ("prepare", 1), ("process", 0), ("prepare", 2), ("process", 1),
+        ("prepare", 3), ("process", 2), ("process", 3),
+    ]  # fmt: skip
+    assert sorted(pose for pose, _ in detector.seen) == [0, 1, 2, 3]
+    assert all(name.startswith("hiper-detect") for _, name in detector.seen)
+    # same result as detecting each frame when it is processed
+    plain = ForegroundStage(detector="log", pixel_step=2, detector_threads=0)
+    world_plain, _ = run_stages(walker_frames(n=4), [plain], World(background=background_instances(room())))
+    ((a,), (b,)) = world.foreground.values(), world_plain.foreground.values()
+    assert a.class_name == b.class_name == "person"
+    assert len(a.data["trajectory"]) == 4
+    assert np.allclose(a.data["trajectory"], b.data["trajectory"])
+    assert len(a.observation_uuids) == len(b.observation_uuids) == 4

@@ -43,12 +43,23 @@ def run_stages(
 
     ``on_frame(frame, merged_result)`` is called after every frame, and once more with
     ``frame=None`` for what the stages flush in ``finish``. Each stage sees the world as
-    updated by the stages before it in the same frame.
+    updated by the stages before it in the same frame. A stage with a ``prepare(frame)``
+    method is handed the next frame before the current one is processed, to start work that
+    needs no world (the foreground stage runs its detector on it in a worker thread, so the
+    detector is busy while this frame's point cloud is processed).
     """
     world = world if world is not None else World()
     stats = RunStats()
-    for frame in frames:
+    ahead = [p for p in (getattr(stage, "prepare", None) for stage in stages) if callable(p)]
+    stream = iter(frames)
+    upcoming = next(stream, None)
+    while upcoming is not None:
+        frame = upcoming
+        upcoming = next(stream, None)
         start = time.perf_counter()
+        if upcoming is not None:
+            for prepare in ahead:
+                prepare(upcoming)
         merged = FrameResult()
         for stage in stages:
             t0 = time.perf_counter()

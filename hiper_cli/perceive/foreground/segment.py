@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import Box3D
+from hiper_cli.model import CORNER_SIGNS, Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
@@ -293,8 +293,9 @@ def _box_roi(
 ) -> tuple[slice, slice] | None:
     """The rows and columns of the subsampled grid a box (grown by a margin) can cover; None
     when it is out of view."""
-    grown = Box3D(box.center_m, box.extent_m + 2.0 * margin_m, box.R)
-    corners = grown.corners() @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+    half = (box.extent_m / 2.0 + margin_m) * CORNER_SIGNS  # the grown box's corners, box axes
+    R_cam = T_cam_map[:3, :3] @ box.R
+    corners = half @ R_cam.T + (T_cam_map[:3, :3] @ box.center_m + T_cam_map[:3, 3])
     z = corners[:, 2]
     h, w = shape
     if np.all(z < config.min_depth_m):

@@ -81,6 +81,7 @@ class ForegroundStage:
 
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
         self._pool: ThreadPoolExecutor | None = None
+        self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
         self._priors: dict[tuple[str, str], dict[str, Any]] = {}
         self._analyses_seen = -1
         self.tracker = Tracker(cfg, self._class_prior)
@@ -130,14 +131,26 @@ class ForegroundStage:
         dets = self.detector.detect(frame)
         return dets, time.perf_counter() - t0
 
+    def _submit(self, frame: Frame) -> Future[tuple[Detections, float]]:
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
+        return self._pool.submit(self._detect_timed, frame)
+
+    def prepare(self, frame: Frame) -> None:
+        """Start the detector on the next frame (``run_stages`` hands it over before it
+        processes the current one): the worker thread detects while this thread segments."""
+        if self.config.detector_threads:
+            self._ahead[id(frame)] = (frame, self._submit(frame))
+
     def process(self, frame: Frame, world: World) -> FrameResult:
         cfg = self.config
         t_start = time.perf_counter()
         future: Future[tuple[Detections, float]] | None = None
-        if cfg.detector_threads:
-            if self._pool is None:
-                self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
-            future = self._pool.submit(self._detect_timed, frame)
+        ahead = self._ahead.pop(id(frame), None)
+        if ahead is not None and ahead[0] is frame:
+            future = ahead[1]
+        elif cfg.detector_threads:
+            future = self._submit(frame)
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
@@ -219,6 +232,7 @@ class ForegroundStage:
 
     def finish(self, world: World) -> FrameResult:
         closed = self.tracker.close_all()
+        self._ahead.clear()
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None

@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -95,6 +96,7 @@ class Track:
     # per trajectory row: posterior covariance and the process noise (q, q_vertical) used
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
+    _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
 
     @property
     def position(self) -> FloatArray:
@@ -109,6 +111,11 @@ class Track:
         """The vote winner among the known classes seen at least ``min_class_observations``
         times, when it holds at least ``min_class_share`` of all known-class votes (two
         classes that keep swapping leave the track ``unknown``) and outweighs ``unknown``."""
+        if self._class_name is None:
+            self._class_name = self._vote_winner()
+        return self._class_name
+
+    def _vote_winner(self) -> str:
         known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
         eligible = [k for k in sorted(known) if self.class_counts.get(k, 0) >= self.min_class_observations]
         if not eligible:
@@ -125,15 +132,27 @@ class Track:
         return self.score_sum / max(self.hits, 1)
 
 
+@lru_cache(maxsize=64)
 def _process_noise(dt: float, q: float, q_vertical: float) -> FloatArray:
-    """Q of the constant-velocity model with white acceleration of variance q (z: q_vertical)."""
+    """Q of the constant-velocity model with white acceleration of variance q (z: q_vertical).
+    Cached (most frames share one dt): read-only."""
     Q = np.zeros((6, 6))
     for axis in range(3):
         var = q_vertical if axis == 2 else q
         Q[axis, axis] = var * dt**4 / 4.0
         Q[axis, axis + 3] = Q[axis + 3, axis] = var * dt**3 / 2.0
         Q[axis + 3, axis + 3] = var * dt**2
+    Q.setflags(write=False)
     return Q
+
+
+@lru_cache(maxsize=64)
+def _transition(dt: float) -> FloatArray:
+    """F of the constant-velocity model over ``dt``. Cached: read-only."""
+    F = np.eye(6)
+    F[:3, 3:] = np.eye(3) * dt
+    F.setflags(write=False)
+    return F
 
 
 def smooth_trajectory(track: Track) -> None:
@@ -238,10 +257,8 @@ class Tracker:
         if dt <= 0:
             return
         kf = track.kf
-        F = np.eye(6)
-        F[:3, 3:] = np.eye(3) * dt
         q = self._accel_noise(track.class_name) ** 2
-        kf.predict(F=F, Q=_process_noise(dt, q, q * self.config.vertical_noise_ratio**2))  # type: ignore[attr-defined]
+        kf.predict(F=_transition(dt), Q=_process_noise(dt, q, q * self.config.vertical_noise_ratio**2))  # type: ignore[attr-defined]
         track.last_time_s = stamp_s
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
@@ -260,14 +277,12 @@ class Tracker:
         factor = math.exp(-dt / self.config.velocity_decay_s)
         kf = track.kf
         kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
-        P = np.asarray(kf.P, dtype=np.float64).copy()  # type: ignore[attr-defined]
-        P[:3, 3:] *= factor
-        P[3:, :3] *= factor
+        # Position-velocity covariances shrink by a, velocity variances by a² and relax.
+        scale = np.array([1.0, 1.0, 1.0, factor, factor, factor])
         prior = self.config.velocity_prior_mps**2
         ratio = self.config.vertical_noise_ratio**2
-        P[3:, 3:] *= factor**2
-        P[3:, 3:] += (1.0 - factor**2) * np.diag([prior, prior, prior * ratio])
-        kf.P = P  # type: ignore[attr-defined]
+        relax = (1.0 - factor**2) * np.array([0.0, 0.0, 0.0, prior, prior, prior * ratio])
+        kf.P = kf.P * np.outer(scale, scale) + np.diag(relax)  # type: ignore[attr-defined]
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
         kf = track.kf
@@ -300,6 +315,7 @@ class Tracker:
         weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, 1e-3)
         track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
+        track._class_name = None
         track.score_sum += m.score
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map))
         track.observation_uuids.append(m.observation_uuid)
@@ -309,8 +325,10 @@ class Tracker:
         track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
-    def _gate(self, track: Track, stamp_s: float) -> tuple[float, float]:
-        """(base gate, gate): the gate is the base widened while a moving track searches."""
+    def _gate(self, track: Track, stamp_s: float, variance_m2: float | None = None) -> tuple[float, float]:
+        """(base gate, gate): the gate is the base widened while a moving track searches.
+        ``variance_m2``: the largest eigenvalue of the track's position covariance (computed
+        when not given)."""
         cfg = self.config
         dt = stamp_s - track.last_update_s
         prior = self.priors(track.class_name)
@@ -321,8 +339,9 @@ class Tracker:
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
-        P = np.asarray(track.kf.P, dtype=np.float64)[:3, :3]  # type: ignore[attr-defined]
-        sigma = float(np.sqrt(np.linalg.eigvalsh(P).max() + cfg.measurement_noise_m**2))
+        if variance_m2 is None:
+            variance_m2 = float(np.linalg.eigvalsh(track.kf.P[:3, :3]).max())  # type: ignore[attr-defined]
+        sigma = math.sqrt(variance_m2 + cfg.measurement_noise_m**2)
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
         return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
@@ -335,7 +354,12 @@ class Tracker:
         pred = np.array([t.position for t in self.tracks])
         obs = np.array([m.center_map for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
-        gates = np.array([self._gate(t, stamp_s) for t in self.tracks]).reshape(-1, 2)
+        # The filters' own uncertainty, all tracks in one eigenvalue call.
+        P = np.array([t.kf.P[:3, :3] for t in self.tracks])  # type: ignore[attr-defined]
+        variances = np.linalg.eigvalsh(P).max(axis=1)
+        gates = np.array(
+            [self._gate(t, stamp_s, float(v)) for t, v in zip(self.tracks, variances, strict=True)]
+        ).reshape(-1, 2)
         allowed = cost <= gates[:, 1:2]
         searched = cost > gates[:, 0:1]
         same_class = self.config.search_same_class
