@@ -76,7 +76,8 @@ def test_background_filter_matches_inside_boxes_on_rotated_boxes():
         R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
         boxes.append(Box3D(rng.uniform([1.5, -1, 0.5], [4, 1, 1.5]), rng.uniform(0.3, 1.5, 3), R))
     margin = np.full(z.shape, 0.05)
-    got = _filter_background(valid, P_map, margin, boxes, CAMERA, T, step, ForegroundConfig())
+    cols = [np.ascontiguousarray(P_map[..., k].ravel()) for k in range(3)]
+    got = _filter_background(valid, cols, margin, boxes, CAMERA, T, step, ForegroundConfig())
     expected = valid & ~inside_boxes(P_map.reshape(-1, 3), boxes, 0.05).reshape(z.shape)
     assert (got == expected).all() and (expected != valid).sum() > 20
 

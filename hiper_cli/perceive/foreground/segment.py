@@ -140,12 +140,15 @@ def _block_mean_depth(
     import cv2
 
     h, w = z.shape
-    full = np.zeros((h * step, w * step), dtype=np.float32)
-    rows, cols = min(depth_m.shape[0], h * step), min(depth_m.shape[1], w * step)
-    full[:rows, :cols] = depth_m[:rows, :cols]
-    if not np.isfinite(full).all():
+    if depth_m.shape == (h * step, w * step) and depth_m.dtype == np.float32:
+        full = depth_m  # the usual case: the grid tiles the image
+    else:
+        full = np.zeros((h * step, w * step), dtype=np.float32)
+        rows, cols = min(depth_m.shape[0], h * step), min(depth_m.shape[1], w * step)
+        full[:rows, :cols] = depth_m[:rows, :cols]
+    if not np.isfinite(full.sum(dtype=np.float64)):  # one reduction; rarely true
         full = np.nan_to_num(full, nan=0.0, posinf=0.0, neginf=0.0)
-    valid = (full > 0).astype(np.float32)
+    valid = np.greater(full, 0.0, out=np.empty(full.shape, dtype=np.float32), casting="unsafe")
     sum_z = cv2.resize(full, (w, h), interpolation=cv2.INTER_AREA).astype(np.float64)
     count = cv2.resize(valid, (w, h), interpolation=cv2.INTER_AREA).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -321,7 +324,7 @@ def _box_roi(
 
 def _filter_background(
     valid: NDArray[np.bool_],
-    P_map: FloatArray,
+    cols_map: Sequence[FloatArray],
     margin: FloatArray,
     boxes: Sequence[Box3D],
     camera: CameraIntrinsics,
@@ -329,33 +332,37 @@ def _filter_background(
     step: int,
     config: ForegroundConfig,
     noise: FloatArray | None = None,
+    rays_map: Sequence[FloatArray] | None = None,
 ) -> NDArray[np.bool_]:
     """``valid`` without the grid points inside any box; each box only visits the part of the
     grid it projects to.
 
-    ``margin`` (h, w) grows every box on every side. ``noise`` (h, w), when given, is the depth
-    noise of each point: it grows a box face by that noise projected on the face's normal (depth
-    noise moves a point along its viewing ray, so a floor seen at a grazing angle needs far less
-    margin than a wall seen head-on), at least ``background_noise_min_cos`` of it.
+    ``cols_map``: the points' map-frame x, y and z, each a flat (h·w,) array (contiguous
+    columns: a box axis along a map axis, the usual case of walls, floors and tables, then costs
+    one gather and one subtraction per candidate point). ``margin`` (h, w) grows every box on
+    every side. ``noise`` (h, w), when given, is the depth noise of each point: it grows a box
+    face by that noise projected on the face's normal (depth noise moves a point along its
+    viewing ray, so a floor seen at a grazing angle needs far less margin than a wall seen
+    head-on), at least ``background_noise_min_cos`` of it; ``rays_map`` are the unit viewing
+    rays (map frame, columns as ``cols_map``; from the points when not given).
     """
     h, w = valid.shape
     flat_valid = valid.ravel().copy()
     T_cam_map = np.asarray(np.linalg.inv(T_map_cam), dtype=np.float64)
     max_margin = float(margin.max()) if margin.size else 0.0
-    # Coordinates as contiguous columns: a box axis along a map axis (the usual case: walls,
-    # floors, tables) then costs one gather and one subtraction per candidate point.
-    cols_map = [np.ascontiguousarray(P_map[..., k].ravel()) for k in range(3)]
     M = margin.ravel()
     N: FloatArray | None = None
-    ray_cols: list[FloatArray] = []
+    ray_cols: Sequence[FloatArray] = ()
     if noise is not None and noise.size:
         max_margin += float(noise.max())
         N = noise.ravel()
-        rays = P_map.reshape(-1, 3) - T_map_cam[:3, 3]
-        rays /= np.maximum(np.linalg.norm(rays, axis=-1, keepdims=True), 1e-9)
-        ray_cols = [np.ascontiguousarray(rays[:, k]) for k in range(3)]
+        if rays_map is None:
+            rays = np.stack(cols_map, axis=1) - T_map_cam[:3, 3]
+            rays /= np.maximum(np.linalg.norm(rays, axis=-1, keepdims=True), 1e-9)
+            rays_map = [np.ascontiguousarray(rays[:, k]) for k in range(3)]
+        ray_cols = rays_map
 
-    def along(columns: list[FloatArray], idx: NDArray[np.int64], direction: FloatArray) -> FloatArray:
+    def along(columns: Sequence[FloatArray], idx: NDArray[np.int64], direction: FloatArray) -> FloatArray:
         main = int(np.argmax(np.abs(direction)))
         if abs(direction[main]) > 1.0 - 1e-9:
             return np.asarray(columns[main][idx] * np.sign(direction[main]), dtype=np.float64)
@@ -479,17 +486,26 @@ def segment(
             margin, along = np.full(z.shape, config.background_margin_m), noise
         else:
             margin, along = config.background_margin_m + noise, None
-        test_map = map_full.reshape(P.shape)
+        # The points tested (block means where usable) as map-frame columns, and their unit
+        # viewing rays: x = rx·z, y = ry·z, so the ray is (rx, ry, 1) normalised, whatever z.
+        ray_x, ray_y, z_test = rx, ry, z
         if config.background_block_mean and step > 1:
             tol = config.background_block_tolerance * (config.background_margin_m + noise)
-            z_mean, use = _block_mean_depth(depth_m, step, z, tol)
+            z_test, use = _block_mean_depth(depth_m, step, z, tol)
             centre = (step - 1) / 2.0 - step // 2  # the block's centre, from its sample's pixel
-            ray_x, ray_y = rx + centre / camera.fx, ry + centre / camera.fy
-            mean_cam = np.stack([ray_x * z_mean, ray_y * z_mean, z_mean], axis=-1)
-            test_cam = np.where(use[..., None], mean_cam, P)
-            test_map = (test_cam.reshape(-1, 3) @ R.T + t).reshape(P.shape)
+            ray_x = np.where(use, rx + centre / camera.fx, rx)
+            ray_y = np.where(use, ry + centre / camera.fy, ry)
+        x_cam, y_cam = (ray_x * z_test).ravel(), (ray_y * z_test).ravel()
+        z_cam = z_test.ravel()
+        cols_map = [R[k, 0] * x_cam + R[k, 1] * y_cam + R[k, 2] * z_cam + t[k] for k in range(3)]
+        rays_map = None
+        if along is not None:
+            inv_norm = 1.0 / np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0).ravel()
+            ux, uy = ray_x.ravel() * inv_norm, ray_y.ravel() * inv_norm
+            rays_map = [R[k, 0] * ux + R[k, 1] * uy + R[k, 2] * inv_norm for k in range(3)]
         valid = _filter_background(
-            valid, test_map, margin, background_boxes_map, camera, T_map_cam, step, config, along,
+            valid, cols_map, margin, background_boxes_map, camera, T_map_cam, step, config, along,
+            rays_map,
         )
     stats.after_background = int(valid.sum())
     t2 = time.perf_counter()
