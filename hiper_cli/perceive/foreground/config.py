@@ -233,6 +233,13 @@ class ForegroundConfig:
     walker_classes: tuple[str, ...] = ("person",)
     """Classes that walk: their tracks use ``walker_accel_noise_mps2`` and
     ``walker_min_size_ratio``."""
+    settled_hits: int = 15
+    """A track not of a walker class, with at least this many observations and not moving
+    (``moving_speed_mps``), is settled: it only takes an observation whose box overlaps its
+    own grown by ``settled_overlap_m``. Something that stood still is where it stood: the 2 cm
+    sliver of a door frame must not take the person walking past it half a metre away, and
+    turn its standing rows into the person's (0: off) ..."""
+    settled_overlap_m: float = 0.1
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15

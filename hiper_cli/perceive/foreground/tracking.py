@@ -345,6 +345,13 @@ class Tracker:
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
         return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
+    def _settled(self, track: Track) -> bool:
+        """Whether a track stood still long enough to be known where it is (``settled_hits``)."""
+        cfg = self.config
+        if cfg.settled_hits <= 0 or track.hits < cfg.settled_hits or track.class_name in cfg.walker_classes:
+            return False
+        return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
+
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated Hungarian assignment."""
         from scipy.optimize import linear_sum_assignment
@@ -369,6 +376,11 @@ class Tracker:
         walkers, min_ratio = self.config.walker_classes, self.config.walker_min_size_ratio
         for i, t in enumerate(self.tracks):
             cls = t.class_name
+            if self._settled(t):
+                reach = t.extent_m / 2.0 + self.config.settled_overlap_m
+                for j, m in enumerate(measurements):
+                    if np.any(np.abs(m.center_map - t.position) > reach + m.extent_map / 2.0):
+                        allowed[i, j] = False
             for j, m in enumerate(measurements):
                 if not _compatible(cls, m.class_name):
                     cost[i, j] += self.config.class_mismatch_m
