@@ -146,3 +146,17 @@ def test_frame_without_depth_gives_nothing(method):
     nan = type(frame)(**{**frame.__dict__, "depth_m": np.full_like(frame.depth_m, np.nan)})
     assert observe(empty, BackgroundConfig(method=method)) == []
     assert observe(nan, BackgroundConfig(method=method)) == []
+
+
+def test_a_chair_back_behind_the_table_at_its_height_is_not_part_of_the_top():
+    table = SceneBox(20, "table", (2.6, 2.0, 0.71), (3.8, 2.8, 0.75))
+    back = SceneBox(21, "chair", (2.8, 3.0, 0.62), (3.6, 3.04, 0.90))  # 0.2 m behind the far edge
+    pose = look_at((1.5, 0.8, 1.3), (3.2, 2.4, 0.6))
+
+    def table_far_edge_y(**options):
+        world, _ = _run([*box_room(), table, back], [pose], **options)
+        (top,) = _by_class(world)["table"]
+        return top.box.aabb()[1][1]
+
+    assert table_far_edge_y() == pytest.approx(2.8, abs=0.05)
+    assert table_far_edge_y(join_jump_frac=0.0) > 2.95  # without the rule the top takes the back's strip

@@ -5,7 +5,7 @@ import pytest
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import cell_inverse, inside_boxes, segment, support_below
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, inside_boxes, segment, support_below
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 
@@ -82,7 +82,7 @@ def test_background_filter_matches_inside_boxes_on_rotated_boxes():
     assert (got == expected).all() and (expected != valid).sum() > 20
 
 
-def test_a_blob_cut_by_the_lower_image_edge_stands_on_nothing_known():
+def test_a_blob_whose_base_is_cut_by_the_lower_image_edge_stands_on_nothing_known():
     boxes = [*room(), person(10, 3.0, 0.0)]
     frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
     bg = background_instances(boxes)
@@ -90,8 +90,18 @@ def test_a_blob_cut_by_the_lower_image_edge_stands_on_nothing_known():
     cfg = ForegroundConfig(pixel_step=2)
     (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg, floor)
     assert support_below(blob, floor, cfg, CAMERA.height) == pytest.approx(0.0)
-    blob.image_box_xyxy = np.array([*blob.image_box_xyxy[:3], float(CAMERA.height)])  # its feet out of view
-    assert support_below(blob, floor, cfg, CAMERA.height) is None
+    z = blob.points_map[:, 2]
+    edge_v = CAMERA.height - 1
+    # the lowest points at the image's lower edge: the feet are out of view
+    feet = blob.pixels_uv.copy()
+    feet[z <= z.min() + 0.005, 1] = edge_v
+    cut = Blob(blob.points_cam, blob.points_map, feet, np.array([*blob.image_box_xyxy[:3], CAMERA.height]))
+    assert support_below(cut, floor, cfg, CAMERA.height) is None
+    # a higher part at the edge (a chair's front legs cut, its back feet in view): it still stands
+    head = blob.pixels_uv.copy()
+    head[z >= z.max() - 0.05, 1] = edge_v
+    part = Blob(blob.points_cam, blob.points_map, head, np.array([*blob.image_box_xyxy[:3], CAMERA.height]))
+    assert support_below(part, floor, cfg, CAMERA.height) == pytest.approx(0.0)
 
 
 def test_cell_inverse_numbers_cells_like_unique_rows():

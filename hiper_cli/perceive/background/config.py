@@ -46,6 +46,10 @@ class BackgroundConfig:
     inlier_m: float = 0.03  # point-to-plane distance of an inlier at 1 m (grows with depth)
     min_plane_cells: int = 4
     refine_passes: int = 2  # assign samples to the closest plane and refit, this many times
+    # a plane keeps only the samples it reaches from its own cells through neighbours whose
+    # depths differ by at most this fraction (a chair back behind a table top's far edge, at
+    # the top's height, is coplanar with it but 0.45 m behind; 0: off)
+    join_jump_frac: float = 0.05
     # ransac extraction (the paper's method)
     ransac_max_planes: int = 8
     ransac_iterations: int = 500

@@ -204,6 +204,49 @@ def _join_regions(cells: list[NDArray[np.bool_]], n: FloatArray, s1: FloatArray,
         cells = [c for k, c in enumerate(cells) if k not in pair] + [cells[a] | cells[b]]
 
 
+def _smooth_neighbours(grid: SampleGrid, jump_frac: float) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    """Whether each sample and its right / lower neighbour lie on one surface: both valid and
+    their depths within ``jump_frac`` of the nearer one. Shapes (h, w - 1) and (h - 1, w)."""
+    z = grid.points_cam[..., 2]
+    v = grid.valid
+    a, b = z[:, :-1], z[:, 1:]
+    right = v[:, :-1] & v[:, 1:] & (np.abs(b - a) <= jump_frac * np.minimum(a, b))
+    a, b = z[:-1], z[1:]
+    down = v[:-1] & v[1:] & (np.abs(b - a) <= jump_frac * np.minimum(a, b))
+    return right, down
+
+
+def _reachable(
+    label: NDArray[np.int64], core: NDArray[np.bool_], joined: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+    shape: tuple[int, int],
+) -> NDArray[np.int64]:
+    """``label`` without the samples a plane cannot reach from its own cells through image
+    neighbours of the same label and no depth jump: a chair back behind a table, seen just
+    above the table's far edge at the table's height, is within the inlier distance of the
+    top's plane but 0.45 m behind it."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    h, w = shape
+    lab = label.reshape(h, w)
+    right, down = joined
+    has = np.flatnonzero(label >= 0)
+    node = np.full((h, w), -1, dtype=np.int64)  # graph nodes: the labelled samples only
+    node.ravel()[has] = np.arange(len(has))
+    same_r = right & (lab[:, :-1] == lab[:, 1:]) & (lab[:, :-1] >= 0)
+    same_d = down & (lab[:-1] == lab[1:]) & (lab[:-1] >= 0)
+    r = np.concatenate([node[:, :-1][same_r], node[:-1][same_d]])
+    c = np.concatenate([node[:, 1:][same_r], node[1:][same_d]])
+    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(len(has), len(has)))
+    n_comp, comp = connected_components(graph, directed=False)
+    # components never mix labels: keep those holding a core sample of their own plane
+    keep = np.zeros(n_comp, dtype=bool)
+    keep[comp[core[label[has], has]]] = True
+    out = label.copy()
+    out[has[~keep[comp]]] = -1
+    return out
+
+
 def _refine(grid: SampleGrid, planes: FloatArray, region_cells: list[NDArray[np.bool_]],
             cfg: BackgroundConfig, cell: int) -> list[PlaneSegment]:
     """Give every sample near a region to its closest plane, then refit each plane."""
@@ -215,22 +258,27 @@ def _refine(grid: SampleGrid, planes: FloatArray, region_cells: list[NDArray[np.
     threshold = cfg.inlier_m * np.maximum(pts[:, 2], 1.0)
     # where each plane may take samples: its cells and their neighbours
     near = np.zeros((len(planes), h * w), bool)
+    core = np.zeros((len(planes), h * w), bool)  # the samples of its own cells
     kernel = np.ones((3, 3), np.uint8)
     for k, cells in enumerate(region_cells):
-        grown = cv2.dilate(cells.astype(np.uint8), kernel)
-        up = np.zeros((h, w), np.uint8)
-        big = np.repeat(np.repeat(grown, cell, axis=0), cell, axis=1)
-        up[: big.shape[0], : big.shape[1]] = big[:h, :w]
-        near[k] = up.reshape(-1).astype(bool) & valid
+        for grid_k, cells_k in ((near, cv2.dilate(cells.astype(np.uint8), kernel)), (core, cells)):
+            up = np.zeros((h, w), np.uint8)
+            big = np.repeat(np.repeat(np.asarray(cells_k, np.uint8), cell, axis=0), cell, axis=1)
+            up[: big.shape[0], : big.shape[1]] = big[:h, :w]
+            grid_k[k] = up.reshape(-1).astype(bool) & valid
+    joined = _smooth_neighbours(grid, cfg.join_jump_frac) if cfg.join_jump_frac > 0 else None
     rms = np.full(len(planes), np.inf)
     out: list[PlaneSegment] = []
-    for _ in range(max(cfg.refine_passes, 1)):
+    passes = max(cfg.refine_passes, 1)
+    for pass_k in range(passes):
         dist = np.abs(pts @ planes[:, :3].T + planes[:, 3]).T  # (K, h*w)
         # after the first pass each plane accepts samples within 2.5 of its own spreads
         limit = np.minimum(threshold[None], np.maximum(2.5 * rms, 0.01)[:, None])
         dist = np.where(near & (dist < limit), dist, np.inf)
         best = np.argmin(dist, axis=0)
         label = np.where(np.isfinite(dist.min(axis=0)), best, -1)
+        if joined is not None and pass_k == passes - 1:  # the final masks (a strip moves no fit)
+            label = _reachable(label, core, joined, (h, w))
         out = []
         for k in range(len(planes)):
             sel = np.flatnonzero(label == k)

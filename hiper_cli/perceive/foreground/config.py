@@ -103,6 +103,7 @@ class ForegroundConfig:
     fragment_distance_m: float = 0.3
     """... when its centre is this close to that cluster's box (grazing sides, heads)."""
     support_gap_m: float = 0.1
+    support_edge_band_m: float = 0.01
     """A blob whose base is at most the filter margin plus this above a floor or table top
     stands on it: its box reaches down to the support (0.25 m, to catch chairs whose thin legs
     lose their lowest samples, moved the centre away from what the sensor sees: worse on the

@@ -431,10 +431,15 @@ def support_below(
     plus ``support_gap_m`` above it (thin legs and feet lose their lowest samples to the margin
     and to the subsampling). None for a blob that reaches the lower edge of the image
     (``image_height``): its base is out of view, and its box stays what the camera sees."""
-    if image_height is not None and blob.image_box_xyxy[3] >= image_height - config.pixel_step:
-        return None
     lo = blob.points_map.min(axis=0)
     hi = blob.points_map.max(axis=0)
+    edge_v = None if image_height is None else image_height - config.pixel_step
+    if edge_v is not None and blob.image_box_xyxy[3] >= edge_v:
+        # Cut by the lower edge: the base is out of view when the lowest points are at the edge
+        # (a chair's front legs may be cut while its back feet stand in view).
+        low = blob.points_map[:, 2] <= lo[2] + config.support_edge_band_m
+        if np.any(blob.pixels_uv[low, 1] >= edge_v):
+            return None
     depth = float(np.median(blob.points_cam[:, 2]))
     margin = config.background_margin_m + config.background_margin_per_m2 * depth * depth
     best: float | None = None
