@@ -103,11 +103,13 @@ class ForegroundConfig:
     fragment_distance_m: float = 0.3
     """... when its centre is this close to that cluster's box (grazing sides, heads)."""
     support_gap_m: float = 0.1
-    support_edge_band_m: float = 0.01
     """A blob whose base is at most the filter margin plus this above a floor or table top
     stands on it: its box reaches down to the support (0.25 m, to catch chairs whose thin legs
     lose their lowest samples, moved the centre away from what the sensor sees: worse on the
     tuning logs)."""
+    support_edge_band_m: float = 0.01
+    """... unless its lowest points (within this of its lowest) reach the image's lower edge: its
+    base is out of view (a chair cut there by its front legs, its back feet in view, stands)."""
     min_cluster_points: int = 15
     max_cluster_points: int = 8000
     max_cluster_extent_m: float = 3.0

@@ -429,8 +429,9 @@ def support_below(
 ) -> float | None:
     """Top height of the support the blob stands on, if its base is within the filter margin
     plus ``support_gap_m`` above it (thin legs and feet lose their lowest samples to the margin
-    and to the subsampling). None for a blob that reaches the lower edge of the image
-    (``image_height``): its base is out of view, and its box stays what the camera sees."""
+    and to the subsampling). None for a blob whose lowest points (``support_edge_band_m``)
+    reach the lower edge of the image (``image_height``): its base is out of view, and its box
+    stays what the camera sees."""
     lo = blob.points_map.min(axis=0)
     hi = blob.points_map.max(axis=0)
     edge_v = None if image_height is None else image_height - config.pixel_step
