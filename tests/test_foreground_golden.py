@@ -10,7 +10,9 @@ log stayed ``unknown``; joining blobs by depth range instead of median depth bri
 (its back legs join it): 0.0249 m (median 0.0147 m). The background test at each sample's
 pixel-block mean with a margin of 0.0015 m per m² (was 0.005), no support below a blob cut by
 the image's lower edge, and 0.3 m of range slack: 0.0177 m (median 0.0110 m); the fourth chair
-is classified, and the tracker switches identity 3 times.
+is classified, and the tracker switches identity 3 times. Sixth round: a class needs 4
+observations (was 3; this 4 Hz log's fourth chair has 3 and stays ``unknown``), support unless
+a blob's lowest points are at the lower edge, settled tracks: 0.0161 m (median 0.0103 m).
 """
 
 from pathlib import Path
@@ -25,9 +27,9 @@ FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "house_small"
 def test_golden_table_iii_on_the_fixture():
     report = evaluate_foreground(FIXTURE, detector="truth", ablation=False, background="truth")
     ours = report["ours"]
-    assert ours["classification"] == {"chair": {"tp": 4, "fp": 0}, "person": {"tp": 1, "fp": 0}}
-    assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (2, 7, 103)
+    assert ours["classification"] == {"chair": {"tp": 3, "fp": 0}, "person": {"tp": 1, "fp": 0}}
+    assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (3, 7, 103)
     assert ours["identity_switches"] == 3 and ours["truth_instances_seen"] == 7
-    assert ours["localisation_classified_m"][0] == pytest.approx(0.0177, abs=0.003)
-    assert ours["localisation_visible_median_m"] == pytest.approx(0.0110, abs=0.003)
+    assert ours["localisation_classified_m"][0] == pytest.approx(0.0161, abs=0.003)
+    assert ours["localisation_visible_median_m"] == pytest.approx(0.0103, abs=0.003)
     assert ours["localisation_box_centre_m"][0] == pytest.approx(0.298, abs=0.05)

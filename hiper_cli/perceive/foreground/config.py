@@ -170,7 +170,7 @@ class ForegroundConfig:
     min_gate_m: float = 0.5
     """... and a settled track gates at gate_sigmas times its predicted position σ, at least
     min_gate_m (a chair does not take the bottle on the table beside it)."""
-    min_class_observations: int = 3
+    min_class_observations: int = 4
     """A track takes a class only after at least this many observations of it (one confused
     detection cannot name a track) ..."""
     min_class_share: float = 0.6
@@ -242,7 +242,7 @@ class ForegroundConfig:
     own grown by ``settled_overlap_m``. Something that stood still is where it stood: the 2 cm
     sliver of a door frame must not take the person walking past it half a metre away, and
     turn its standing rows into the person's (0: off) ..."""
-    settled_overlap_m: float = 0.1
+    settled_overlap_m: float = 0.05
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
