@@ -343,8 +343,8 @@ def _filter_background(
     every side. ``noise`` (h, w), when given, is the depth noise of each point: it grows a box
     face by that noise projected on the face's normal (depth noise moves a point along its
     viewing ray, so a floor seen at a grazing angle needs far less margin than a wall seen
-    head-on), at least ``background_noise_min_cos`` of it; ``rays_map`` are the unit viewing
-    rays (map frame, columns as ``cols_map``; from the points when not given).
+    head-on), at least ``background_noise_min_cos`` of it; ``rays_map`` (required with
+    ``noise``) are the unit viewing rays, map frame, columns as ``cols_map``.
     """
     h, w = valid.shape
     flat_valid = valid.ravel().copy()
@@ -357,9 +357,7 @@ def _filter_background(
         max_margin += float(noise.max())
         N = noise.ravel()
         if rays_map is None:
-            rays = np.stack(cols_map, axis=1) - T_map_cam[:3, 3]
-            rays /= np.maximum(np.linalg.norm(rays, axis=-1, keepdims=True), 1e-9)
-            rays_map = [np.ascontiguousarray(rays[:, k]) for k in range(3)]
+            raise ValueError("_filter_background: noise needs rays_map")
         ray_cols = rays_map
 
     def along(columns: Sequence[FloatArray], idx: NDArray[np.int64], direction: FloatArray) -> FloatArray:
