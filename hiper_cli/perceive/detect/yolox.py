@@ -131,7 +131,10 @@ class YoloxDetector:
 
     def detect(self, frame: Frame) -> Detections:
         canvas, r, _ = letterbox(frame.rgb, self.size_hw, centre=False)
-        blob = np.ascontiguousarray(canvas[:, :, ::-1].transpose(2, 0, 1), dtype=np.float32)[None]
+        # YOLOX takes BGR, channels first, float pixel values: one plane copy per channel.
+        blob = np.empty((1, 3, *canvas.shape[:2]), dtype=np.float32)
+        for k in range(3):
+            blob[0, k] = canvas[:, :, 2 - k]
         (output,) = self.session.run(None, {self.input_name: blob})
         xyxy, class_ids, scores = decode_yolox(
             output, self.size_hw, r, score_threshold=self.score_threshold, nms_iou=self.nms_iou

@@ -26,6 +26,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -322,6 +323,19 @@ def _box_roi(
     return slice(r0, r1), slice(c0, c1)
 
 
+def _along(columns: Sequence[FloatArray], index: Any, direction: FloatArray) -> FloatArray:
+    """The coordinate along ``direction`` of the points ``columns[k][index]`` (x, y, z
+    columns); only the columns the direction needs are indexed (one for an axis-aligned box)."""
+    main = int(np.argmax(np.abs(direction)))
+    if abs(direction[main]) > 1.0 - 1e-9:
+        return np.asarray(columns[main][index] * np.sign(direction[main]), dtype=np.float64)
+    out = np.zeros(columns[0][index].shape)
+    for k in range(3):
+        if direction[k] != 0.0:
+            out += columns[k][index] * direction[k]
+    return out
+
+
 def _filter_background(
     valid: NDArray[np.bool_],
     cols_map: Sequence[FloatArray],
@@ -360,15 +374,11 @@ def _filter_background(
             raise ValueError("_filter_background: noise needs rays_map")
         ray_cols = rays_map
 
-    def along(columns: Sequence[FloatArray], idx: NDArray[np.int64], direction: FloatArray) -> FloatArray:
-        main = int(np.argmax(np.abs(direction)))
-        if abs(direction[main]) > 1.0 - 1e-9:
-            return np.asarray(columns[main][idx] * np.sign(direction[main]), dtype=np.float64)
-        out = np.zeros(len(idx))
-        for k in range(3):
-            if direction[k] != 0.0:
-                out += columns[k][idx] * direction[k]
-        return out
+    grid_valid = flat_valid.reshape(h, w)  # a view: the boxes' removals show in it
+    grids = [c.reshape(h, w) for c in cols_map]
+    ray_grids = [c.reshape(h, w) for c in ray_cols]
+    M_grid = M.reshape(h, w)
+    N_grid = None if N is None else N.reshape(h, w)
 
     # Largest boxes first (floor, walls): they remove most points, the others test fewer.
     for box in sorted(boxes, key=lambda b: -b.volume_m3):
@@ -376,18 +386,29 @@ def _filter_background(
         if roi is None:
             continue
         rows, cols = roi
-        local_idx = np.flatnonzero(flat_valid.reshape(h, w)[rows, cols])
+        # Thinnest axis first (walls, floors): few points survive it, the others test fewer.
+        # The first test runs on the box's image rectangle as is (no gather).
+        axes = np.argsort(box.extent_m)
+        direction = box.R[:, axes[0]]
+        d = _along(grids, (rows, cols), direction) - float(box.center_m @ direction)
+        allowed = M_grid[rows, cols]
+        if N_grid is not None:
+            cos = np.maximum(np.abs(_along(ray_grids, (rows, cols), direction)),
+                             config.background_noise_min_cos)
+            allowed = allowed + N_grid[rows, cols] * cos
+        keep = grid_valid[rows, cols] & (np.abs(d) - box.extent_m[axes[0]] / 2.0 <= allowed)
+        local_idx = np.flatnonzero(keep)
         if len(local_idx) == 0:
             continue
         width = cols.stop - cols.start
         cand = (local_idx // width + rows.start) * w + local_idx % width + cols.start
-        # Thinnest axis first (walls, floors): few points survive it, the others test fewer.
-        for axis in np.argsort(box.extent_m):
+        for axis in axes[1:]:
             direction = box.R[:, axis]
-            d = along(cols_map, cand, direction) - float(box.center_m @ direction)
+            d = _along(cols_map, cand, direction) - float(box.center_m @ direction)
             allowed = M[cand]
             if N is not None:
-                cos = np.maximum(np.abs(along(ray_cols, cand, direction)), config.background_noise_min_cos)
+                cos = np.maximum(np.abs(_along(ray_cols, cand, direction)),
+                                 config.background_noise_min_cos)
                 allowed = allowed + N[cand] * cos
             cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= allowed]
             if len(cand) == 0:

@@ -325,17 +325,21 @@ class Tracker:
         track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
-    def _gate(self, track: Track, stamp_s: float, variance_m2: float | None = None) -> tuple[float, float]:
+    def _gate(
+        self, track: Track, stamp_s: float, variance_m2: float | None = None, moving: bool | None = None
+    ) -> tuple[float, float]:
         """(base gate, gate): the gate is the base widened while a moving track searches.
-        ``variance_m2``: the largest eigenvalue of the track's position covariance (computed
-        when not given)."""
+        ``variance_m2``: the largest eigenvalue of the track's position covariance; ``moving``:
+        ``_was_moving`` of the track (each computed when not given)."""
         cfg = self.config
         dt = stamp_s - track.last_update_s
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
             return learned, learned
-        searching = track.class_name in cfg.search_classes and _was_moving(track, cfg)
+        if moving is None:
+            moving = _was_moving(track, cfg)
+        searching = track.class_name in cfg.search_classes and moving
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
@@ -345,12 +349,13 @@ class Tracker:
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
         return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
-    def _settled(self, track: Track) -> bool:
-        """Whether a track stood still long enough to be known where it is (``settled_hits``)."""
+    def _settled(self, track: Track, moving: bool) -> bool:
+        """Whether a track stood still long enough to be known where it is (``settled_hits``);
+        ``moving``: ``_was_moving`` of the track."""
         cfg = self.config
         if cfg.settled_hits <= 0 or track.hits < cfg.settled_hits or track.class_name in cfg.walker_classes:
             return False
-        return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
+        return not moving and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated Hungarian assignment."""
@@ -364,33 +369,34 @@ class Tracker:
         # The filters' own uncertainty, all tracks in one eigenvalue call.
         P = np.array([t.kf.P[:3, :3] for t in self.tracks])  # type: ignore[attr-defined]
         variances = np.linalg.eigvalsh(P).max(axis=1)
-        gates = np.array(
-            [self._gate(t, stamp_s, float(v)) for t, v in zip(self.tracks, variances, strict=True)]
-        ).reshape(-1, 2)
+        moving = [_was_moving(t, self.config) for t in self.tracks]
+        gates = np.array([
+            self._gate(t, stamp_s, float(v), mv)
+            for t, v, mv in zip(self.tracks, variances, moving, strict=True)
+        ]).reshape(-1, 2)
         allowed = cost <= gates[:, 1:2]
         searched = cost > gates[:, 0:1]
-        same_class = self.config.search_same_class
+        cfg = self.config
         # lost: more than one frame missed (picked up again after one miss, the gap is 2 frames)
-        grace = max(self.config.velocity_decay_grace_s, 2.5 * self._frame_dt_s)
-        lost = [stamp_s - t.last_update_s > grace for t in self.tracks]
-        walkers, min_ratio = self.config.walker_classes, self.config.walker_min_size_ratio
+        grace = max(cfg.velocity_decay_grace_s, 2.5 * self._frame_dt_s)
+        classes = np.array([m.class_name for m in measurements], dtype=object)
+        unknown = classes == UNKNOWN
+        sizes = np.array([_size_m(m.extent_map) for m in measurements])
+        half_extents = np.array([m.extent_map for m in measurements]) / 2.0
         for i, t in enumerate(self.tracks):
             cls = t.class_name
-            if self._settled(t):
-                reach = t.extent_m / 2.0 + self.config.settled_overlap_m
-                for j, m in enumerate(measurements):
-                    if np.any(np.abs(m.center_map - t.position) > reach + m.extent_map / 2.0):
-                        allowed[i, j] = False
-            for j, m in enumerate(measurements):
-                if not _compatible(cls, m.class_name):
-                    cost[i, j] += self.config.class_mismatch_m
-                if cls in walkers and _size_m(m.extent_map) < min_ratio * t.max_size_m:
-                    allowed[i, j] = False
-                if same_class and searched[i, j] and lost[i] and cls in same_class and m.class_name != cls:
-                    # an unmatched blob as big as the person may be the person (cut by the border)
-                    person_sized = _size_m(m.extent_map) >= self.config.search_min_size_ratio * t.max_size_m
-                    if not (m.class_name == UNKNOWN and person_sized):
-                        allowed[i, j] = False
+            if self._settled(t, moving[i]):
+                reach = t.extent_m / 2.0 + cfg.settled_overlap_m
+                allowed[i] &= np.all(np.abs(obs - t.position) <= reach + half_extents, axis=1)
+            if cls != UNKNOWN:
+                cost[i, ~unknown & (classes != cls)] += cfg.class_mismatch_m
+            if cls in cfg.walker_classes:
+                allowed[i] &= sizes >= cfg.walker_min_size_ratio * t.max_size_m
+            if cls in cfg.search_same_class and stamp_s - t.last_update_s > grace:
+                # Lost and searching: another class only when it is an unmatched blob as big as
+                # the person (the person cut by the border).
+                person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
+                allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
         big = 1e6
         rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
         return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
