@@ -47,3 +47,29 @@ def test_columns_that_go_higher_or_stop_lower_are_not_legs():
     assert not legs[: len(back_leg) + len(front_leg)].any()
     assert legs[len(back_leg) + len(front_leg):].all()
     assert not leg_points(table_leg + np.array([3.0, 0.0, 0.0]), [table], cfg).any()  # far from the table
+
+
+def test_the_rim_of_a_table_top_no_longer_joins_a_chair_to_a_vase_on_the_table():
+    # The background layer knows the top as a thin plane; the top's edge under it survives the
+    # filter and links the chair in front of the table to the vase standing at the edge.
+    # (Block means off: the rim is a single row of samples here, a block would mix in the top.)
+    cfg = ForegroundConfig(pixel_step=2, table_rim_depth_m=0.08, background_block_mean=False)
+    top_plane = Box3D(np.array([3.0, 0.6, 0.75]), np.array([0.8, 1.0, 0.01]))
+    slab = SceneBox(30, np.array([3.0, 0.6, 0.715]), np.array([0.8, 1.0, 0.07]), "table")
+    chair = SceneBox(31, np.array([2.36, 0.6, 0.3]), np.array([0.4, 0.4, 0.6]), "chair")
+    vase = SceneBox(32, np.array([2.68, 0.6, 0.86]), np.array([0.16, 0.16, 0.22]), "vase")
+    frame = make_frame([*room(), slab, chair, vase], pose_looking_x(x=0.3, z=1.2), 0.0, 0)
+    filters = [i.box for i in background_instances(room()).values()] + [top_plane]
+    (merged,) = segment(frame.depth_m, CAMERA, frame.T_map_cam, filters, cfg)[0]
+    assert merged.points_map[:, 2].max() > 0.9  # chair, rim and vase in one blob
+    # Without the rim rule the blob stays one (the rim is no leg).
+    (same,) = drop_table_legs([merged], [top_plane], cfg, 2, CAMERA.width, CAMERA.height)
+    assert len(same.points_map) == len(merged.points_map)
+    parts = drop_table_legs([merged], [top_plane], cfg, 2, CAMERA.width, CAMERA.height, rims=True)
+    assert len(parts) == 2
+    low, high = sorted(parts, key=lambda b: b.points_map[:, 2].max())
+    assert low.points_map[:, 2].max() == pytest.approx(0.6, abs=0.02)  # the chair, alone
+    assert low.points_map[:, 0].mean() == pytest.approx(2.2, abs=0.05)
+    assert high.points_map[:, 0].mean() == pytest.approx(2.62, abs=0.03)  # the vase
+    assert np.mean(high.points_map[:, 2] > 0.75) > 0.8  # with the bit of rim right below it
+    assert len(low.points_map) + len(high.points_map) < len(merged.points_map)  # the rim left

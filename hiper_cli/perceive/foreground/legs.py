@@ -13,6 +13,15 @@ from at least ``table_leg_min_height_m`` below the top to within ``table_leg_top
 it, and no higher, is a leg, and its points leave the blob. A chair's back legs go on up to its
 backrest (higher than the table), its front legs stop at the seat (far below the top), a person
 is taller still: they keep their points.
+
+The top's rim: the background layer knows the top as a plane, and the few centimetres of edge
+under it survive the filter; far from the camera, where the cluster tolerance is some 0.3 m,
+the rim joined a chair beside the table to the cups standing on it. After the tables the
+background layer has not mapped yet are out (``tables.py``), ``drop_table_legs(rims=True)``
+also takes cells that lie wholly within ``table_rim_depth_m`` below the top (and
+``table_rim_above_m`` above it), near the mapped top (``table_rim_reach_m``), with the legs
+under them, and clusters what remains again: each part stands on the blob's support or on the
+table (``standing_on``).
 """
 
 from __future__ import annotations
@@ -32,7 +41,7 @@ FloatArray = NDArray[np.float64]
 
 
 def leg_points(
-    points_map: FloatArray, tables: Sequence[Box3D], config: ForegroundConfig
+    points_map: FloatArray, tables: Sequence[Box3D], config: ForegroundConfig, rims: bool = False
 ) -> NDArray[np.bool_]:
     """Which of ``points_map`` (N, 3) belong to table legs (see the module docstring)."""
     legs = np.zeros(len(points_map), dtype=bool)
@@ -48,7 +57,21 @@ def leg_points(
     np.maximum.at(z_hi, inverse, z)
     for table in tables:
         lo, hi = table.aabb()
+        lo, hi = lo.copy(), hi.copy()
         top_z = float(hi[2])
+        if rims:
+            # The top's rim, and the part of the top the background layer has not mapped yet:
+            # cells that lie wholly in the top's band; the legs under them count too.
+            rim_cells = (z_lo >= top_z - config.table_rim_depth_m) & (
+                z_hi <= top_z + config.table_rim_above_m
+            )
+            grow = config.table_rim_reach_m
+            xy = points_map[:, :2]
+            inside = np.all(xy >= lo[:2] - grow, axis=1) & np.all(xy <= hi[:2] + grow, axis=1)
+            rim = rim_cells[inverse] & inside
+            if rim.any():
+                lo[:2] = np.minimum(lo[:2], points_map[rim, :2].min(axis=0))
+                hi[:2] = np.maximum(hi[:2], points_map[rim, :2].max(axis=0))
         reach = config.table_leg_reach_m
         near = (
             (points_map[:, 0] >= lo[0] - reach) & (points_map[:, 0] <= hi[0] + reach)
@@ -61,24 +84,53 @@ def leg_points(
             & (z_hi <= top_z + config.table_leg_above_m)
             & (z_lo <= top_z - config.table_leg_min_height_m)
         )
+        if rims:
+            column |= rim_cells
         legs |= near & column[inverse]
     return legs
 
 
+def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: ForegroundConfig) -> float | None:
+    """The highest of ``supports_z_m`` (support top heights) that the blob's base is within
+    the filter margin plus ``support_gap_m`` above, if any."""
+    base = float(blob.points_map[:, 2].min())
+    depth = float(np.median(blob.points_cam[:, 2]))
+    reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    best = None
+    for support in supports_z_m:
+        if support is not None and 0.0 <= base - support <= reach + config.support_gap_m:
+            best = support if best is None else max(best, support)
+    return best
+
+
 def drop_table_legs(
-    blobs: list[Blob], tables: Sequence[Box3D], config: ForegroundConfig, step: int, width: int, height: int
+    blobs: list[Blob], tables: Sequence[Box3D], config: ForegroundConfig, step: int, width: int, height: int,
+    rims: bool = False,
 ) -> list[Blob]:
     """``blobs`` without their table-leg points; a blob that was only legs is gone."""
     if not tables or config.table_leg_cell_m <= 0:
         return blobs
     out: list[Blob] = []
     for blob in blobs:
-        legs = leg_points(blob.points_map, tables, config)
+        legs = leg_points(blob.points_map, tables, config, rims)
         if not legs.any():
             out.append(blob)
             continue
         keep = np.flatnonzero(~legs)
         if len(keep) < 3 or (len(keep) < config.min_cluster_points and not blob.fragment):
+            continue
+        if rims and not blob.fragment:
+            from hiper_cli.perceive.foreground.tables import grid_components
+
+            tops = [float(t.aabb()[1][2]) for t in tables]
+            for part in grid_components(blob, keep, step, config):
+                fragment = len(part) < config.min_cluster_points
+                if len(part) < 3 or (fragment and not config.detection_join):
+                    continue
+                piece = sub_blob(blob, keep[part], step, width, height)
+                piece.fragment = fragment
+                piece.support_z_m = standing_on(piece, [blob.support_z_m, *tops], config)
+                out.append(piece)
             continue
         out.append(sub_blob(blob, keep, step, width, height))
     return out

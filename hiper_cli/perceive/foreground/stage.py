@@ -184,6 +184,10 @@ class ForegroundStage:
         if cfg.background_filter:
             names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
             blobs = drop_unseen_tables(blobs, usable, names, cfg, frame.camera.width, frame.camera.height)
+            if cfg.table_rim_depth_m > 0:
+                blobs = drop_table_legs(
+                    blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height, rims=True
+                )
         if refine:
             blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports)
         t_refine = time.perf_counter()
