@@ -207,41 +207,47 @@ def _cluster_labels(
     Only the valid points are visited, so the cost follows the number of points left after
     the background filter (the paper's observation: filtering speeds up segmentation).
     """
-    from scipy.sparse import coo_matrix
+    from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import connected_components
 
     h, w = valid.shape
-    flat_valid = valid.ravel()
-    idx = np.flatnonzero(flat_valid)
     labels = np.full(h * w, -1, dtype=np.int64)
+    idx = np.flatnonzero(valid.ravel())
     n = len(idx)
     if n == 0:
         return labels
-    compact = np.full(h * w, -1, dtype=np.int64)
-    compact[idx] = np.arange(n)
+    # Compact indices on a grid padded by ``cells`` columns on both sides and rows below: a
+    # neighbour is then a constant offset away, with no bounds tests.
+    padded_w = w + 2 * cells
+    compact = np.full((h + cells) * padded_w, -1, dtype=np.int32)
     ys, xs = np.divmod(idx, w)
-    pts = P.reshape(-1, 3)[idx]
-    tol = tolerance_m + per_m * pts[:, 2]
+    at = ys * padded_w + xs + cells
+    compact[at] = np.arange(n, dtype=np.int32)
+    flat = P.reshape(-1, 3)
+    X, Y, Z = flat[idx, 0], flat[idx, 1], flat[idx, 2]
+    tol = tolerance_m + per_m * Z
     tol2 = tol * tol
     rows: list[NDArray[np.int64]] = []
-    cols: list[NDArray[np.int64]] = []
+    cols: list[NDArray[np.int32]] = []
     # The 8-neighbourhood, plus straight jumps of up to ``cells`` over missing samples.
     offsets = [(0, 1), (1, -1), (1, 0), (1, 1)] + [(0, k) for k in range(2, cells + 1)]
     offsets += [(k, 0) for k in range(2, cells + 1)]
     for dy, dx in offsets:
-        ny, nx = ys + dy, xs + dx
-        inside = (ny < h) & (nx >= 0) & (nx < w)
-        src = np.flatnonzero(inside)
-        nb = compact[ny[src] * w + nx[src]]
-        ok = nb >= 0
-        src, nb = src[ok], nb[ok]
-        diff = pts[src] - pts[nb]
-        close = np.einsum("ij,ij->i", diff, diff) <= tol2[src]
+        nb = compact[at + (dy * padded_w + dx)]
+        src = np.flatnonzero(nb >= 0)
+        nb = nb[src]
+        d = X[src] - X[nb]
+        dist2 = d * d
+        d = Y[src] - Y[nb]
+        dist2 += d * d
+        d = Z[src] - Z[nb]
+        dist2 += d * d
+        close = dist2 <= tol2[src]
         rows.append(src[close])
         cols.append(nb[close])
     r = np.concatenate(rows)
     c = np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n)).tocsr()
+    graph = csr_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
     _, comp = connected_components(graph, directed=False)
     labels[idx] = comp
     return labels
