@@ -254,9 +254,12 @@ def _cluster_labels(
 
 
 def _merge_fragments(
-    groups: list[NDArray[np.int64]], map_full: FloatArray, grid_w: int, config: ForegroundConfig
+    member: NDArray[np.int64], starts: NDArray[np.int64], map_full: FloatArray, grid_w: int,
+    config: ForegroundConfig, min_size: int = 3,
 ) -> list[NDArray[np.int64]]:
-    """Fold small fragments into a much larger neighbouring cluster.
+    """The clusters of at least ``min_size`` points, small fragments folded into a much
+    larger neighbouring cluster. The clusters are the consecutive slices of ``member`` (grid
+    indices) that begin at ``starts``.
 
     Surfaces seen at a grazing angle (the side of a body at the silhouette) break away from
     the object they belong to: consecutive samples are far apart in depth; so does a head
@@ -264,36 +267,48 @@ def _merge_fragments(
     touches its own and whose centre is within ``fragment_distance_m`` of that cluster's box
     (map frame) joins that cluster.
     """
-    if len(groups) < 2:
-        return groups
-    groups = sorted(groups, key=len, reverse=True)
+    ends = np.r_[starts[1:], len(member)]
+    sizes = ends - starts
+    keep = np.flatnonzero(sizes >= min_size)
+    if len(keep) < 2:
+        return [member[starts[k]:ends[k]] for k in keep]
+    # Every cluster's box and grid box at once (reductions over the slices); a centre only
+    # when a fragment's grid box touches a larger cluster's.
+    pts = map_full[member]
+    lows = np.minimum.reduceat(pts, starts, axis=0)
+    highs = np.maximum.reduceat(pts, starts, axis=0)
     pad = config.cluster_neighbour_cells + 1
-    boxes = []
-    for g in groups:
-        gy, gx = g // grid_w, g % grid_w
-        boxes.append((gy.min() - pad, gx.min() - pad, gy.max() + pad, gx.max() + pad))
-    centres = [map_full[g].mean(axis=0) for g in groups]
-    lows = [map_full[g].min(axis=0) for g in groups]
-    highs = [map_full[g].max(axis=0) for g in groups]
+    gy, gx = member // grid_w, member % grid_w
+    grid_boxes = np.stack([
+        np.minimum.reduceat(gy, starts) - pad, np.minimum.reduceat(gx, starts) - pad,
+        np.maximum.reduceat(gy, starts) + pad, np.maximum.reduceat(gx, starts) + pad,
+    ], axis=1).tolist()
+    order = keep[np.argsort(-sizes[keep], kind="stable")].tolist()  # largest first
     kept: list[int] = []
     members: dict[int, list[NDArray[np.int64]]] = {}
-    for i, g in enumerate(groups):
+    ratio, reach = config.fragment_ratio, config.fragment_distance_m
+    for i in order:
         target = None
+        a = grid_boxes[i]
+        centre: FloatArray | None = None
         for j in kept:
-            if len(g) > config.fragment_ratio * len(groups[j]):
+            if sizes[i] > ratio * sizes[j]:
                 continue
-            a, b = boxes[i], boxes[j]
+            b = grid_boxes[j]
             if a[0] > b[2] or b[0] > a[2] or a[1] > b[3] or b[1] > a[3]:
                 continue
-            gap = np.maximum(np.maximum(lows[j] - centres[i], centres[i] - highs[j]), 0.0)
-            if np.linalg.norm(gap) <= config.fragment_distance_m:
+            if centre is None:
+                centre = pts[starts[i]:ends[i]].mean(axis=0)
+            gap = np.maximum(np.maximum(lows[j] - centre, centre - highs[j]), 0.0)
+            if np.linalg.norm(gap) <= reach:
                 target = j
                 break
+        group = member[starts[i]:ends[i]]
         if target is None:
             kept.append(i)
-            members[i] = [g]
+            members[i] = [group]
         else:
-            members[target].append(g)
+            members[target].append(group)
     return [np.concatenate(members[i]) if len(members[i]) > 1 else members[i][0] for i in kept]
 
 
@@ -369,7 +384,11 @@ def _filter_background(
     h, w = valid.shape
     flat_valid = valid.ravel().copy()
     T_cam_map = np.asarray(np.linalg.inv(T_map_cam), dtype=np.float64)
+    # One margin for every point (the usual case: the depth noise is in ``noise``) is added as a
+    # number, not gathered per point.
+    uniform = margin.size > 0 and float(margin.min()) == float(margin.max())
     max_margin = float(margin.max()) if margin.size else 0.0
+    m_all = max_margin
     M = margin.ravel()
     N: FloatArray | None = None
     ray_cols: Sequence[FloatArray] = ()
@@ -397,7 +416,7 @@ def _filter_background(
         axes = np.argsort(box.extent_m)
         direction = box.R[:, axes[0]]
         d = _along(grids, (rows, cols), direction) - float(box.center_m @ direction)
-        allowed = M_grid[rows, cols]
+        allowed = m_all if uniform else M_grid[rows, cols]
         if N_grid is not None:
             cos = np.maximum(np.abs(_along(ray_grids, (rows, cols), direction)),
                              config.background_noise_min_cos)
@@ -411,7 +430,7 @@ def _filter_background(
         for axis in axes[1:]:
             direction = box.R[:, axis]
             d = _along(cols_map, cand, direction) - float(box.center_m @ direction)
-            allowed = M[cand]
+            allowed = m_all if uniform else M[cand]
             if N is not None:
                 cos = np.maximum(np.abs(_along(ray_cols, cand, direction)),
                                  config.background_noise_min_cos)
@@ -550,11 +569,8 @@ def segment(
         order = np.argsort(lab, kind="stable")
         member, lab = member[order], lab[order]
         starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
-        ends = np.r_[starts[1:], len(lab)]
-        sizes = ends - starts
         U_flat, V_flat = U.ravel(), V.ravel()
-        groups = [member[s:e] for s, e, size in zip(starts, ends, sizes, strict=True) if size >= 3]
-        groups = _merge_fragments(groups, map_full, valid.shape[1], config)
+        groups = _merge_fragments(member, starts, map_full, valid.shape[1], config)
         for sel in groups:
             size = len(sel)
             fragment = size < config.min_cluster_points
