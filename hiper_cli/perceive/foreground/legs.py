@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
 __all__ = ["drop_table_legs", "leg_points"]
 
@@ -56,8 +56,7 @@ def leg_points(
     np.minimum.at(z_lo, inverse, z)
     np.maximum.at(z_hi, inverse, z)
     for table in tables:
-        lo, hi = table.aabb()
-        lo, hi = lo.copy(), hi.copy()
+        lo, hi = table.aabb()  # new arrays: the rim may grow them
         top_z = float(hi[2])
         if rims:
             # The top's rim, and the part of the top the background layer has not mapped yet:
@@ -91,16 +90,15 @@ def leg_points(
 
 
 def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: ForegroundConfig) -> float | None:
-    """The highest of ``supports_z_m`` (support top heights) that the blob's base is within
-    the filter margin plus ``support_gap_m`` above, if any."""
+    """The first of ``supports_z_m`` (support top heights, in order of preference; None: no
+    support) that the blob's base is within the filter margin plus ``support_gap_m`` above."""
     base = float(blob.points_map[:, 2].min())
     depth = float(np.median(blob.points_cam[:, 2]))
     reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
-    best = None
     for support in supports_z_m:
         if support is not None and 0.0 <= base - support <= reach + config.support_gap_m:
-            best = support if best is None else max(best, support)
-    return best
+            return support
+    return None
 
 
 def drop_table_legs(
@@ -120,8 +118,6 @@ def drop_table_legs(
         if len(keep) < 3 or (len(keep) < config.min_cluster_points and not blob.fragment):
             continue
         if rims and not blob.fragment:
-            from hiper_cli.perceive.foreground.tables import grid_components
-
             tops = [float(t.aabb()[1][2]) for t in tables]
             for part in grid_components(blob, keep, step, config):
                 fragment = len(part) < config.min_cluster_points
@@ -129,7 +125,7 @@ def drop_table_legs(
                     continue
                 piece = sub_blob(blob, keep[part], step, width, height)
                 piece.fragment = fragment
-                piece.support_z_m = standing_on(piece, [blob.support_z_m, *tops], config)
+                piece.support_z_m = standing_on(piece, [*tops, blob.support_z_m], config)
                 out.append(piece)
             continue
         out.append(sub_blob(blob, keep, step, width, height))

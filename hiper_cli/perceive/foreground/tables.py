@@ -26,11 +26,11 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.legs import leg_points
+from hiper_cli.perceive.foreground.legs import leg_points, standing_on
 from hiper_cli.perceive.foreground.match import iou_matrix
-from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
-__all__ = ["drop_unseen_tables", "grid_components", "table_points", "unseen_table_top"]
+__all__ = ["drop_unseen_tables", "table_points", "unseen_table_top"]
 
 FloatArray = NDArray[np.float64]
 SLAB_BIN_M = 0.02  # height bins of the search for a table top
@@ -102,44 +102,6 @@ def table_points(points_map: FloatArray, top: Box3D, config: ForegroundConfig) -
     return np.asarray(on_top | leg_points(points_map, [top], config))
 
 
-def grid_components(
-    blob: Blob, sel: NDArray[np.int64], step: int, config: ForegroundConfig
-) -> list[NDArray[np.int64]]:
-    """The connected parts of the points ``sel`` of ``blob`` (indices into ``sel``), linked
-    as the segmentation links points: neighbours on the sampling grid (8-neighbourhood plus
-    straight jumps of up to ``cluster_neighbour_cells``) closer than the cluster tolerance."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(sel)
-    if n == 0:
-        return []
-    grid = (blob.pixels_uv[sel] // step).astype(np.int64)
-    grid -= grid.min(axis=0)
-    width, height = int(grid[:, 0].max()) + 1, int(grid[:, 1].max()) + 1
-    index = np.full((height, width), -1, dtype=np.int64)
-    index[grid[:, 1], grid[:, 0]] = np.arange(n)
-    pts = blob.points_cam[sel]
-    tol = config.cluster_tolerance_m + config.cluster_tolerance_per_m * pts[:, 2]
-    cells = config.cluster_neighbour_cells
-    offsets = [(0, 1), (1, -1), (1, 0), (1, 1)] + [(0, k) for k in range(2, cells + 1)]
-    offsets += [(k, 0) for k in range(2, cells + 1)]
-    rows, cols = [], []
-    for dy, dx in offsets:
-        ny, nx = grid[:, 1] + dy, grid[:, 0] + dx
-        src = np.flatnonzero((ny < height) & (nx >= 0) & (nx < width))
-        nb = index[ny[src], nx[src]]
-        src, nb = src[nb >= 0], nb[nb >= 0]
-        close = np.linalg.norm(pts[src] - pts[nb], axis=1) <= tol[src]
-        rows.append(src[close])
-        cols.append(nb[close])
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
-    _, labels = connected_components(graph, directed=False)
-    return [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
-
-
-
 def drop_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: ForegroundConfig,
     width: int, height: int,
@@ -172,14 +134,8 @@ def drop_unseen_tables(
 def _part(
     blob: Blob, sel: NDArray[np.int64], top: Box3D, config: ForegroundConfig, width: int, height: int
 ) -> Blob:
-    """A part of ``blob`` as a blob of its own, standing on the floor below the blob (as the
-    segmentation found it), on the table top, or on nothing known."""
+    """A part of ``blob`` as a blob of its own, standing on the table top, on the floor below the
+    blob (as the segmentation found it), or on nothing known."""
     part = sub_blob(blob, sel, config.pixel_step, width, height)
-    base = float(part.points_map[:, 2].min())
-    depth = float(np.median(part.points_cam[:, 2]))
-    reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
-    part.support_z_m = None
-    for support in (blob.support_z_m, float(top.aabb()[1][2])):
-        if support is not None and 0.0 <= base - support <= reach + config.support_gap_m:
-            part.support_z_m = support
+    part.support_z_m = standing_on(part, [float(top.aabb()[1][2]), blob.support_z_m], config)
     return part
