@@ -214,10 +214,6 @@ def _size_m(extent_m: FloatArray) -> float:
     return max(math.hypot(float(extent_m[0]), float(extent_m[1])), float(extent_m[2]))
 
 
-def _compatible(track_class: str, meas_class: str) -> bool:
-    return UNKNOWN in (track_class, meas_class) or track_class == meas_class
-
-
 class Tracker:
     """Hungarian association + constant-velocity Kalman filters (see the module docstring)."""
 
@@ -388,7 +384,7 @@ class Tracker:
             if self._settled(t, moving[i]):
                 reach = t.extent_m / 2.0 + cfg.settled_overlap_m
                 allowed[i] &= np.all(np.abs(obs - t.position) <= reach + half_extents, axis=1)
-            if cls != UNKNOWN:
+            if cls != UNKNOWN:  # two different known classes cost more; unknown is neutral
                 cost[i, ~unknown & (classes != cls)] += cfg.class_mismatch_m
             if cls in cfg.walker_classes:
                 allowed[i] &= sizes >= cfg.walker_min_size_ratio * t.max_size_m
