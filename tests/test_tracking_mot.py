@@ -178,6 +178,29 @@ def test_a_static_track_out_of_view_does_not_take_an_object_metres_away():
     assert joined == [chair_track.uuid]
 
 
+def _chair_piece_then_cup(cfg):
+    """A piece of a chair seen for 0.4 s as it leaves the view, half a second out of view, then
+    a cup (unmatched) on the table 0.85 m away: which track does the cup join?"""
+    tracker = Tracker(cfg)
+    for k in range(12):
+        tracker.step(k / RATE_HZ, [meas([2.2 - 0.005 * k, 2.53, 0.46], "chair", k=k)])
+    (chair_track,) = tracker.tracks
+    for k in range(12, 28):
+        tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
+    cup = Measurement(np.array([2.31, 1.76, 0.81]), np.array([0.07, 0.07, 0.07]), "unknown", 0.0, "cup")
+    _, joined = tracker.step(28 / RATE_HZ, [cup])
+    return chair_track, joined
+
+
+def test_a_chair_out_of_view_for_half_a_second_does_not_take_the_cup_beside_it():
+    chair_track, joined = _chair_piece_then_cup(ForegroundConfig())
+    assert joined == [None]
+    # With the velocity uncertainty of every class relaxing towards walking speeds, the chair's
+    # gate grows to gate_m within half a second and takes the cup.
+    chair_track, joined = _chair_piece_then_cup(ForegroundConfig(velocity_relax_static=True))
+    assert joined == [chair_track.uuid]
+
+
 def test_a_walker_picked_up_again_relearns_its_speed_at_once():
     def speed_after_gap(prior_mps):
         # the mechanism alone: a livelier filter (the walker default) also relearns faster

@@ -224,7 +224,12 @@ class ForegroundConfig:
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
     velocity_prior_mps: float = 1.0
     """While the velocity decays, its uncertainty relaxes towards this (walking speeds), so a
-    track picked up again learns its new velocity at once."""
+    track picked up again learns its new velocity at once ..."""
+    velocity_relax_static: bool = False
+    """... also for tracks of classes that do not search (``search_classes``), if true. False:
+    a chair's or a cup's only decays, and its gate does not grow to ``gate_m`` within half a
+    second unseen (the piece of a chair leaving the view took the cup on the table 0.85 m away:
+    a false positive on house 894)."""
     velocity_decay_grace_s: float = 0.1
     """No decay for this long after the last update (a missed detection must not slow a walker)."""
     accel_noise_mps2: float = 1.0

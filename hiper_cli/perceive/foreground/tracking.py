@@ -261,9 +261,11 @@ class Tracker:
         """Shrink the velocity of a track that got no update (after a grace of two frames).
 
         The decay is a mean-reverting (Ornstein-Uhlenbeck) velocity: the estimate shrinks by
-        a = exp(-dt / velocity_decay_s) and its variance relaxes towards the prior
-        ``velocity_prior_mps``², so that a track picked up again learns its speed from the
-        next observations at once instead of trusting the decayed (near zero) velocity.
+        a = exp(-dt / velocity_decay_s) and, for the classes that search (people, ``unknown``),
+        its variance relaxes towards the prior ``velocity_prior_mps``², so that a track picked
+        up again learns its speed from the next observations at once instead of trusting the
+        decayed (near zero) velocity. A chair's does not (``velocity_relax_static``): its gate
+        would grow to ``gate_m`` within half a second unseen.
         """
         # The grace covers at least one missed frame at any frame rate (at 4 Hz one frame is
         # 0.25 s, longer than the grace: every single miss decayed and unsettled the velocity).
@@ -275,7 +277,8 @@ class Tracker:
         kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
         # Position-velocity covariances shrink by a, velocity variances by a² and relax.
         scale = np.array([1.0, 1.0, 1.0, factor, factor, factor])
-        prior = self.config.velocity_prior_mps**2
+        relaxes = self.config.velocity_relax_static or track.class_name in self.config.search_classes
+        prior = self.config.velocity_prior_mps**2 if relaxes else 0.0
         ratio = self.config.vertical_noise_ratio**2
         relax = (1.0 - factor**2) * np.array([0.0, 0.0, 0.0, prior, prior, prior * ratio])
         kf.P = kf.P * np.outer(scale, scale) + np.diag(relax)  # type: ignore[attr-defined]
