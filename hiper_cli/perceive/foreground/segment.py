@@ -257,37 +257,23 @@ def grid_components(
     blob: Blob, sel: NDArray[np.int64], step: int, config: ForegroundConfig
 ) -> list[NDArray[np.int64]]:
     """The connected parts of the points ``sel`` of ``blob`` (indices into ``sel``), linked
-    as the segmentation links points: neighbours on the sampling grid (8-neighbourhood plus
-    straight jumps of up to ``cluster_neighbour_cells``) closer than the cluster tolerance."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(sel)
-    if n == 0:
+    as the segmentation links points (``_cluster_labels`` on the blob's own sampling grid);
+    ordered by their first point in ``sel``."""
+    if len(sel) == 0:
         return []
     grid = (blob.pixels_uv[sel] // step).astype(np.int64)
     grid -= grid.min(axis=0)
     width, height = int(grid[:, 0].max()) + 1, int(grid[:, 1].max()) + 1
-    index = np.full((height, width), -1, dtype=np.int64)
-    index[grid[:, 1], grid[:, 0]] = np.arange(n)
-    pts = blob.points_cam[sel]
-    tol = config.cluster_tolerance_m + config.cluster_tolerance_per_m * pts[:, 2]
-    cells = config.cluster_neighbour_cells
-    offsets = [(0, 1), (1, -1), (1, 0), (1, 1)] + [(0, k) for k in range(2, cells + 1)]
-    offsets += [(k, 0) for k in range(2, cells + 1)]
-    rows, cols = [], []
-    for dy, dx in offsets:
-        ny, nx = grid[:, 1] + dy, grid[:, 0] + dx
-        src = np.flatnonzero((ny < height) & (nx >= 0) & (nx < width))
-        nb = index[ny[src], nx[src]]
-        src, nb = src[nb >= 0], nb[nb >= 0]
-        close = np.linalg.norm(pts[src] - pts[nb], axis=1) <= tol[src]
-        rows.append(src[close])
-        cols.append(nb[close])
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
-    _, labels = connected_components(graph, directed=False)
-    return [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
+    points = np.zeros((height, width, 3))
+    valid = np.zeros((height, width), dtype=bool)
+    points[grid[:, 1], grid[:, 0]] = blob.points_cam[sel]
+    valid[grid[:, 1], grid[:, 0]] = True
+    labels = _cluster_labels(
+        points, valid, config.cluster_tolerance_m, config.cluster_tolerance_per_m,
+        config.cluster_neighbour_cells,
+    )[grid[:, 1] * width + grid[:, 0]]
+    _, first = np.unique(labels, return_index=True)
+    return [np.flatnonzero(labels == labels[i]) for i in np.sort(first)]
 
 
 def _merge_fragments(
