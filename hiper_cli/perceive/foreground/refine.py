@@ -135,7 +135,7 @@ def _trim(
 
 def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig) -> int | None:
     """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
-    share = _inside(blob.pixels_uv, boxes).mean(axis=0)
+    share = np.count_nonzero(_inside(blob.pixels_uv, boxes), axis=0) / len(blob.pixels_uv)
     ok = np.flatnonzero(share >= config.join_containment)
     if len(ok) == 0:
         return None
@@ -145,6 +145,11 @@ def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundC
 def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
     from scipy.spatial import cKDTree
 
+    # Boxes farther apart than the gap hold no points within it (distances are the same in the
+    # map frame, where the blobs' bounds are known already).
+    (a_min, a_max), (b_min, b_max) = a.bounds_map, b.bounds_map
+    if np.linalg.norm(np.maximum(np.maximum(a_min - b_max, b_min - a_max), 0.0)) > config.join_gap_m:
+        return False
     # Depth ranges (10th to 90th percentile), not medians: a chair's back legs lie 0.4 m
     # behind the middle of its front.
     za, zb = a.points_cam[:, 2], b.points_cam[:, 2]

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import CORNER_SIGNS, Box3D
+from hiper_cli.model import CORNER_SIGNS, Box3D, point_bounds
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
@@ -56,9 +56,20 @@ class Blob:
     """Top of the floor or table the blob stands on, when the background filter cut its base."""
     fragment: bool = False
     """Fewer points than ``min_cluster_points``: kept only to be joined to an object (refine)."""
+    _bounds: tuple[FloatArray, FloatArray] | None = field(default=None, init=False, repr=False, compare=False)
+    _mean: FloatArray | None = field(default=None, init=False, repr=False, compare=False)
+
+    @property
+    def bounds_map(self) -> tuple[FloatArray, FloatArray]:
+        """(min, max) corners (3,) of the points, map frame; computed once (a blob's points do
+        not change: a part of it is a new blob), not to be modified."""
+        if self._bounds is None:
+            self._bounds = point_bounds(self.points_map)
+        return self._bounds
 
     def _z_range(self) -> tuple[float, float]:
-        lo, hi = float(self.points_map[:, 2].min()), float(self.points_map[:, 2].max())
+        lo_m, hi_m = self.bounds_map
+        lo, hi = float(lo_m[2]), float(hi_m[2])
         if self.support_z_m is not None and self.support_z_m < lo:
             lo = self.support_z_m
         return lo, hi
@@ -68,14 +79,17 @@ class Blob:
         """Where the blob is, map frame: the centroid of its points horizontally (robust to
         depth noise, which moves the box's extreme points) and the middle of its vertical
         extent (the box centre height, independent of how densely each part was sampled)."""
-        centre = self.points_map.mean(axis=0)
+        if self._mean is None:
+            self._mean = np.asarray(self.points_map.mean(axis=0), dtype=np.float64)
+        centre = self._mean.copy()
         z_lo, z_hi = self._z_range()
         centre[2] = (z_lo + z_hi) / 2.0
-        return np.asarray(centre, dtype=np.float64)
+        return centre
 
     @property
     def extent_map(self) -> FloatArray:
-        extent = self.points_map.max(axis=0) - self.points_map.min(axis=0)
+        lo, hi = self.bounds_map
+        extent = hi - lo
         z_lo, z_hi = self._z_range()
         extent[2] = z_hi - z_lo
         return np.asarray(extent, dtype=np.float64)
@@ -85,12 +99,13 @@ def image_box(uv: NDArray[np.int32], step: int, width: int, height: int) -> Floa
     """The image box (xyxy pixels) of sampled pixels ``uv`` (N, 2): each sample covers
     ``step`` pixels, clipped to the image."""
     half = step / 2.0
+    lo, hi = point_bounds(uv)
     return np.array(
         [
-            max(0.0, uv[:, 0].min() - half),
-            max(0.0, uv[:, 1].min() - half),
-            min(float(width), uv[:, 0].max() + half),
-            min(float(height), uv[:, 1].max() + half),
+            max(0.0, lo[0] - half),
+            max(0.0, lo[1] - half),
+            min(float(width), hi[0] + half),
+            min(float(height), hi[1] + half),
         ]
     )
 
@@ -335,36 +350,60 @@ def _merge_fragments(
     return [np.concatenate(members[i]) if len(members[i]) > 1 else members[i][0] for i in kept]
 
 
-def _box_roi(
-    box: Box3D, margin_m: float, camera: CameraIntrinsics, T_cam_map: FloatArray, step: int,
+# The 12 edges of a box as pairs of ``CORNER_SIGNS`` rows (rows that differ in one sign).
+_EDGES = np.array([(i, i | bit) for bit in (4, 2, 1) for i in range(8) if not i & bit])
+_NEAR_Z_M = 0.05  # boxes are cut at this depth (or half min_depth_m) before projecting
+
+
+def _box_rois(
+    boxes: Sequence[Box3D], margin_m: float, camera: CameraIntrinsics, T_cam_map: FloatArray, step: int,
     shape: tuple[int, int], config: ForegroundConfig,
-) -> tuple[slice, slice] | None:
-    """The rows and columns of the subsampled grid a box (grown by a margin) can cover; None
-    when it is out of view."""
-    half = (box.extent_m / 2.0 + margin_m) * CORNER_SIGNS  # the grown box's corners, box axes
-    R_cam = T_cam_map[:3, :3] @ box.R
-    corners = half @ R_cam.T + (T_cam_map[:3, :3] @ box.center_m + T_cam_map[:3, 3])
-    z = corners[:, 2]
+) -> list[tuple[slice, slice] | None]:
+    """For each box (grown by a margin), the rows and columns of the subsampled grid it can
+    cover; None when it is out of view.
+
+    A box that reaches behind the camera (a wall or the floor beside the robot) is cut at
+    ``_NEAR_Z_M`` (or half ``min_depth_m``: no point nearer is valid) first: its part in front
+    of the camera is the convex hull of its corners there and the points where its edges cross
+    that depth, and a projection maps that hull onto the hull of their images. (Taking the
+    whole image for it tested every point of the frame.)
+    """
+    if not boxes:
+        return []
+    centres = np.stack([b.center_m for b in boxes])
+    halves = np.stack([b.extent_m for b in boxes]) / 2.0 + margin_m
+    R_cam = T_cam_map[:3, :3] @ np.stack([b.R for b in boxes])  # (B, 3, 3)
+    # corners[b, k] = R_cam[b] @ (halves[b] * signs[k]) + centre of b in the camera frame
+    corners = np.einsum("bij,bkj->bki", R_cam, halves[:, None, :] * CORNER_SIGNS)
+    corners += (centres @ T_cam_map[:3, :3].T + T_cam_map[:3, 3])[:, None, :]
+    z = corners[:, :, 2]
     h, w = shape
-    if np.all(z < config.min_depth_m):
-        return None  # behind the camera
-    lo_c, hi_c = corners.min(axis=0), corners.max(axis=0)
     reach_m = config.max_depth_m + config.max_depth_slack_m
-    if np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0)) > reach_m:
-        return None  # farther than the sensor sees
-    if np.any(z < 0.05):
-        return slice(0, h), slice(0, w)  # straddles the image plane: take the whole image
-    u = camera.fx * corners[:, 0] / z + camera.cx
-    v = camera.fy * corners[:, 1] / z + camera.cy
+    lo_c, hi_c = corners.min(axis=1), corners.max(axis=1)
+    gap_m = np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0), axis=1)
+    behind = np.all(z < config.min_depth_m, axis=1)
+    near_z = max(min(_NEAR_Z_M, config.min_depth_m / 2.0), 1e-3)
     off = step // 2
-    c0 = int(np.floor((u.min() - off) / step))
-    c1 = int(np.ceil((u.max() - off) / step)) + 1
-    r0 = int(np.floor((v.min() - off) / step))
-    r1 = int(np.ceil((v.max() - off) / step)) + 1
-    c0, c1, r0, r1 = max(c0, 0), min(c1, w), max(r0, 0), min(r1, h)
-    if c0 >= c1 or r0 >= r1:
-        return None
-    return slice(r0, r1), slice(c0, c1)
+    out: list[tuple[slice, slice] | None] = []
+    for b in range(len(boxes)):
+        if behind[b] or gap_m[b] > reach_m:
+            out.append(None)  # behind the camera, or farther than the sensor sees
+            continue
+        pts = corners[b]
+        if np.any(z[b] < near_z):
+            za, zb = z[b][_EDGES[:, 0]], z[b][_EDGES[:, 1]]
+            crossing = (za < near_z) != (zb < near_z)
+            a, c = pts[_EDGES[crossing, 0]], pts[_EDGES[crossing, 1]]
+            t = (near_z - za[crossing]) / (zb[crossing] - za[crossing])
+            pts = np.concatenate([pts[z[b] >= near_z], a + t[:, None] * (c - a)])
+        u = camera.fx * pts[:, 0] / pts[:, 2] + camera.cx
+        v = camera.fy * pts[:, 1] / pts[:, 2] + camera.cy
+        c0 = max(int(np.floor((u.min() - off) / step)), 0)
+        c1 = min(int(np.ceil((u.max() - off) / step)) + 1, w)
+        r0 = max(int(np.floor((v.min() - off) / step)), 0)
+        r1 = min(int(np.ceil((v.max() - off) / step)) + 1, h)
+        out.append(None if c0 >= c1 or r0 >= r1 else (slice(r0, r1), slice(c0, c1)))
+    return out
 
 
 def _along(columns: Sequence[FloatArray], index: Any, direction: FloatArray) -> FloatArray:
@@ -429,8 +468,9 @@ def _filter_background(
     N_grid = None if N is None else N.reshape(h, w)
 
     # Largest boxes first (floor, walls): they remove most points, the others test fewer.
-    for box in sorted(boxes, key=lambda b: -b.volume_m3):
-        roi = _box_roi(box, max_margin, camera, T_cam_map, step, (h, w), config)
+    boxes = sorted(boxes, key=lambda b: -b.volume_m3)
+    rois = _box_rois(boxes, max_margin, camera, T_cam_map, step, (h, w), config)
+    for box, roi in zip(boxes, rois, strict=True):
         if roi is None:
             continue
         rows, cols = roi
@@ -499,8 +539,7 @@ def support_below(
     and to the subsampling). None for a blob whose lowest points (``support_edge_band_m``)
     reach the lower edge of the image (``image_height``): its base is out of view, and its box
     stays what the camera sees."""
-    lo = blob.points_map.min(axis=0)
-    hi = blob.points_map.max(axis=0)
+    lo, hi = blob.bounds_map
     edge_v = None if image_height is None else image_height - config.pixel_step
     if edge_v is not None and blob.image_box_xyxy[3] >= edge_v:
         # Cut by the lower edge: the base is out of view when the lowest points are at the edge
@@ -605,12 +644,14 @@ def segment(
             if config.max_depth_slack_m > 0 and np.median(P_flat[sel, 2]) > config.max_depth_m:
                 continue  # beyond the range: the slack only keeps the far side of nearer objects
             pm = map_full[sel]
-            if np.any(pm.max(axis=0) - pm.min(axis=0) > config.max_cluster_extent_m):
+            lo, hi = point_bounds(pm)
+            if np.any(hi - lo > config.max_cluster_extent_m):
                 stats.rejected_clusters += 1
                 continue
             uv = np.stack([U_flat[sel], V_flat[sel]], axis=1).astype(np.int32)
             box = image_box(uv, step, camera.width, camera.height)
             blob = Blob(P_flat[sel], pm, uv, box, fragment=fragment)
+            blob._bounds = (lo, hi)
             if config.background_filter and support_boxes_map:
                 blob.support_z_m = support_below(blob, support_boxes_map, config, camera.height)
             blobs.append(blob)

@@ -55,11 +55,12 @@ def unseen_table_top(points_map: FloatArray, config: ForegroundConfig) -> Box3D 
     if len(points_map) < config.min_cluster_points:
         return None
     z = points_map[:, 2]
+    at_height = (z >= config.unseen_table_min_height_m) & (z <= config.unseen_table_max_height_m)
+    if np.count_nonzero(at_height) < config.min_cluster_points:
+        return None  # too few points at table height, whichever columns end there
     reach = 2 * SLAB_BIN_M + config.table_leg_above_m
     ending = _column_tops(points_map, config.table_leg_cell_m) <= z + reach
-    sel = np.flatnonzero(
-        (z >= config.unseen_table_min_height_m) & (z <= config.unseen_table_max_height_m) & ending
-    )
+    sel = np.flatnonzero(at_height & ending)
     if len(sel) < config.min_cluster_points:
         return None
     bins = np.floor(z[sel] / SLAB_BIN_M).astype(np.int64)

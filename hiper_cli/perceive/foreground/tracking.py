@@ -155,6 +155,23 @@ def _transition(dt: float) -> FloatArray:
     return F
 
 
+@lru_cache(maxsize=64)
+def _decay_terms(
+    dt: float, decay_s: float, prior: float, ratio: float
+) -> tuple[float, FloatArray, FloatArray]:
+    """The velocity decay over ``dt`` (``Tracker._decay``): the factor a = exp(-dt/decay_s), the
+    covariance scale (position-velocity terms by a, velocity variances by a²) and the relaxation
+    (1 - a²)·prior on the velocity variances (vertical: times ``ratio``). Cached (most frames
+    share one dt): read-only."""
+    factor = math.exp(-dt / decay_s)
+    scale = np.array([1.0, 1.0, 1.0, factor, factor, factor])
+    scale_P = np.outer(scale, scale)
+    relax = np.diag((1.0 - factor**2) * np.array([0.0, 0.0, 0.0, prior, prior, prior * ratio]))
+    scale_P.setflags(write=False)
+    relax.setflags(write=False)
+    return factor, scale_P, relax
+
+
 def smooth_trajectory(track: Track) -> None:
     """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place).
 
@@ -272,16 +289,14 @@ class Tracker:
         grace = max(self.config.velocity_decay_grace_s, 1.5 * dt)
         if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
-        factor = math.exp(-dt / self.config.velocity_decay_s)
-        kf = track.kf
-        kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
-        # Position-velocity covariances shrink by a, velocity variances by a² and relax.
-        scale = np.array([1.0, 1.0, 1.0, factor, factor, factor])
         relaxes = self.config.velocity_relax_static or track.class_name in self.config.search_classes
         prior = self.config.velocity_prior_mps**2 if relaxes else 0.0
-        ratio = self.config.vertical_noise_ratio**2
-        relax = (1.0 - factor**2) * np.array([0.0, 0.0, 0.0, prior, prior, prior * ratio])
-        kf.P = kf.P * np.outer(scale, scale) + np.diag(relax)  # type: ignore[attr-defined]
+        factor, scale, relax = _decay_terms(
+            dt, self.config.velocity_decay_s, prior, self.config.vertical_noise_ratio**2
+        )
+        kf = track.kf
+        kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
+        kf.P = kf.P * scale + relax  # type: ignore[attr-defined]
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
         kf = track.kf
