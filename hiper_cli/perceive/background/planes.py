@@ -174,15 +174,20 @@ def _join_regions(cells: list[NDArray[np.bool_]], n: FloatArray, s1: FloatArray,
     """
     import cv2
 
+    def region(sel: NDArray[np.bool_]) -> tuple[FloatArray, float, FloatArray, NDArray[np.bool_]]:
+        """The region's plane (normal, d), mean point and its cells grown by two."""
+        flat = sel.reshape(-1)
+        rn = n[flat].sum()
+        normal, d, _ = _fit_from_moments(np.array(rn), s1[flat].sum(axis=0), s2[flat].sum(axis=0))
+        grown = cv2.dilate(sel.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
+        return normal, d, s1[flat].sum(axis=0) / rn, grown
+
+    cos_join = np.cos(np.radians(cfg.grow_angle_deg))
+    # Computed once per region: a join replaces two regions by their union, the rest stay.
+    regions = [region(sel) for sel in cells]
     while True:
-        stats = []
-        for sel in cells:
-            flat = sel.reshape(-1)
-            rn = n[flat].sum()
-            normal, d, _ = _fit_from_moments(np.array(rn), s1[flat].sum(axis=0), s2[flat].sum(axis=0))
-            stats.append((normal, d, s1[flat].sum(axis=0) / rn))
-        grown = [cv2.dilate(c.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool) for c in cells]
-        cos_join = np.cos(np.radians(cfg.grow_angle_deg))
+        stats = [r[:3] for r in regions]
+        grown = [r[3] for r in regions]
         pair = None
         for a in range(len(cells)):
             for b in range(a + 1, len(cells)):
@@ -202,6 +207,7 @@ def _join_regions(cells: list[NDArray[np.bool_]], n: FloatArray, s1: FloatArray,
             return cells
         a, b = pair
         cells = [c for k, c in enumerate(cells) if k not in pair] + [cells[a] | cells[b]]
+        regions = [r for k, r in enumerate(regions) if k not in pair] + [region(cells[-1])]
 
 
 def _smooth_neighbours(grid: SampleGrid, jump_frac: float) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
