@@ -174,7 +174,7 @@ def _join_regions(cells: list[NDArray[np.bool_]], n: FloatArray, s1: FloatArray,
     """
     import cv2
 
-    def region(sel: NDArray[np.bool_]) -> tuple[FloatArray, float, FloatArray, NDArray[np.bool_]]:
+    def region(sel: NDArray[np.bool_]) -> tuple[FloatArray, FloatArray, FloatArray, NDArray[np.bool_]]:
         """The region's plane (normal, d), mean point and its cells grown by two."""
         flat = sel.reshape(-1)
         rn = n[flat].sum()
