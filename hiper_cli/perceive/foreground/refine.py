@@ -110,13 +110,12 @@ def _split(
 
 
 def _trim(
-    blob: Blob, boxes: FloatArray, grown: FloatArray, step_pad: FloatArray, config: ForegroundConfig
+    blob: Blob, iou: FloatArray, boxes: FloatArray, grown: FloatArray, step_pad: FloatArray,
+    config: ForegroundConfig,
 ) -> NDArray[np.int64] | None:
-    """The points of ``blob`` inside the (grown) box of the detection it overlaps best, when
-    that IoU reaches ``trim_iou`` and the points outside are at most ``trim_max_share``."""
-    from hiper_cli.perceive.foreground.match import iou_matrix
-
-    iou = iou_matrix(blob.image_box_xyxy.reshape(1, 4), boxes)[0]
+    """The points of ``blob`` inside the (grown) box of the detection it overlaps best (``iou``
+    (K,) of its image box with ``boxes``), when that IoU reaches ``trim_iou`` and the points
+    outside are at most ``trim_max_share``."""
     k = int(np.argmax(iou))
     if iou[k] < config.trim_iou:
         return None
@@ -225,10 +224,11 @@ def refine_blobs(
         sign = np.array([-1.0, -1.0, 1.0, 1.0])
         trim_pad = np.tile(size * config.trim_margin_frac + step, 2) * sign
         step_pad = step * sign
+        ious = iou_matrix(np.array([blob.image_box_xyxy for blob in out]).reshape(-1, 4), boxes)
         for i, blob in enumerate(out):
             if blob.fragment:
                 continue
-            keep = _trim(blob, boxes, boxes + trim_pad, step_pad, config)
+            keep = _trim(blob, ious[i], boxes, boxes + trim_pad, step_pad, config)
             if keep is not None:
                 out[i] = sub_blob(blob, keep, step, width, height)
                 changed[i] = True

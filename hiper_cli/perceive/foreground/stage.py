@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +54,15 @@ def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
                 lo[2] = min(lo[2], top)
         out.append(Box3D((lo + hi) / 2.0, hi - lo))
     return out
+
+
+@lru_cache(maxsize=4096)
+def _spread(n: int, k: int) -> NDArray[np.int64]:
+    """``min(n, k)`` indices evenly spread over ``range(n)`` (the organised grid order:
+    deterministic, cheap; at least one apart, so no duplicates). Cached: read-only."""
+    idx = np.linspace(0, n - 1, min(n, k)).astype(np.int64)
+    idx.setflags(write=False)
+    return idx
 
 
 class ForegroundStage:
@@ -246,10 +256,8 @@ class ForegroundStage:
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
         cfg = self.config
         n = len(blob.points_cam)
-        # Evenly spread subsamples over the organised grid order (deterministic, cheap; at
-        # most n of them, at least one index apart: no duplicates).
-        pts_idx = np.linspace(0, n - 1, min(n, cfg.points_per_observation)).astype(np.int64)
-        pix_idx = np.linspace(0, n - 1, min(n, cfg.pixels_per_observation)).astype(np.int64)
+        pts_idx = _spread(n, cfg.points_per_observation)
+        pix_idx = _spread(n, cfg.pixels_per_observation)
         detection = None
         if match.detection_index is not None:
             k = match.detection_index

@@ -70,8 +70,7 @@ def unseen_table_top(points_map: FloatArray, config: ForegroundConfig) -> Box3D 
         return None
     if _minor_extent_m(points_map[slab, :2]) < config.unseen_table_min_side_m:
         return None
-    lo = np.percentile(points_map[slab, :2], 5, axis=0)
-    hi = np.percentile(points_map[slab, :2], 95, axis=0)
+    lo, hi = np.percentile(points_map[slab, :2], [5, 95], axis=0)
     top = float(np.median(z[slab]))
     return Box3D(
         np.array([(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, top - TOP_THICKNESS_M / 2.0]),
@@ -85,7 +84,8 @@ def _minor_extent_m(points_xy: FloatArray) -> float:
     centred = points_xy - points_xy.mean(axis=0)
     _, vectors = np.linalg.eigh(centred.T @ centred)
     along = centred @ vectors[:, 0]  # eigh sorts ascending: the minor axis first
-    return float(np.percentile(along, 95) - np.percentile(along, 5))
+    p5, p95 = np.percentile(along, [5, 95])
+    return float(p95 - p5)
 
 
 def table_points(points_map: FloatArray, top: Box3D, config: ForegroundConfig) -> NDArray[np.bool_]:
@@ -115,10 +115,10 @@ def drop_unseen_tables(
     if len(boxes) == 0:
         return blobs
     out: list[Blob] = []
-    for blob in blobs:
+    ious = iou_matrix(np.array([blob.image_box_xyxy for blob in blobs]), boxes)
+    for blob, iou in zip(blobs, ious, strict=True):
         top = None
         if not blob.fragment:
-            iou = iou_matrix(blob.image_box_xyxy.reshape(1, 4), boxes)[0]
             k = int(np.argmax(iou))
             if iou[k] >= config.trim_iou and classes[k] not in config.unseen_table_skip_classes:
                 top = unseen_table_top(blob.points_map, config)

@@ -97,6 +97,8 @@ class Track:
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
     _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
+    # ``_was_moving`` for the trajectory of this many rows (rows change only by being added)
+    _moving: tuple[int, bool] | None = field(default=None, repr=False)
 
     @property
     def position(self) -> FloatArray:
@@ -209,8 +211,16 @@ def _was_moving(track: Track, config: ForegroundConfig) -> bool:
     filtered displacement over the last ``moving_window_s`` (at least ``min_moving_span_s`` of
     history) both exceed ``moving_speed_mps``. Either alone is fooled: the velocity by noise,
     the displacement by a blob that grew or lost a part; a track seen too briefly is not
-    known to move."""
+    known to move. Computed once per trajectory length (an update adds a row)."""
     rows = track.trajectory
+    if track._moving is not None and track._moving[0] == len(rows):
+        return track._moving[1]
+    moving = _moving_rows(rows, config)
+    track._moving = (len(rows), moving)
+    return moving
+
+
+def _moving_rows(rows: list[list[float]], config: ForegroundConfig) -> bool:
     if not rows or math.hypot(rows[-1][4], rows[-1][5]) <= config.moving_speed_mps:
         return False
     t_end = rows[-1][0]
