@@ -262,8 +262,11 @@ def _cluster_labels(
         cols.append(nb[close])
     r = np.concatenate(rows)
     c = np.concatenate(cols)
-    graph = csr_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
-    _, comp = connected_components(graph, directed=False)
+    # float64 weights (what the graph routines take, not a copy to convert) and the weak
+    # components of the one-way edges: the components of the undirected graph, without
+    # adding its transpose first.
+    graph = csr_matrix((np.ones(len(r)), (r, c)), shape=(n, n))
+    _, comp = connected_components(graph, directed=True, connection="weak")
     labels[idx] = comp
     return labels
 
@@ -419,6 +422,34 @@ def _along(columns: Sequence[FloatArray], index: Any, direction: FloatArray) -> 
     return out
 
 
+def _within(
+    columns: Sequence[FloatArray], index: Any, direction: FloatArray, offset_m: float, half_m: float,
+    allowed_m: float | FloatArray, noise: FloatArray | None, ray_columns: Sequence[FloatArray],
+    min_cos: float,
+) -> NDArray[np.bool_]:
+    """Whether the points ``columns[k][index]`` lie within a slab: ``|p·direction - offset_m| -
+    half_m <= allowed_m`` (a number or per point), plus, with ``noise`` (per point), the noise
+    times the cosine of the viewing ray (``ray_columns``) with ``direction``, at least
+    ``min_cos``. Computed in place on two arrays, not the eight temporaries of the formula
+    (the same numbers: an axis direction only flips a sign)."""
+    main = int(np.argmax(np.abs(direction)))
+    axis = abs(direction[main]) > 1.0 - 1e-9
+    if axis:  # |x·s - c| = |x - s·c| for s = ±1
+        dist = np.subtract(columns[main][index], float(np.sign(direction[main])) * offset_m)
+    else:
+        dist = _along(columns, index, direction)
+        np.subtract(dist, offset_m, out=dist)
+    np.abs(dist, out=dist)
+    np.subtract(dist, half_m, out=dist)
+    if noise is None:
+        return np.less_equal(dist, allowed_m)
+    cos = np.abs(ray_columns[main][index]) if axis else np.abs(_along(ray_columns, index, direction))
+    np.maximum(cos, min_cos, out=cos)
+    np.multiply(cos, noise[index], out=cos)
+    np.add(cos, allowed_m, out=cos)
+    return np.less_equal(dist, cos)
+
+
 def _filter_background(
     valid: NDArray[np.bool_],
     cols_map: Sequence[FloatArray],
@@ -466,6 +497,7 @@ def _filter_background(
     ray_grids = [c.reshape(h, w) for c in ray_cols]
     M_grid = M.reshape(h, w)
     N_grid = None if N is None else N.reshape(h, w)
+    min_cos = config.background_noise_min_cos
 
     # Largest boxes first (floor, walls): they remove most points, the others test fewer.
     boxes = sorted(boxes, key=lambda b: -b.volume_m3)
@@ -478,13 +510,11 @@ def _filter_background(
         # The first test runs on the box's image rectangle as is (no gather).
         axes = np.argsort(box.extent_m)
         direction = box.R[:, axes[0]]
-        d = _along(grids, (rows, cols), direction) - float(box.center_m @ direction)
-        allowed = m_all if uniform else M_grid[rows, cols]
-        if N_grid is not None:
-            cos = np.maximum(np.abs(_along(ray_grids, (rows, cols), direction)),
-                             config.background_noise_min_cos)
-            allowed = allowed + N_grid[rows, cols] * cos
-        keep = grid_valid[rows, cols] & (np.abs(d) - box.extent_m[axes[0]] / 2.0 <= allowed)
+        keep = _within(
+            grids, (rows, cols), direction, float(box.center_m @ direction), box.extent_m[axes[0]] / 2.0,
+            m_all if uniform else M_grid[rows, cols], N_grid, ray_grids, min_cos,
+        )
+        keep &= grid_valid[rows, cols]
         local_idx = np.flatnonzero(keep)
         if len(local_idx) == 0:
             continue
@@ -492,13 +522,11 @@ def _filter_background(
         cand = (local_idx // width + rows.start) * w + local_idx % width + cols.start
         for axis in axes[1:]:
             direction = box.R[:, axis]
-            d = _along(cols_map, cand, direction) - float(box.center_m @ direction)
-            allowed = m_all if uniform else M[cand]
-            if N is not None:
-                cos = np.maximum(np.abs(_along(ray_cols, cand, direction)),
-                                 config.background_noise_min_cos)
-                allowed = allowed + N[cand] * cos
-            cand = cand[np.abs(d) - box.extent_m[axis] / 2.0 <= allowed]
+            inside = _within(
+                cols_map, cand, direction, float(box.center_m @ direction), box.extent_m[axis] / 2.0,
+                m_all if uniform else M[cand], N, ray_cols, min_cos,
+            )
+            cand = cand[inside]
             if len(cand) == 0:
                 break
         flat_valid[cand] = False
