@@ -162,7 +162,7 @@ def _block_mean_depth(
         full = np.zeros((h * step, w * step), dtype=np.float32)
         rows, cols = min(depth_m.shape[0], h * step), min(depth_m.shape[1], w * step)
         full[:rows, :cols] = depth_m[:rows, :cols]
-    if not np.isfinite(full.sum(dtype=np.float64)):  # one reduction; rarely true
+    if full.size and not (np.isfinite(full.min()) and np.isfinite(full.max())):  # NaN, inf: rare
         full = np.nan_to_num(full, nan=0.0, posinf=0.0, neginf=0.0)
     valid = np.greater(full, 0.0, out=np.empty(full.shape, dtype=np.float32), casting="unsafe")
     sum_z = cv2.resize(full, (w, h), interpolation=cv2.INTER_AREA).astype(np.float64)
