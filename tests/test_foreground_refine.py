@@ -8,8 +8,9 @@ import pytest
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
+from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.segment import Blob, image_box, segment, table_leg_boxes
+from hiper_cli.perceive.foreground.segment import Blob, image_box, segment
 from tests.fg_scene import (
     CAMERA,
     SceneBox,

@@ -5,7 +5,8 @@ import pytest
 
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
-from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, inside_boxes, segment, support_below
+from hiper_cli.perceive.foreground.background_filter import inside_boxes
+from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, segment, support_below
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 
@@ -61,7 +62,8 @@ def test_boxes_behind_the_camera_are_skipped_and_cost_nothing():
 
 
 def test_background_filter_matches_inside_boxes_on_rotated_boxes():
-    from hiper_cli.perceive.foreground.segment import _filter_background, _rays
+    from hiper_cli.perceive.foreground.background_filter import _filter_background
+    from hiper_cli.perceive.foreground.segment import _rays
 
     rng = np.random.default_rng(7)
     step = 4
@@ -83,7 +85,8 @@ def test_background_filter_matches_inside_boxes_on_rotated_boxes():
 
 
 def test_boxes_reaching_behind_the_camera_filter_exactly_and_visit_only_their_view():
-    from hiper_cli.perceive.foreground.segment import _box_rois, _filter_background, _rays
+    from hiper_cli.perceive.foreground.background_filter import _box_rois, _filter_background
+    from hiper_cli.perceive.foreground.segment import _rays
 
     rng = np.random.default_rng(11)
     step = 4

@@ -15,12 +15,13 @@ from numpy.typing import NDArray
 from hiper_cli.errors import PerceptionError
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.segment import Blob, segment, table_leg_boxes
+from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.tables import drop_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
 from hiper_cli.perceive.stage import FrameResult, World
