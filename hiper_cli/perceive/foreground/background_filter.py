@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import CORNER_SIGNS, Box3D
+from hiper_cli.model import CORNER_SIGNS, Box3D, point_bounds
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.types import CameraIntrinsics
 
@@ -114,7 +114,7 @@ def inside_boxes(
     margin = np.asarray(margin_m, dtype=np.float64)
     max_margin = float(margin.max())
     per_point = margin.reshape(-1, 1) if margin.ndim else margin
-    plo, phi = points.min(axis=0), points.max(axis=0)
+    plo, phi = point_bounds(points)
     todo = np.arange(len(points))  # points not yet known to be inside: the set shrinks
     for box in sorted(boxes, key=lambda b: -b.volume_m3):  # floors and walls first
         lo, hi = box.aabb()
