@@ -23,7 +23,7 @@ from typing import Any
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.documents import Session
-from hiper_cli.perceive.runner import run_stages
+from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
 from hiper_cli.types import Frame
 
@@ -202,26 +202,23 @@ def perceive(
     )
     obs_counts: Counter[tuple[str, str]] = Counter()
     last_sync = time.perf_counter()
-    done = 0
     current = session
 
     def frames() -> Iterator[Frame]:
-        nonlocal done
+        # Runs in the reading thread (``prefetch``): the only writer of frames_already_done.
         for frame in log:
             if after_pose is not None and frame.pose_id <= after_pose:
-                done += 1
                 summary.frames_already_done += 1
                 continue
             yield frame
 
     def on_frame(frame: Frame | None, result: FrameResult) -> None:
-        nonlocal done, last_sync
+        nonlocal last_sync
         if frame is None:
             kb.write_frame(current, result)
         else:
             kb.write_frame(current, result, pose_id=frame.pose_id, stamp_s=frame.stamp_s,
                            T_map_cam=frame.T_map_cam)
-            done += 1
             summary.frames_read += 1
         for obs in result.observations:
             obs_counts[(obs.layer, obs.class_name)] += 1
@@ -233,10 +230,12 @@ def perceive(
             summary.graph_sync_s += time.perf_counter() - t0
             last_sync = time.perf_counter()
         if progress is not None and frame is not None:
-            progress(done, total)
+            progress(summary.frames_already_done + summary.frames_read, total)
 
     start = time.perf_counter()
-    world, stats = run_stages(frames(), stage_list, world, on_frame)
+    # Frames are read and decoded one thread ahead (decoding releases the interpreter lock):
+    # with the `truth` or `log` detector the second core decodes while this one perceives.
+    world, stats = run_stages(prefetch(frames()), stage_list, world, on_frame)
     kb.end_session(current)
     t0 = time.perf_counter()
     kb.sync_graph()

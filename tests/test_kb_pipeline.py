@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hiper_cli.cli import app
-from hiper_cli.errors import ConfigError, KnowledgeBaseError
+from hiper_cli.errors import ConfigError, KnowledgeBaseError, LogError
 from hiper_cli.graph import open_kb
 from hiper_cli.perceive import stage as stage_module
 from hiper_cli.perceive.logs import TumWriter
@@ -92,6 +92,32 @@ def test_resume_continues_after_the_last_committed_frame(tmp_path):
         assert len(floor.observation_uuids) == 12
         with pytest.raises(KnowledgeBaseError, match="nothing to resume"):
             perceive(_log(), kb, [ProbeStage()], resume=True)
+
+
+class UnreadableAt(FrameList):
+    """A log whose reader fails on one frame (a corrupt image), in the reading thread."""
+
+    def __init__(self, frames, bad_pose_id: int) -> None:
+        super().__init__(frames)
+        self.bad_pose_id = bad_pose_id
+
+    def __iter__(self):
+        for frame in self.frames:
+            if frame.pose_id == self.bad_pose_id:
+                raise LogError(f"/logs/codelog/rgb/{frame.pose_id}.png: cannot decode the image")
+            yield frame
+
+
+def test_a_frame_the_reader_cannot_decode_stops_the_run_after_the_frames_before_it(tmp_path):
+    # frames are read one thread ahead: the reader's error reaches the caller, in order
+    with open_kb(tmp_path / "kb") as kb:
+        with pytest.raises(LogError, match=r"5\.png: cannot decode"):
+            perceive(UnreadableAt([make_frame(i) for i in range(12)], 5), kb, [ProbeStage()])
+        (session,) = kb.docs.sessions()
+        assert not session.finished and session.last_pose_id == 4 and session.frames == 5
+        assert kb.docs.count(type="observation") == 10
+    with open_kb(tmp_path / "kb") as kb:  # opening brings the graph up to the committed frames
+        assert kb.check(repair=False).ok
 
 
 def test_sessions_of_several_logs_accumulate_in_one_environment(tmp_path):

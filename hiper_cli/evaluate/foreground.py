@@ -30,7 +30,6 @@ from __future__ import annotations
 import itertools
 import time
 from collections import Counter
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,7 +40,7 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import Instance, Observation
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.runner import run_stages
+from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import FrameResult, Stage, World, make_stage
 from hiper_cli.sim.truth import Truth, load_truth
 from hiper_cli.types import Frame
@@ -208,44 +207,6 @@ def _run(
             run.obs_visible_error_xy_m.update(errors_xy)
     run.world, run.frames = world, stats.frames
     return run
-
-
-def prefetch(frames: Iterator[Frame], depth: int = 4) -> Iterator[Frame]:
-    """Read frames in a background thread (image decoding releases the GIL), ``depth`` ahead."""
-    import queue
-    import threading
-
-    q: queue.Queue[Any] = queue.Queue(maxsize=depth)
-    done = object()
-    stop = threading.Event()
-
-    def work() -> None:
-        try:
-            for frame in frames:
-                if stop.is_set():
-                    return
-                q.put(frame)
-        except BaseException as err:  # handed to the consumer, raised there
-            q.put(err)
-        q.put(done)
-
-    thread = threading.Thread(target=work, name="hiper-read", daemon=True)
-    thread.start()
-    try:
-        while True:
-            item = q.get()
-            if item is done:
-                return
-            if isinstance(item, BaseException):
-                raise item
-            yield item
-    finally:
-        stop.set()
-        while thread.is_alive():
-            try:
-                q.get_nowait()
-            except queue.Empty:
-                thread.join(timeout=0.01)
 
 
 def _mean_std(values: list[float] | NDArray[np.float64]) -> list[float | None]:

@@ -7,13 +7,14 @@ merged result in ``on_frame``; the evaluators run it without a store and read th
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from hiper_cli.perceive.stage import FrameResult, Stage, World
 from hiper_cli.types import Frame
 
-__all__ = ["RunStats", "run_stages"]
+__all__ = ["RunStats", "prefetch", "run_stages"]
 
 OnFrame = Callable[[Frame | None, FrameResult], None]
 
@@ -46,16 +47,22 @@ def run_stages(
     updated by the stages before it in the same frame. A stage with a ``prepare(frame)``
     method is handed the next frame before the current one is processed, to start work that
     needs no world (the foreground stage runs its detector on it in a worker thread, so the
-    detector is busy while this frame's point cloud is processed).
+    detector is busy while this frame's point cloud is processed). A frame that cannot be read
+    raises its error after the frames before it are processed and handed to ``on_frame``;
+    ``finish`` does not run then.
     """
     world = world if world is not None else World()
     stats = RunStats()
     ahead = [p for p in (getattr(stage, "prepare", None) for stage in stages) if callable(p)]
     stream = iter(frames)
     upcoming = next(stream, None)
+    unreadable: Exception | None = None
     while upcoming is not None:
         frame = upcoming
-        upcoming = next(stream, None)
+        try:
+            upcoming = next(stream, None)
+        except Exception as err:  # the next frame cannot be read: finish this one first
+            upcoming, unreadable = None, err
         start = time.perf_counter()
         if upcoming is not None:
             for prepare in ahead:
@@ -72,6 +79,8 @@ def run_stages(
         stats.frame_times_s.append(time.perf_counter() - start)
         if on_frame is not None:
             on_frame(frame, merged)
+    if unreadable is not None:
+        raise unreadable
     final = FrameResult()
     for stage in stages:
         result = stage.finish(world)
@@ -81,3 +90,41 @@ def run_stages(
     if on_frame is not None:
         on_frame(None, final)
     return world, stats
+
+
+def prefetch(frames: Iterator[Frame], depth: int = 4) -> Iterator[Frame]:
+    """Read frames in a background thread (image decoding releases the GIL), ``depth`` ahead."""
+    import queue
+    import threading
+
+    q: queue.Queue[Any] = queue.Queue(maxsize=depth)
+    done = object()
+    stop = threading.Event()
+
+    def work() -> None:
+        try:
+            for frame in frames:
+                if stop.is_set():
+                    return
+                q.put(frame)
+        except BaseException as err:  # handed to the consumer, raised there
+            q.put(err)
+        q.put(done)
+
+    thread = threading.Thread(target=work, name="hiper-read", daemon=True)
+    thread.start()
+    try:
+        while True:
+            item = q.get()
+            if item is done:
+                return
+            if isinstance(item, BaseException):
+                raise item
+            yield item
+    finally:
+        stop.set()
+        while thread.is_alive():
+            try:
+                q.get_nowait()
+            except queue.Empty:
+                thread.join(timeout=0.01)
