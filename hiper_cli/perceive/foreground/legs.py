@@ -113,6 +113,7 @@ def drop_table_legs(
     # point of it: only the tables near it are tested (same result, a fraction of the work).
     reach = config.table_leg_reach_m + (config.table_rim_reach_m if rims else 0.0)
     footprints = [table.aabb() for table in tables]
+    tops = [float(hi[2]) for _, hi in footprints]
     out: list[Blob] = []
     for blob in blobs:
         lo, hi = blob.bounds_map
@@ -131,7 +132,6 @@ def drop_table_legs(
         if len(keep) < 3 or (len(keep) < config.min_cluster_points and not blob.fragment):
             continue
         if rims and not blob.fragment:
-            tops = [float(t.aabb()[1][2]) for t in tables]
             for part in grid_components(blob, keep, step, config):
                 fragment = len(part) < config.min_cluster_points
                 if len(part) < 3 or (fragment and not config.detection_join):

@@ -349,21 +349,17 @@ class Tracker:
         track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
-    def _gate(
-        self, track: Track, stamp_s: float, variance_m2: float | None = None, moving: bool | None = None
-    ) -> tuple[float, float]:
+    def _gate(self, track: Track, stamp_s: float, variance_m2: float | None = None) -> tuple[float, float]:
         """(base gate, gate): the gate is the base widened while a moving track searches.
-        ``variance_m2``: the largest eigenvalue of the track's position covariance; ``moving``:
-        ``_was_moving`` of the track (each computed when not given)."""
+        ``variance_m2``: the largest eigenvalue of the track's position covariance (computed
+        when not given)."""
         cfg = self.config
         dt = stamp_s - track.last_update_s
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
             return learned, learned
-        if moving is None:
-            moving = _was_moving(track, cfg)
-        searching = track.class_name in cfg.search_classes and moving
+        searching = track.class_name in cfg.search_classes and _was_moving(track, cfg)
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
@@ -373,13 +369,12 @@ class Tracker:
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
         return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
 
-    def _settled(self, track: Track, moving: bool) -> bool:
-        """Whether a track stood still long enough to be known where it is (``settled_hits``);
-        ``moving``: ``_was_moving`` of the track."""
+    def _settled(self, track: Track) -> bool:
+        """Whether a track stood still long enough to be known where it is (``settled_hits``)."""
         cfg = self.config
         if cfg.settled_hits <= 0 or track.hits < cfg.settled_hits or track.class_name in cfg.walker_classes:
             return False
-        return not moving and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
+        return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated Hungarian assignment."""
@@ -393,11 +388,9 @@ class Tracker:
         # The filters' own uncertainty, all tracks in one eigenvalue call.
         P = np.array([t.kf.P[:3, :3] for t in self.tracks])  # type: ignore[attr-defined]
         variances = np.linalg.eigvalsh(P).max(axis=1)
-        moving = [_was_moving(t, self.config) for t in self.tracks]
-        gates = np.array([
-            self._gate(t, stamp_s, float(v), mv)
-            for t, v, mv in zip(self.tracks, variances, moving, strict=True)
-        ]).reshape(-1, 2)
+        gates = np.array(
+            [self._gate(t, stamp_s, float(v)) for t, v in zip(self.tracks, variances, strict=True)]
+        ).reshape(-1, 2)
         allowed = cost <= gates[:, 1:2]
         searched = cost > gates[:, 0:1]
         cfg = self.config
@@ -409,7 +402,7 @@ class Tracker:
         half_extents = np.array([m.extent_map for m in measurements]) / 2.0
         for i, t in enumerate(self.tracks):
             cls = t.class_name
-            if self._settled(t, moving[i]):
+            if self._settled(t):
                 reach = t.extent_m / 2.0 + cfg.settled_overlap_m
                 allowed[i] &= np.all(np.abs(obs - t.position) <= reach + half_extents, axis=1)
             if cls != UNKNOWN:  # two different known classes cost more; unknown is neutral
