@@ -3,7 +3,7 @@
 Timeline: stamps ``k / rate_hz`` from 0; the mapping phase (no people, carts still) lasts
 ``mapping_s``, then the operation phase adds the people and lets the carts move. Output:
 the TUM RGB-D folder (written by ``TumWriter``) plus ``gt/`` as specified in
-``hiper_cli.sim.truth``.
+``hiper_cli.perceive.logs.truth``.
 """
 
 from __future__ import annotations

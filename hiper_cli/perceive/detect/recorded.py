@@ -38,7 +38,7 @@ class TruthDetector:
 
     def __init__(self, log_path: Path, min_score: float = 0.0, stamp_tolerance_s: float = 0.005) -> None:
         from hiper_cli.errors import LogError
-        from hiper_cli.sim.truth import load_truth
+        from hiper_cli.perceive.logs.truth import load_truth
 
         try:
             records = load_truth(log_path).load_detections()

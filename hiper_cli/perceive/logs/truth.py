@@ -1,4 +1,4 @@
-"""Ground truth of a simulated log (the ``gt/`` folder written by ``hiper sim``).
+"""Ground truth of a simulated log (the ``gt/`` folder written by ``hiper sim``): a log format.
 
 The layout, beside the TUM RGB-D files of the log (``rgb.txt``, ``depth.txt``,
 ``groundtruth.txt`` = T_map_cam per stamp, ``camera.json``)::
