@@ -4,6 +4,9 @@ Observations (o) are anchored to the sensor frame and the pose id they were seen
 optimised trajectory can recompute every instance. Instances (i) live in the map frame and keep
 the uuids of the observations they were formed from. Analyses (a) hold learned features.
 
+``World`` (the live instances the stages read) and ``FrameResult`` (what a stage made of one
+frame) are shared by the recognition stages and the knowledge base.
+
 High-level attributes (uuid, frame, last update, class, box) are plain fields; low-level data
 (plane model and contour, point blobs, image boxes, trajectories, fused points) live in ``data``,
 a JSON-serialisable dict. ``to_dict``/``from_dict`` give the document form stored in the
@@ -22,17 +25,19 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import DataError
+from hiper_cli.errors import ConfigError, DataError
 
 __all__ = [
     "LAYERS",
     "Analysis",
     "Box3D",
     "Environment",
+    "FrameResult",
     "Instance",
     "Layer",
     "Observation",
     "State",
+    "World",
     "json_default",
     "new_uuid",
     "point_bounds",
@@ -309,3 +314,53 @@ class Environment:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Environment:
         return cls(name=d["name"], data=d.get("data", {}), uuid=d["uuid"])
+
+
+@dataclass
+class World:
+    """What the stages may read: live instances by uuid, per layer, and learned analyses."""
+
+    background: dict[str, Instance] = field(default_factory=dict)
+    foreground: dict[str, Instance] = field(default_factory=dict)
+    analyses: list[Analysis] = field(default_factory=list)
+
+    def layer(self, name: str) -> dict[str, Instance]:
+        if name == "background":
+            return self.background
+        if name == "foreground":
+            return self.foreground
+        raise ConfigError(f"unknown layer {name!r}; expected 'background' or 'foreground'")
+
+    def analysis(self, kind: str, class_name: str) -> Analysis | None:
+        """The newest analysis of ``kind`` for ``class_name``, if any."""
+        found = [a for a in self.analyses if a.kind == kind and a.class_name == class_name]
+        return max(found, key=lambda a: a.created_s) if found else None
+
+    def apply(self, result: FrameResult) -> None:
+        for inst in result.instances:
+            self.layer(inst.layer)[inst.uuid] = inst
+        for uuid in result.deleted_instances:
+            self.background.pop(uuid, None)
+            self.foreground.pop(uuid, None)
+
+
+@dataclass
+class FrameResult:
+    """What one stage made of one frame.
+
+    ``instances`` are created or updated (upserted by uuid); ``deleted_instances`` are uuids
+    merged away. ``timings_s`` holds named durations (e.g. ``background_s``) for reports.
+    ``skipped`` is a reason when the stage did not process the frame (e.g. not a keyframe).
+    """
+
+    observations: list[Observation] = field(default_factory=list)
+    instances: list[Instance] = field(default_factory=list)
+    deleted_instances: list[str] = field(default_factory=list)
+    timings_s: dict[str, float] = field(default_factory=dict)
+    skipped: str | None = None
+
+    def extend(self, other: FrameResult) -> None:
+        self.observations.extend(other.observations)
+        self.instances.extend(other.instances)
+        self.deleted_instances.extend(other.deleted_instances)
+        self.timings_s.update(other.timings_s)

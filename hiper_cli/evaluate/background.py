@@ -32,8 +32,8 @@ import numpy as np
 from hiper_cli.errors import LogError
 from hiper_cli.model import Instance
 from hiper_cli.perceive.background.contour import sample_ring
-from hiper_cli.perceive.stage import FrameResult
 from hiper_cli.perceive.logs.truth import Truth, TruthInstance, load_truth
+from hiper_cli.perceive.stage import FrameResult
 from hiper_cli.types import Frame
 
 __all__ = ["PAPER_TABLE_II", "TARGETS", "BackgroundReport", "evaluate_background", "score_background"]

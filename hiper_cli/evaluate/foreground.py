@@ -40,9 +40,9 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import Instance, Observation
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import FrameResult, Stage, World, make_stage
-from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.types import Frame
 
 __all__ = [

@@ -78,8 +78,7 @@ def run_size(n_obs: int, root: str, config: BenchConfig) -> dict[str, Any]:
 
     from hiper_cli.graph.follower import GraphFollower
     from hiper_cli.graph.kb import KbConfig, open_kb
-    from hiper_cli.model import Box3D, Instance, Observation
-    from hiper_cli.perceive.stage import FrameResult
+    from hiper_cli.model import Box3D, FrameResult, Instance, Observation
 
     rng = random.Random(config.seed)
     kb = open_kb(Path(root) / "bench.hiper", config=KbConfig(observation_detail=config.observation_detail))

@@ -36,8 +36,7 @@ from hiper_cli.graph.ontology import (
 )
 from hiper_cli.graph.scenegraph import DetachedGraph, LocalGraph, SparqlGraph, open_graph
 from hiper_cli.graph.sync import SyncReport, sync_graph
-from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, Instance, Observation
-from hiper_cli.perceive.stage import FrameResult, World
+from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, FrameResult, Instance, Observation, World
 
 __all__ = [
     "DEFAULT_KB",

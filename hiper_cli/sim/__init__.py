@@ -8,11 +8,11 @@ Worlds (``worlds``), people by the Social Force Model (``people``), the robot ro
 the writer (``writer``); the ground-truth format is specified in ``truth``.
 """
 
+from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.sim.noise import NoiseModel
 from hiper_cli.sim.people import SocialForceConfig
 from hiper_cli.sim.render import DepthNoise, RenderConfig
 from hiper_cli.sim.route import RouteConfig
-from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.sim.worlds import WORLDS, make_world
 from hiper_cli.sim.writer import SimConfig, SimResult, simulate
 
