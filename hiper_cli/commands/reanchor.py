@@ -1,7 +1,7 @@
 """``hiper reanchor``: recompute the background instances of a knowledge base with new poses.
 
-Library: ``hiper_cli.perceive.background.reanchor`` (the recomputation) and
-``hiper_cli.graph`` (reading and writing the knowledge base).
+Library: ``hiper_cli.reanchor.reanchor_kb`` (beside ``hiper_cli.pipeline``: it reruns the
+background recomputation over what a knowledge base holds).
 """
 
 from __future__ import annotations
@@ -39,8 +39,8 @@ def register(app: HiperTyper) -> None:
         json_out: bool = JSON_OPTION,
     ) -> None:
         from hiper_cli.graph import open_kb
-        from hiper_cli.graph.reanchor import reanchor_kb
         from hiper_cli.perceive.logs import read_tum_trajectory
+        from hiper_cli.reanchor import reanchor_kb
 
         trajectory = read_tum_trajectory(poses)
         with open_kb(kb, docs_dir=kb_docs) as knowledge:

@@ -2,7 +2,9 @@
 
 Reads every background instance and its observations, recomputes the instances with
 ``hiper_cli.perceive.background.reanchor`` (each observation takes the pose at its stamp) and
-writes the instances, the observations' map boxes and the deletions in one transaction.
+writes the instances, the observations' map boxes and the deletions in one transaction. It
+runs perception over stored data, so it sits beside ``pipeline`` above both ``perceive`` and
+``graph``.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.graph.kb import KnowledgeBase
+from hiper_cli.graph import KnowledgeBase
 from hiper_cli.model import Observation
 from hiper_cli.perceive.background import reanchor
 from hiper_cli.perceive.logs import Trajectory
