@@ -1,15 +1,50 @@
-"""Imports flow one way: perceive -> graph -> analyze -> query/serve -> cli (STYLE.md, 2)."""
+"""Imports flow one way: perceive -> graph -> analyze -> query/serve -> cli (STYLE.md, 2).
+
+Every package and top-level module of ``hiper_cli`` has a rule here, so a new package must say
+where it sits before its first test run passes. A rule lists what its modules may not import.
+"""
 
 import ast
 import pathlib
 
+import pytest
+
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "hiper_cli"
-# A module in the key package may not import from any of the listed packages.
-FORBIDDEN = {
-    "perceive": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.commands", "hiper_cli.cli",
-                 "hiper_cli.pipeline", "typer", "rich", "matplotlib"),
-    "graph": ("hiper_cli.analyze", "hiper_cli.commands", "hiper_cli.cli", "typer", "rich"),
-    "analyze": ("hiper_cli.commands", "hiper_cli.cli", "typer", "rich"),
+
+_UI = ("hiper_cli.commands", "hiper_cli.cli", "typer", "rich")
+_ABOVE_PERCEIVE = ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
+                   "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate")
+_CORE_FORBIDDEN = ("hiper_cli.perceive", *_ABOVE_PERCEIVE, *_UI)
+
+# package (folder) or module (file stem) -> prefixes its modules may not import
+FORBIDDEN: dict[str, tuple[str, ...]] = {
+    # the core: entities and errors every layer shares
+    "types": _CORE_FORBIDDEN,
+    "model": _CORE_FORBIDDEN,
+    "errors": _CORE_FORBIDDEN,
+    # recognition: log readers (the simulator's truth format included), stages, detectors
+    "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib"),
+    # the knowledge base stores what perceive produced
+    "graph": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor",
+              "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # interpretation of a knowledge base
+    "analyze": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim", *_UI),
+    # questions over perceive types, the graph and the analyses
+    "query": ("hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # the simulator writes logs (perceive.logs writers), never reads a knowledge base
+    "sim": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
+            "hiper_cli.reanchor", "hiper_cli.evaluate", *_UI),
+    # scoring perception against simulator truth
+    "evaluate": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
+                 "hiper_cli.reanchor", *_UI),
+    # runs of perception into a knowledge base
+    "pipeline": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    "reanchor": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # the command line sits on top of everything
+    "commands": (),
+    "cli": (),
+    "__init__": ("hiper_cli.",),
+    "__main__": (),
 }
 
 
@@ -23,17 +58,36 @@ def _imports(path: pathlib.Path) -> set[str]:
     return names
 
 
-def test_imports_flow_one_way():
-    offenders = []
-    for package, forbidden in FORBIDDEN.items():
-        for path in (PACKAGE / package).rglob("*.py"):
-            for name in _imports(path):
-                if name.startswith(forbidden):
-                    offenders.append(f"{path.relative_to(PACKAGE)} imports {name}")
+def _units() -> list[str]:
+    return sorted(p.stem if p.is_file() else p.name for p in PACKAGE.iterdir()
+                  if (p.is_file() and p.suffix == ".py") or (p.is_dir() and (p / "__init__.py").exists()))
+
+
+def _modules(unit: str) -> list[pathlib.Path]:
+    folder = PACKAGE / unit
+    return sorted(folder.rglob("*.py")) if folder.is_dir() else [PACKAGE / f"{unit}.py"]
+
+
+def test_every_package_has_a_rule():
+    missing = [unit for unit in _units() if unit not in FORBIDDEN]
+    assert not missing, f"add an import rule to FORBIDDEN for {missing}"
+
+
+@pytest.mark.parametrize("unit", _units())
+def test_imports_flow_one_way(unit):
+    forbidden = FORBIDDEN[unit]
+    offenders = [
+        f"{path.relative_to(PACKAGE)} imports {name}"
+        for path in _modules(unit)
+        for name in _imports(path)
+        if forbidden and name.startswith(forbidden)
+    ]
     assert not offenders, "\n".join(offenders)
 
 
-def test_core_types_import_no_stage():
-    for module in ("types.py", "model.py", "errors.py"):
-        for name in _imports(PACKAGE / module):
-            assert not name.startswith(("hiper_cli.perceive", "hiper_cli.graph", "hiper_cli.analyze"))
+def test_query_rule_allows_what_it_builds_on():
+    """The coming query layer may read perceive types, the graph and the analyses."""
+    for allowed in ("hiper_cli.perceive.logs", "hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.model"):
+        assert not allowed.startswith(FORBIDDEN["query"])
+    for denied in ("hiper_cli.commands._common", "hiper_cli.cli", "typer", "rich.table"):
+        assert denied.startswith(FORBIDDEN["query"])
