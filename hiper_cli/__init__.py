@@ -4,4 +4,5 @@ The library has one public entry per stage; the CLI (``hiper``) is a thin layer 
 """
 
 __version__ = "0.1.0"
-__all__ = ["__version__"]
+DEFAULT_KB = "scene.hiper"  # the knowledge base every command and ``open_kb`` use unless told
+__all__ = ["DEFAULT_KB", "__version__"]

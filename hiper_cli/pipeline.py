@@ -2,34 +2,165 @@
 
 The pipeline owns the ``World``. Every frame's merged ``FrameResult`` (observations, upserted
 and deleted instances) is written in one transaction together with the frame's pose row and
-the session's progress, so a crash loses at most the frame in flight and ``resume=True``
+the session's progress, so a crash loses at most the frame in flight and ``resume``
 continues after the last committed frame of the unfinished session of the same log. The scene
 graph follows the documents every ``graph_sync_s`` seconds and at the end (see ``graph.kb``).
 
 Each run is a session of an environment (default: the log folder's name); the environment's
 live instances and analyses are loaded into the ``World`` first, so several logs of the same
 place accumulate into one environment.
+
+Two entries: ``perceive(reader, kb, stages, options)`` runs built stages over an open log;
+``perceive_log(path, kb_location, LogOptions(...), PerceiveOptions(...))`` is the whole of
+``hiper perceive`` (open the log, choose and build the stages, open the knowledge base, run).
 """
 
 from __future__ import annotations
 
+import json
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.documents import Session
+from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
 from hiper_cli.types import Frame
 
-__all__ = ["PerceiveSummary", "available_stages", "build_stages", "perceive"]
+__all__ = [
+    "PerceiveOptions",
+    "PerceiveSummary",
+    "StageSet",
+    "available_stages",
+    "build_stages",
+    "parse_stage_options",
+    "perceive",
+    "perceive_log",
+    "select_stages",
+]
 
 Progress = Callable[[int, int], None]
+DEFAULT_GRAPH_SYNC_S = 2.0  # the scene graph follows the documents this often during a run
+
+
+def parse_stage_options(items: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """``["foreground.detector=truth", "background.keyframe_hz=2"]`` -> per-stage option dicts.
+
+    Values are read as JSON when they parse (numbers, true/false, lists), else kept as text.
+    """
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        stage, dot, name = key.partition(".")
+        if not sep or not dot or not stage or not name:
+            raise ConfigError(f"-o {item!r}: expected STAGE.KEY=VALUE, e.g. -o foreground.detector=truth")
+        try:
+            value: Any = json.loads(raw)
+        except ValueError:
+            value = raw
+        out.setdefault(stage, {})[name] = value
+    return out
+
+
+@dataclass(frozen=True)
+class PerceiveOptions:
+    """How one ``perceive`` run goes: which stages, their options, where the results go.
+
+    ``stages``: registry names (``None`` = every available stage; options given for stages
+    that are not available are then dropped, not errors). ``stage_options``: per stage, the
+    keyword options of its factory, e.g. ``{"foreground": {"detector": "truth"}}``
+    (``parse_stage_options`` reads them from ``-o STAGE.KEY=VALUE``). ``env_name``: the
+    environment (default: the log folder's name). ``resume``: continue the unfinished session
+    of this log. ``log_path`` names the log in the session (default: the reader's path).
+    """
+
+    stages: tuple[str, ...] | None = None
+    stage_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    env_name: str | None = None
+    resume: bool = False
+    log_path: Path | None = None
+    graph_sync_s: float = DEFAULT_GRAPH_SYNC_S
+
+    @classmethod
+    def from_text(
+        cls,
+        *,
+        stages: str | None = None,
+        options: Sequence[str] = (),
+        overrides: Mapping[str, Mapping[str, Any]] | None = None,
+        env_name: str | None = None,
+        resume: bool = False,
+    ) -> PerceiveOptions:
+        """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
+
+        ``overrides[stage][key]`` beats the same ``-o`` key (a dedicated flag such as
+        ``--detector``); an override whose value is ``None`` was not given and is ignored.
+        """
+        merged = parse_stage_options(options)
+        for stage, values in (overrides or {}).items():
+            for key, value in values.items():
+                if value is not None:
+                    merged.setdefault(stage, {})[key] = value
+        names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
+        return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume)
+
+
+@dataclass(frozen=True)
+class StageSet:
+    """Built stages in run order, and why each registered stage left out cannot run here."""
+
+    stages: tuple[Stage, ...]
+    unavailable: Mapping[str, str] = field(default_factory=dict)
+
+
+def select_stages(log_path: Path, options: PerceiveOptions) -> StageSet:
+    """Build the stages ``options`` asks for; ``ConfigError`` when none can run."""
+    stage_options = options.stage_options
+    if options.stages is None:
+        ok, _ = available_stages()
+        stage_options = {k: v for k, v in stage_options.items() if k in ok}
+    built, unavailable = build_stages(options.stages, log_path, stage_options)
+    if not built:
+        raise ConfigError(
+            "no recognition stage is available in this version of hiper ("
+            + "; ".join(unavailable.values()) + "); nothing to perceive"
+        )
+    return StageSet(tuple(built), unavailable)
+
+
+def perceive_log(
+    log: Path,
+    kb: str,
+    log_options: LogOptions | None = None,
+    options: PerceiveOptions | None = None,
+    *,
+    kb_docs: Path | None = None,
+    progress: Progress | None = None,
+    on_start: Callable[[int], None] | None = None,
+) -> PerceiveSummary:
+    """``hiper perceive`` in one call: open ``log``, build the stages, ``perceive`` into ``kb``.
+
+    ``kb`` is a knowledge base location (see ``open_kb``; ``kb_docs`` its documents directory
+    for an http:// endpoint). The log is opened and the stages built first, so bad options
+    leave no knowledge base behind. ``on_start(total_frames)`` is called before the first frame.
+    """
+    from hiper_cli.graph import open_kb
+
+    options = options or PerceiveOptions()
+    reader = open_log(log, log_options or LogOptions())
+    stages = select_stages(log.resolve(), options)
+    if options.log_path is None:
+        options = replace(options, log_path=log)
+    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+        if on_start is not None:
+            on_start(len(reader))
+        return perceive(reader, knowledge, stages, options, progress=progress)
 
 
 @dataclass
@@ -143,39 +274,27 @@ def _layer_class_counts(pairs: Counter[tuple[str, str]]) -> dict[str, dict[str, 
 
 
 def perceive(
-    log: Any,
+    reader: LogReader,
     kb: KnowledgeBase,
-    stages: Sequence[Stage] | Sequence[str] | None = None,
-    stage_options: Mapping[str, Mapping[str, Any]] | None = None,
+    stages: StageSet | Sequence[Stage],
+    options: PerceiveOptions | None = None,
     *,
-    poses: str | Path | None = None,
-    log_path: Path | None = None,
-    env_name: str | None = None,
-    resume: bool = False,
     progress: Progress | None = None,
-    graph_sync_s: float = 2.0,
-    unavailable_stages: Mapping[str, str] | None = None,
 ) -> PerceiveSummary:
-    """Run ``stages`` over the frames of ``log`` and store everything in ``kb``.
+    """Run ``stages`` over the frames of ``reader`` and store everything in ``kb``.
 
-    ``log``: a path (opened with ``open_log(log, poses=poses)``) or a ``LogReader``.
-    ``stages``: ``Stage`` objects, or registry names built with ``stage_options[name]`` and
-    ``log_path`` (``None`` = every available stage). ``log_path`` names the log in the session
-    (default: the path of ``log``); ``env_name`` the environment (default: the log folder's
-    name). ``progress(done, total)`` is called after every frame.
+    ``stages``: built stages, or a ``StageSet`` from ``select_stages`` (whose unavailable
+    stages the summary reports). ``options.log_path`` names the log in the session (default:
+    the reader's path); ``options.env_name`` the environment (default: the log folder's name).
+    ``progress(done, total)`` is called after every frame.
     """
-    if isinstance(log, str | Path):
-        from hiper_cli.perceive.logs import open_log
-
-        log_path = Path(log) if log_path is None else log_path
-        log = open_log(log, poses=poses)
-    path = Path(log_path if log_path is not None else log.info().path).resolve()
-    if stages is None or all(isinstance(s, str) for s in stages):
-        names_in = None if stages is None else [str(s) for s in stages]
-        built, missing = build_stages(names_in, path, stage_options)
-        stages = built
-        unavailable_stages = {**missing, **dict(unavailable_stages or {})}
-    stage_list = [s for s in stages if not isinstance(s, str)]
+    options = options or PerceiveOptions()
+    if isinstance(stages, StageSet):
+        stage_list, unavailable_stages = list(stages.stages), dict(stages.unavailable)
+    else:
+        stage_list, unavailable_stages = list(stages), {}
+    env_name, resume, graph_sync_s = options.env_name, options.resume, options.graph_sync_s
+    path = Path(options.log_path if options.log_path is not None else reader.info().path).resolve()
     env = kb.environment(env_name or path.stem or path.name)
     names = [s.name for s in stage_list]
     session: Session | None = None
@@ -194,11 +313,11 @@ def perceive(
     if session is None:
         session = kb.start_session(env, str(path), names)
     world = kb.load_world(env)
-    total = len(log)
+    total = len(reader)
     summary = PerceiveSummary(
         log=str(path), kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=after_pose if resume else None, frames_total=total,
-        unavailable_stages=dict(unavailable_stages or {}),
+        unavailable_stages=unavailable_stages,
     )
     obs_counts: Counter[tuple[str, str]] = Counter()
     last_sync = time.perf_counter()
@@ -206,7 +325,7 @@ def perceive(
 
     def frames() -> Iterator[Frame]:
         # Runs in the reading thread (``prefetch``): the only writer of frames_already_done.
-        for frame in log:
+        for frame in reader:
             if after_pose is not None and frame.pose_id <= after_pose:
                 summary.frames_already_done += 1
                 continue
@@ -241,7 +360,7 @@ def perceive(
     kb.sync_graph()
     summary.graph_sync_s += time.perf_counter() - t0
     summary.seconds = time.perf_counter() - start
-    summary.skipped = [{"source": s, "reason": r} for s, r in getattr(log, "skipped", [])]
+    summary.skipped = [{"source": s, "reason": r} for s, r in getattr(reader, "skipped", [])]
     summary.observations = _layer_class_counts(obs_counts)
     inst_counts: Counter[tuple[str, str]] = Counter()
     for layer in ("background", "foreground"):

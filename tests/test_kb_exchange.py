@@ -12,7 +12,7 @@ from hiper_cli.errors import DataError
 from hiper_cli.graph import open_kb
 from hiper_cli.graph.exchange import export_kb, import_kb, json_export
 from hiper_cli.model import Analysis
-from hiper_cli.pipeline import perceive
+from hiper_cli.pipeline import PerceiveOptions, perceive
 from tests import kb_helpers
 from tests.kb_helpers import FrameList, ProbeStage, make_frame
 
@@ -26,7 +26,8 @@ SUFFIX = {"turtle": "ttl", "nquads": "nq", "jsonld": "jsonld", "graphml": "graph
 
 def _filled(location, docs_dir):
     kb = open_kb(location, docs_dir=docs_dir)
-    perceive(FrameList([make_frame(i, x_m=0.3 * i) for i in range(10)]), kb, [ProbeStage()], env_name="lab")
+    log = FrameList([make_frame(i, x_m=0.3 * i) for i in range(10)])
+    perceive(log, kb, [ProbeStage()], PerceiveOptions(env_name="lab"))
     kb.put_analyses([Analysis("ods", "cup", 0.0, 9.0, {"mean_mps": 0.3, "cl_mps": 0.1}, 5.0)])
     kb.sync_graph()
     return kb

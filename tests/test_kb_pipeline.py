@@ -13,7 +13,7 @@ from hiper_cli.errors import ConfigError, KnowledgeBaseError, LogError
 from hiper_cli.graph import open_kb
 from hiper_cli.perceive import stage as stage_module
 from hiper_cli.perceive.logs import TumWriter
-from hiper_cli.pipeline import available_stages, build_stages, perceive
+from hiper_cli.pipeline import PerceiveOptions, available_stages, build_stages, perceive
 from tests.kb_helpers import CAMERA, FrameList, ProbeStage, make_frame
 
 runner = CliRunner()
@@ -58,7 +58,7 @@ def _log(n=12):
 def test_perceive_writes_every_frame_and_summarises(tmp_path):
     done = []
     with open_kb(tmp_path / "kb") as kb:
-        summary = perceive(_log(), kb, [ProbeStage()], env_name="lab",
+        summary = perceive(_log(), kb, [ProbeStage()], PerceiveOptions(env_name="lab"),
                            progress=lambda d, t: done.append((d, t)))
         assert kb.check(repair=False).ok
         (session,) = kb.docs.sessions()
@@ -81,7 +81,7 @@ def test_resume_continues_after_the_last_committed_frame(tmp_path):
         (session,) = kb.docs.sessions()
         assert not session.finished and session.last_pose_id == 6 and session.frames == 7
     with open_kb(tmp_path / "kb") as kb:
-        summary = perceive(_log(), kb, [ProbeStage()], resume=True)
+        summary = perceive(_log(), kb, [ProbeStage()], PerceiveOptions(resume=True))
         assert summary.resumed_after_pose_id == 6
         assert summary.frames_already_done == 7 and summary.frames_read == 5
         (session,) = kb.docs.sessions()
@@ -91,7 +91,7 @@ def test_resume_continues_after_the_last_committed_frame(tmp_path):
         (floor,) = kb.instances(layer="background")
         assert len(floor.observation_uuids) == 12
         with pytest.raises(KnowledgeBaseError, match="nothing to resume"):
-            perceive(_log(), kb, [ProbeStage()], resume=True)
+            perceive(_log(), kb, [ProbeStage()], PerceiveOptions(resume=True))
 
 
 class UnreadableAt(FrameList):
@@ -123,7 +123,8 @@ def test_a_frame_the_reader_cannot_decode_stops_the_run_after_the_frames_before_
 def test_sessions_of_several_logs_accumulate_in_one_environment(tmp_path):
     with open_kb(tmp_path / "kb") as kb:
         for name, n in (("/logs/a", 4), ("/logs/b", 3)):
-            perceive(FrameList([make_frame(i) for i in range(n)], name), kb, [ProbeStage()], env_name="house")
+            log = FrameList([make_frame(i) for i in range(n)], name)
+            perceive(log, kb, [ProbeStage()], PerceiveOptions(env_name="house"))
         assert [e.name for e in kb.environments()] == ["house"]
         assert [s.frames for s in kb.docs.sessions()] == [4, 3]
         (floor,) = kb.instances(layer="background")

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import typer
 
-JSON_OPTION = typer.Option(False, "--json", help="Print machine-readable JSON on stdout.")
+from hiper_cli.commands._common import JSON_OPTION
+
+__all__ = ["JSON_OPTION", "HiperTyper", "console", "frame_progress", "group", "print_error", "print_json"]
 
 
 def print_error(message: str) -> None:
@@ -62,3 +66,37 @@ class HiperTyper(typer.Typer):
 def group(name: str, help: str) -> HiperTyper:
     """A command group such as ``hiper kb``; ``help`` must contain an ``Example:``."""
     return HiperTyper(name=name, help=help, no_args_is_help=True, add_completion=False)
+
+
+class FrameBar:
+    """A rich progress bar over frames: ``start(total)`` once, then ``update(done, total)``."""
+
+    def __init__(self, bar: Any) -> None:
+        self._bar = bar
+        self._task: Any = None
+
+    def start(self, total: int) -> None:
+        self._task = self._bar.add_task("frames", total=total, rate=0.0)
+
+    def advance(self, *_: Any) -> None:
+        self._bar.advance(self._task)
+
+    def update(self, done: int, total: int) -> None:
+        if self._task is None:
+            self.start(total)
+        elapsed = self._bar.tasks[0].elapsed or 0.0
+        self._bar.update(self._task, completed=done, total=total, rate=done / elapsed if elapsed > 0 else 0.0)
+
+
+@contextmanager
+def frame_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[FrameBar | None]:
+    """A ``FrameBar`` labelled ``label`` on console ``out``; ``None`` when not ``enabled`` (``--json``)."""
+    if not enabled:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("{task.fields[rate]:.1f} frames/s"), TimeElapsedColumn(), console=out) as bar:
+        yield FrameBar(bar)
+

@@ -7,13 +7,11 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._render import JSON_OPTION, console, print_json
-from hiper_cli.commands.perceive import KB_DOCS_HELP, KB_HELP
+from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
+from hiper_cli.commands._render import console, print_json
 
 __all__ = ["register"]
 
-KbOption = Annotated[str, typer.Option("--kb", help=KB_HELP)]
-KbDocsOption = Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)]
 FormatOption = Annotated[
     str | None,
     typer.Option("--format", "-f", help="turtle, nquads, jsonld, graphml or json (default: by suffix)."),
@@ -22,7 +20,7 @@ FormatOption = Annotated[
 
 def export_command(
     out: Annotated[Path, typer.Argument(help="Output file (.ttl, .nq, .jsonld, .graphml, .json).")],
-    kb: KbOption = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
     fmt: FormatOption = None,
     observations: Annotated[
@@ -48,7 +46,7 @@ def export_command(
 
 def import_command(
     path: Annotated[Path, typer.Argument(help="A file written by 'hiper export'.")],
-    kb: KbOption = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
     fmt: FormatOption = None,
     as_json: bool = JSON_OPTION,

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
-from hiper_cli.commands._render import JSON_OPTION, console, group, print_json
-from hiper_cli.commands.perceive import KB_DOCS_HELP, KB_HELP
+from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
+from hiper_cli.commands._render import console, group, print_json
 
 __all__ = ["kb_app", "register"]
 
@@ -17,13 +16,11 @@ kb_app = group(
     "Inspect, check and benchmark a knowledge base.\n\nExample: hiper kb info --kb scene.hiper",
 )
 
-KbOption = Annotated[str, typer.Option("--kb", help=KB_HELP)]
-KbDocsOption = Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)]
 
 
 @kb_app.command("info")
 def info_command(
-    kb: KbOption = "scene.hiper", kb_docs: KbDocsOption = None, as_json: bool = JSON_OPTION
+    kb: KbOption = DEFAULT_KB, kb_docs: KbDocsOption = None, as_json: bool = JSON_OPTION
 ) -> None:
     """Counts per layer and class, environments, sessions and size on disk.
 
@@ -58,7 +55,7 @@ def info_command(
 
 @kb_app.command("check")
 def check_command(
-    kb: KbOption = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
     no_repair: Annotated[
         bool, typer.Option("--no-repair", help="Only report; do not rebuild the graph.")

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from hiper_cli import DEFAULT_KB
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
 from hiper_cli.graph.ontology import (
@@ -48,7 +49,6 @@ __all__ = [
     "open_kb_for_reading",
 ]
 
-DEFAULT_KB = "scene.hiper"
 DOCUMENTS_FILE = "documents.sqlite"
 GRAPH_DIR = "graph"
 

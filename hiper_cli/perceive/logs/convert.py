@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 from hiper_cli.errors import ConfigError
 from hiper_cli.perceive.logs import LogReader
@@ -12,7 +13,7 @@ from hiper_cli.perceive.logs.bag_writer import BAG_KINDS, BagLayout, BagWriter
 from hiper_cli.perceive.logs.tum_writer import TumWriter
 from hiper_cli.types import Frame
 
-__all__ = ["CONVERT_TARGETS", "ConvertResult", "convert_log"]
+__all__ = ["CONVERT_TARGETS", "ConvertResult", "bag_layout", "convert_log"]
 
 CONVERT_TARGETS = ("tum", *BAG_KINDS)
 TUM_DEPTH_SCALE = 5000.0  # TUM RGB-D convention: depth PNG units per metre
@@ -24,6 +25,29 @@ class ConvertResult:
     to: str
     frames_written: int
     skipped: list[tuple[str, str]] = field(default_factory=list)
+    input: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"input": self.input, "output": self.output, "to": self.to,
+                "frames_written": self.frames_written,
+                "skipped": [{"source": s, "reason": r} for s, r in self.skipped]}
+
+
+_CHOICES = {"--rgb-format": ("raw", "png", "jpeg"), "--depth-encoding": ("16UC1", "32FC1"),
+            "--pose-as": ("tf", "odometry", "pose")}
+_POSE_TOPICS = {"tf": "/tf", "odometry": "/odom", "pose": "/pose"}
+
+
+def bag_layout(to: str, rgb_format: str = "raw", depth_encoding: str = "16UC1",
+               pose_as: str = "tf") -> BagLayout:
+    """The ``BagLayout`` for these choices (the ``hiper convert`` flags), each checked by name."""
+    given = {"--to": (to, CONVERT_TARGETS), **{flag: (value, _CHOICES[flag]) for flag, value in
+             (("--rgb-format", rgb_format), ("--depth-encoding", depth_encoding), ("--pose-as", pose_as))}}
+    for flag, (value, allowed) in given.items():
+        if value not in allowed:
+            raise ConfigError(f"{flag} {value}: unknown; expected one of {', '.join(allowed)}")
+    return BagLayout(rgb_format=rgb_format, depth_encoding=depth_encoding, pose_as=pose_as,  # type: ignore[arg-type]
+                     pose_topic=_POSE_TOPICS[pose_as])
 
 
 def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayout | None = None,
@@ -49,4 +73,4 @@ def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayou
             written += 1
             if on_frame is not None:
                 on_frame(frame)
-    return ConvertResult(str(out), to, written, list(reader.skipped))
+    return ConvertResult(str(out), to, written, list(reader.skipped), input=str(reader.info().path))
