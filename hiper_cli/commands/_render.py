@@ -89,8 +89,10 @@ class FrameBar:
 
 
 @contextmanager
-def frame_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[FrameBar | None]:
-    """A ``FrameBar`` labelled ``label`` on console ``out``; ``None`` when not ``enabled`` (``--json``)."""
+def frame_progress(label: str, out: Any, *, enabled: bool = True, total: int | None = None
+                   ) -> Iterator[FrameBar | None]:
+    """A ``FrameBar`` labelled ``label`` on console ``out`` (started when ``total`` is given);
+    ``None`` when not ``enabled`` (``--json``)."""
     if not enabled:
         yield None
         return
@@ -98,5 +100,8 @@ def frame_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[Fr
 
     with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.fields[rate]:.1f} frames/s"), TimeElapsedColumn(), console=out) as bar:
-        yield FrameBar(bar)
+        frame_bar = FrameBar(bar)
+        if total is not None:
+            frame_bar.start(total)
+        yield frame_bar
 

@@ -8,7 +8,15 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["show_log_info", "show_perceive"]
+__all__ = [
+    "show_background_eval",
+    "show_bench_size",
+    "show_foreground_eval",
+    "show_kb_check",
+    "show_kb_info",
+    "show_log_info",
+    "show_perceive",
+]
 
 
 def show_perceive(out: Any, data: dict[str, Any]) -> None:
@@ -78,3 +86,163 @@ def show_log_info(out: Any, data: dict[str, Any]) -> None:
         out.print(frames)
 
 
+def _fmt(value: Any, digits: int = 3) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, list | tuple):
+        return "; ".join(_fmt(v, digits) for v in value)
+    if isinstance(value, float):
+        return f"{value:.{digits}f}"
+    return str(value)
+
+
+def show_foreground_eval(out: Any, report: dict[str, Any]) -> None:
+    """``hiper eval foreground``: our Table III beside the paper's three environments."""
+    from rich.table import Table
+
+    ours, paper = report["ours"], report["paper"]
+
+    def cols(key: str, digits: int = 3) -> list[str]:
+        return [_fmt(paper[key][env], digits) for env in ("house", "hospital", "office")]
+
+    title = (
+        f"Foreground, {report['world'] or report['log']} (seed {report['seed']}), "
+        f"detector {report['detector']}, background: {report['background_source']}"
+    )
+    if report.get("classes"):
+        title += f"; classes: {', '.join(report['classes'])}"
+    if report.get("exclude_classes"):
+        title += f"; {len(report['exclude_classes'])} classes excluded"
+    table = Table(title=title)
+    for name in ("metric", "ours", "paper house", "paper hospital", "paper office"):
+        table.add_column(name)
+    classes = ", ".join(f"{c} {r['tp']}/{r['fp']}" for c, r in sorted(ours["classification"].items()))
+    rows = [
+        ("3D detect. time / s: mu; sigma", _fmt(ours["detect_time_s"]), *cols("detect_time_s")),
+        ("classification i: TP; FP", f"{ours['tp']}; {ours['fp']}", *cols("classification_tp_fp")),
+        ("  per class TP/FP", classes or "-", "", "", ""),
+        ("FP share", _fmt(ours["fp_share"]), *cols("fp_share")),
+        ("unknown instances", str(ours["unknown_instances"]), "", "", ""),
+        ("sum i; sum o", f"{ours['sum_i']}; {ours['sum_o']}", *cols("sum_i_o")),
+        ("loc. accuracy / m (classified obs.): mu; sigma", _fmt(ours["localisation_classified_m"]),
+         *cols("localisation_m")),
+        ("loc. accuracy / m (all obs.): mu; sigma; median", _fmt([*ours["localisation_visible_m"],
+                                                                ours["localisation_visible_median_m"]]),
+         "", "", ""),
+        ("loc. accuracy / m (all obs., horizontal): mu; sigma", _fmt(ours["localisation_visible_xy_m"]),
+         "", "", ""),
+        ("loc. accuracy / m (true box centre): mu; sigma", _fmt(ours["localisation_box_centre_m"]),
+         "", "", ""),
+        ("people dyn. ratio", _fmt(ours["people_dynamic_ratio"]), *cols("people_dynamic_ratio")),
+        ("people |v| / m/s: mu; sigma", _fmt(ours["people_speed_mps"]), *cols("people_speed_mps")),
+        ("people CI / m/s: c_l; c_u", _fmt(ours["people_speed_ci_mps"]), *cols("people_speed_ci_mps")),
+        ("moving people |v| ours vs truth / m/s", f"{_fmt(ours['moving_people_speed_mps'][0])} vs "
+         f"{_fmt(ours['moving_people_true_speed_mps'][0])}", "true 0.6", "true 0.6", ""),
+        ("identity switches", str(ours["identity_switches"]), "", "", ""),
+        ("frames/s end to end", _fmt(ours["frames_per_s"], 1), "~10 (GPU)", "~10 (GPU)", "~10 (GPU)"),
+    ]
+    if "ablation" in report:
+        ab = report["ablation"]
+        rows.append(("C4 no background filter: detect. time / s", _fmt(ab["detect_time_s"]), "", "0.130", ""))
+        rows.append(("C4 latency increase", _fmt(ab["latency_increase"]), "", "~0.69", ""))
+        rows.append(("C4 FP share; sum i", f"{_fmt(ab['fp_share'])}; {ab['sum_i']}", "", "", ""))
+    for row in rows:
+        table.add_row(*row)
+    out.print(table)
+    out.print(f"{ours['frames']} frames; points per frame {ours['points_mean']:.0f}, "
+                    f"after background filter {ours['points_after_background_mean']:.0f}")
+
+
+def _pct(v: Any) -> str:
+    return "—" if v is None else f"{100.0 * v:.1f}"
+
+
+def _pair(a: Any, b: Any, fmt: str = "{}") -> str:
+    if a is None or b is None:
+        return "N/A"
+    return f"{fmt.format(a)}; {fmt.format(b)}"
+
+
+def _rows(r: dict[str, Any], p: dict[str, Any] | None) -> list[tuple[str, str, str, str]]:
+    p = p or {}
+
+    def both(a: str, b: str, fmt: str = "{}") -> tuple[str, str]:
+        return _pair(r[a], r[b], fmt), _pair(p.get(a), p.get(b), fmt)
+
+    def one(key: str) -> tuple[str, str]:
+        return str(r[key]), str(p.get(key, ""))
+
+    def pct(key: str) -> tuple[str, str]:
+        return _pct(r[key]), _pct(p.get(key))
+
+    return [
+        ("Processing time / s: μ; σ (CPU, 1 thread)", *both("time_mean_s", "time_std_s", "{:.3f}"), "≤ 0.05"),
+        ("Processing time / s: μ; σ (wall)", _pair(r["wall_mean_s"], r["wall_std_s"], "{:.3f}"), "", ""),
+        ("Sum: i; o", *both("instances", "observations"), ""),
+        ("Precision stat./dyn. / %", *pct("static_precision"), "≥ 99.5"),
+        ("Precision semantics / %", *pct("semantic_precision"), "≥ 90"),
+        ("Walls: TP; FP", *both("walls_tp", "walls_fp"), ""),
+        ("Tables: TP; FP", *both("tables_tp", "tables_fp"), ""),
+        ("Furniture: FP", *one("furniture_fp"), ""),
+        ("Door, door frame: FP", *one("door_fp"), ""),
+        ("Foreground instances: FP", *one("foreground_fp"), ""),
+        ("Background / m: μ; σ", *both("distance_mean_m", "distance_std_m", "{:.3f}"), "≤ 0.02"),
+        ("Floors; ceilings: TP", _pair(r["floors_tp"], r["ceilings_tp"]), "(added by hand)", ""),
+        ("Truth walls found", f"{r['truth_walls_found']} of {r['truth_walls']}", "", ""),
+        ("Truth tables found", f"{r['truth_tables_found']} of {r['truth_tables']}", "", ""),
+    ]
+
+
+def show_background_eval(out: Any, data: dict[str, Any]) -> None:
+    """``hiper eval background``: our Table II rows beside the paper's and the targets."""
+    from rich.table import Table
+
+    table = Table(title=f"Table II, {data['world'] or 'log'} ({data['method']}, {data['keyframes']} "
+                        f"keyframes of {data['frames']} frames)")
+    for col in ("Description", "hiper", "paper", "target"):
+        table.add_column(col)
+    for row in _rows(data, data.get("paper")):
+        table.add_row(*row)
+    out.print(table)
+
+
+def show_kb_info(out: Any, data: dict[str, Any]) -> None:
+    """``hiper kb info``: totals, counts per type, layer and class, and the sessions."""
+    from rich.table import Table
+
+    totals = data["totals"]
+    out.print(
+        f"[bold]{data['kb']}[/]: {totals['observation']} observations, {totals['instance']} instances, "
+        f"{totals['analysis']} analyses, {totals['environment']} environments, "
+        f"{data['size_bytes'] / 1e6:.1f} MB on disk"
+    )
+    table = Table("type", "layer", "class", "count")
+    for c in data["counts"]:
+        table.add_row(c["type"], c["layer"] or "", c["class"] or "", str(c["count"]))
+    out.print(table)
+    sessions = Table("session", "log", "frames", "finished")
+    for s in data["sessions"]:
+        sessions.add_row(str(s["id"]), s["log_path"], str(s["frames"]), "yes" if s["ended_s"] else "no")
+    if data["sessions"]:
+        out.print(sessions)
+
+
+def show_bench_size(out: Any, r: dict[str, Any]) -> None:
+    """One size of ``hiper kb bench``: ingest rates, peak memory and p50/p95 latencies."""
+    lat = "  ".join(f"{k} {v['p50_ms']:.2f}/{v['p95_ms']:.2f} ms" for k, v in r["latency"].items())
+    follower = (f" + follower {r['follower_peak_rss_mb']:.0f} MB" if r["follower_peak_rss_mb"] else "")
+    out.print(
+        f"[bold]{r['observations']:>8}[/] obs: documents {r['ingest_obs_per_s']:.0f}/s "
+        f"({r['ingest_obs_per_cpu_s']:.0f}/CPU-s), graph {r['graph_sync_obs_per_s']:.0f}/s "
+        f"({r['graph']}), end to end {r['end_to_end_obs_per_s']:.0f}/s, peak RSS "
+        f"{r['peak_rss_mb']:.0f} MB{follower}, load {r['load_average_1min']}\n    p50/p95: {lat}"
+    )
+
+
+def show_kb_check(out: Any, data: dict[str, Any]) -> None:
+    """``hiper kb check``: each problem found, whether the graph was rebuilt, the verdict."""
+    for problem in data["problems"]:
+        out.print(f"[yellow]problem:[/] {problem}")
+    if data["repaired"]:
+        out.print("graph rebuilt from the documents")
+    out.print("[green]consistent[/]" if data["ok"] else "[red]inconsistent[/]")

@@ -41,7 +41,7 @@ def convert(
     layout = bag_layout(to, rgb_format, depth_encoding, pose_as)
     reader = open_log(log, log_options)
     screen = console()
-    with frame_progress(f"writing {out}", screen, enabled=not json_out) as bar:
+    with frame_progress(f"writing {out}", screen, enabled=not json_out, total=len(reader)) as bar:
         result = convert_log(reader, out, to, layout=layout, overwrite=overwrite,
                              on_frame=bar.advance if bar else None)
     if json_out:

@@ -4,56 +4,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._render import JSON_OPTION, console, print_json
+from hiper_cli.commands._common import JSON_OPTION
+from hiper_cli.commands._render import console, print_json
 from hiper_cli.commands.eval import eval_app
-
-
-def register(app: typer.Typer) -> None:
-    """Nothing to do: the command adds itself to ``hiper eval``."""
-
-
-def _pct(v: Any) -> str:
-    return "—" if v is None else f"{100.0 * v:.1f}"
-
-
-def _pair(a: Any, b: Any, fmt: str = "{}") -> str:
-    if a is None or b is None:
-        return "N/A"
-    return f"{fmt.format(a)}; {fmt.format(b)}"
-
-
-def _rows(r: dict[str, Any], p: dict[str, Any] | None) -> list[tuple[str, str, str, str]]:
-    p = p or {}
-
-    def both(a: str, b: str, fmt: str = "{}") -> tuple[str, str]:
-        return _pair(r[a], r[b], fmt), _pair(p.get(a), p.get(b), fmt)
-
-    def one(key: str) -> tuple[str, str]:
-        return str(r[key]), str(p.get(key, ""))
-
-    def pct(key: str) -> tuple[str, str]:
-        return _pct(r[key]), _pct(p.get(key))
-
-    return [
-        ("Processing time / s: μ; σ (CPU, 1 thread)", *both("time_mean_s", "time_std_s", "{:.3f}"), "≤ 0.05"),
-        ("Processing time / s: μ; σ (wall)", _pair(r["wall_mean_s"], r["wall_std_s"], "{:.3f}"), "", ""),
-        ("Sum: i; o", *both("instances", "observations"), ""),
-        ("Precision stat./dyn. / %", *pct("static_precision"), "≥ 99.5"),
-        ("Precision semantics / %", *pct("semantic_precision"), "≥ 90"),
-        ("Walls: TP; FP", *both("walls_tp", "walls_fp"), ""),
-        ("Tables: TP; FP", *both("tables_tp", "tables_fp"), ""),
-        ("Furniture: FP", *one("furniture_fp"), ""),
-        ("Door, door frame: FP", *one("door_fp"), ""),
-        ("Foreground instances: FP", *one("foreground_fp"), ""),
-        ("Background / m: μ; σ", *both("distance_mean_m", "distance_std_m", "{:.3f}"), "≤ 0.02"),
-        ("Floors; ceilings: TP", _pair(r["floors_tp"], r["ceilings_tp"]), "(added by hand)", ""),
-        ("Truth walls found", f"{r['truth_walls_found']} of {r['truth_walls']}", "", ""),
-        ("Truth tables found", f"{r['truth_tables_found']} of {r['truth_tables']}", "", ""),
-    ]
 
 
 @eval_app.command(
@@ -89,12 +46,10 @@ def eval_background(
     if json_out:
         print_json(data)
         return
-    from rich.table import Table
+    from hiper_cli.commands._tables import show_background_eval
 
-    table = Table(title=f"Table II, {report.world or 'log'} ({report.method}, {report.keyframes} keyframes "
-                        f"of {report.frames} frames)")
-    for col in ("Description", "hiper", "paper", "target"):
-        table.add_column(col)
-    for row in _rows(data, data.get("paper")):
-        table.add_row(*row)
-    console().print(table)
+    show_background_eval(console(), data)
+
+
+def register(app: typer.Typer) -> None:
+    """Nothing to do: the command adds itself to ``hiper eval``."""

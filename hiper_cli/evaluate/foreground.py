@@ -28,8 +28,10 @@ paper's C4) and reports the slowdown.
 from __future__ import annotations
 
 import itertools
+import json
 import time
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -51,6 +53,7 @@ __all__ = [
     "TRUE_PEOPLE_SPEED_MPS",
     "ForegroundRun",
     "evaluate_foreground",
+    "parse_settings",
     "prefetch",
 ]
 
@@ -333,6 +336,25 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         "identity_switches": switches,
         "truth_instances_seen": len(by_truth),
     }
+
+
+def parse_settings(settings: Sequence[str], *, classes: str | None = None,
+                   exclude_classes: str | None = None) -> dict[str, Any]:
+    """Foreground options from ``KEY=VALUE`` text (values read as JSON when they parse);
+    ``classes`` / ``exclude_classes`` (dedicated flags) win over the same keys."""
+    out: dict[str, Any] = {}
+    for item in settings:
+        key, sep, raw = item.partition("=")
+        if not sep or not key:
+            raise ConfigError(f"--set {item!r}: expected KEY=VALUE, e.g. --set pixel_step=2")
+        try:
+            out[key.strip()] = json.loads(raw)
+        except json.JSONDecodeError:
+            out[key.strip()] = raw
+    for key, value in (("classes", classes), ("exclude_classes", exclude_classes)):
+        if value is not None:
+            out[key] = value
+    return out
 
 
 def evaluate_foreground(

@@ -34,7 +34,9 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-__all__ = ["BenchConfig", "run_bench", "run_size"]
+from hiper_cli.errors import ConfigError
+
+__all__ = ["BenchConfig", "parse_sizes", "run_bench", "run_size"]
 
 AREA_M = 40.0  # the synthetic building floor, AREA_M x AREA_M; objects 0.2-2.0 m high
 CLASSES = ("person", "chair", "cup", "bottle", "laptop", "book", "tv", "couch", "bed", "dog")
@@ -219,6 +221,17 @@ def run_size(n_obs: int, root: str, config: BenchConfig) -> dict[str, Any]:
 def _child(n_obs: int, config: BenchConfig) -> dict[str, Any]:
     with tempfile.TemporaryDirectory(prefix="hiper-bench-") as root:
         return run_size(n_obs, root, config)
+
+
+def parse_sizes(text: str) -> list[int]:
+    """``"10000,100000"`` -> ``[10000, 100000]``: the observation counts to measure."""
+    try:
+        counts = [int(s) for s in text.split(",") if s.strip()]
+    except ValueError as err:
+        raise ConfigError(f"--sizes {text!r}: expected comma-separated integers, e.g. 10000,100000") from err
+    if not counts or min(counts) <= 0:
+        raise ConfigError(f"--sizes {text!r}: expected positive observation counts")
+    return counts
 
 
 def run_bench(

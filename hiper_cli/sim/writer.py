@@ -25,7 +25,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.sim.meshes import Mesh, human, rot_z
 from hiper_cli.sim.noise import NoiseModel, detect
 from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
-from hiper_cli.sim.render import RenderConfig, Renderer
+from hiper_cli.sim.render import DepthNoise, RenderConfig, Renderer
 from hiper_cli.sim.route import Route, RouteConfig, plan_route
 from hiper_cli.sim.worlds import World, make_world
 
@@ -45,6 +45,24 @@ class SimConfig:
     people: SocialForceConfig = field(default_factory=SocialForceConfig)
     noise: NoiseModel = field(default_factory=NoiseModel)
     png_compression: int = 3
+
+    @classmethod
+    def from_flat(
+        cls, *, rate_hz: float = 30.0, mapping_s: float | None = None, width_px: int = 640,
+        height_px: int = 480, max_range_m: float = 5.0, speed_mps: float = 0.6, depth_noise: bool = True,
+        miss_rate: float = 0.1, jitter_frac: float = 0.05, false_positives_per_image: float = 0.05,
+        confusion_rate: float = 0.03,
+        png_compression: int = 3,
+    ) -> SimConfig:
+        """The configuration from the flat choices ``hiper sim`` offers (the rest at defaults)."""
+        return cls(
+            rate_hz=rate_hz, mapping_s=mapping_s, png_compression=png_compression,
+            render=RenderConfig(width=width_px, height=height_px, max_range_m=max_range_m,
+                                noise=DepthNoise() if depth_noise else DepthNoise.off()),
+            route=RouteConfig(speed_mps=speed_mps),
+            noise=NoiseModel(miss_rate=miss_rate, jitter_frac=jitter_frac, confusion_rate=confusion_rate,
+                             false_positives_per_image=false_positives_per_image),
+        )
 
     def mapping_for(self, seconds: float) -> float:
         if self.mapping_s is None:
