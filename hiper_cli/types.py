@@ -32,6 +32,7 @@ def check_pose(T: Any, name: str = "T_map_cam") -> FloatArray:
     if not isinstance(T, np.ndarray) or T.shape != (4, 4):
         raise DataError(f"{name}: expected a (4, 4) array, got {_describe(T)}")
     T = T.astype(np.float64, copy=False)
+    pose: FloatArray = T
     if not np.all(np.isfinite(T)):
         raise DataError(f"{name}: pose contains NaN or infinite values; fix or drop that pose")
     if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], atol=1e-6):
@@ -39,7 +40,7 @@ def check_pose(T: Any, name: str = "T_map_cam") -> FloatArray:
     R = T[:3, :3]
     if not np.allclose(R @ R.T, np.eye(3), atol=1e-3) or np.linalg.det(R) < 0:
         raise DataError(f"{name}: rotation part is not a proper rotation (R·Rᵀ ≠ I or det < 0)")
-    return T
+    return pose
 
 
 @dataclass(frozen=True)

@@ -222,12 +222,14 @@ def _within(
     np.abs(dist, out=dist)
     np.subtract(dist, half_m, out=dist)
     if noise is None:
-        return np.less_equal(dist, allowed_m)
+        inside: NDArray[np.bool_] = np.less_equal(dist, allowed_m)
+        return inside
     cos = np.abs(ray_columns[main][index]) if axis else np.abs(_along(ray_columns, index, direction))
     np.maximum(cos, min_cos, out=cos)
     np.multiply(cos, noise[index], out=cos)
     np.add(cos, allowed_m, out=cos)
-    return np.less_equal(dist, cos)
+    within: NDArray[np.bool_] = np.less_equal(dist, cos)
+    return within
 
 
 def _filter_background(

@@ -9,6 +9,7 @@ Depth encodings: ``16UC1``/``mono16`` are millimetres (ROS convention) unless a
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,7 +32,7 @@ DEPTH_ENCODINGS = ("16UC1", "mono16", "32FC1")
 ROS_DEPTH_MM_PER_M = 1000.0
 
 
-def _cv2():  # type: ignore[no-untyped-def]
+def _cv2() -> Any:
     import cv2
 
     return cv2
@@ -64,7 +65,8 @@ def _depth_from_array(image: NDArray[np.generic], depth_scale: float, source: st
         raise LogError(f"{source}: depth image has {image.shape[2]} channels; expected one 16-bit channel")
     if image.dtype == np.uint16:
         # One pass (uint16 -> float32, then divide), the same values as astype then divide.
-        return np.divide(image, np.float32(depth_scale), dtype=np.float32)
+        depth: NDArray[np.float32] = np.divide(image, np.float32(depth_scale), dtype=np.float32)
+        return depth
     if image.dtype == np.float32:
         depth = image.astype(np.float32, copy=True)
         depth[~np.isfinite(depth)] = 0.0

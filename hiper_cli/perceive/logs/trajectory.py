@@ -178,7 +178,8 @@ def _slerp(q0: FloatArray, q1: FloatArray, alpha: FloatArray) -> FloatArray:
         theta = np.arccos(np.clip(dot[far], -1.0, 1.0))[:, None]
         sin = np.sin(theta)
         out[far] = (np.sin((1 - a[far]) * theta) * q0[far] + np.sin(a[far] * theta) * q1[far]) / sin
-    return out / np.linalg.norm(out, axis=1, keepdims=True)
+    unit: FloatArray = out / np.linalg.norm(out, axis=1, keepdims=True)
+    return unit
 
 
 def read_tum_trajectory(path: str | Path) -> Trajectory:
