@@ -29,6 +29,11 @@ from hiper_cli.errors import ConfigError, DataError
 
 __all__ = [
     "LAYERS",
+    "ROW_POSITION",
+    "ROW_STAMP",
+    "ROW_STATE",
+    "ROW_VELOCITY",
+    "TRAJECTORY_COLUMNS",
     "Analysis",
     "Box3D",
     "Environment",
@@ -37,6 +42,7 @@ __all__ = [
     "Layer",
     "Observation",
     "State",
+    "TrackTrajectory",
     "World",
     "json_default",
     "new_uuid",
@@ -46,6 +52,13 @@ __all__ = [
 Layer = Literal["environment", "background", "foreground", "map"]
 LAYERS: tuple[str, ...] = ("environment", "background", "foreground", "map")
 State = Literal["static", "dynamic"]
+
+# A tracked instance's trajectory (``Instance.data["trajectory"]``): one row per update, map frame.
+TRAJECTORY_COLUMNS = ("stamp_s", "x_map_m", "y_map_m", "z_map_m", "vx_map_mps", "vy_map_mps", "vz_map_mps")
+ROW_STAMP = 0  # row[ROW_STAMP]: seconds
+ROW_POSITION = slice(1, 4)  # row[ROW_POSITION]: x, y, z / m
+ROW_VELOCITY = slice(4, 7)  # row[ROW_VELOCITY]: vx, vy, vz / (m/s)
+ROW_STATE = slice(1, 7)  # position and velocity, the Kalman state
 
 
 def new_uuid() -> str:
@@ -81,6 +94,51 @@ def point_bounds(points: NDArray[Any]) -> tuple[NDArray[Any], NDArray[Any]]:
 
 # The corners of the unit cube [-1, 1]³, in ``Box3D.corners`` order.
 CORNER_SIGNS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class TrackTrajectory:
+    """A tracked instance's trajectory with named columns (``TRAJECTORY_COLUMNS``).
+
+    ``rows``: (N, 7) float64, time order. The stored form is ``Instance.data["trajectory"]``,
+    a list of 7-number rows whose columns ``ROW_STAMP``, ``ROW_POSITION``, ``ROW_VELOCITY``
+    name; tracking, the knowledge base and the evaluation read both through these names.
+    """
+
+    rows: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        if self.rows.ndim != 2 or self.rows.shape[1] != len(TRAJECTORY_COLUMNS):
+            raise DataError(f"trajectory: expected (N, {len(TRAJECTORY_COLUMNS)}) rows "
+                            f"{list(TRAJECTORY_COLUMNS)}, got shape {self.rows.shape}")
+
+    @classmethod
+    def from_rows(cls, rows: Any) -> TrackTrajectory:
+        """From the stored list of rows (or an array); no rows gives an empty trajectory."""
+        array = np.asarray(rows if rows is not None else [], dtype=np.float64)
+        return cls(array.reshape(-1, len(TRAJECTORY_COLUMNS)))
+
+    def __len__(self) -> int:
+        return int(self.rows.shape[0])
+
+    @property
+    def stamps_s(self) -> NDArray[np.float64]:
+        return self.rows[:, ROW_STAMP]
+
+    @property
+    def position_map_m(self) -> NDArray[np.float64]:
+        return self.rows[:, ROW_POSITION]
+
+    @property
+    def velocity_map_mps(self) -> NDArray[np.float64]:
+        return self.rows[:, ROW_VELOCITY]
+
+    @property
+    def speed_xy_mps(self) -> NDArray[np.float64]:
+        """Horizontal speed per row."""
+        velocity = self.rows[:, ROW_VELOCITY]
+        speed: NDArray[np.float64] = np.hypot(velocity[:, 0], velocity[:, 1])
+        return speed
 
 
 @dataclass(frozen=True)

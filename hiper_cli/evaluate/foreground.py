@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.model import Instance, Observation
+from hiper_cli.model import Instance, Observation, TrackTrajectory
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.perceive.runner import prefetch, run_stages
@@ -254,11 +254,11 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
             continue
         t = truth.instances[gid]
         if t.state == "dynamic" and gid in truth.tracks:
-            rows = np.asarray(inst.data.get("trajectory", []), dtype=np.float64).reshape(-1, 7)
-            for row in rows:
-                p = truth.position_at(gid, float(row[0]))
+            path = TrackTrajectory.from_rows(inst.data.get("trajectory"))
+            for stamp_s, position in zip(path.stamps_s, path.position_map_m, strict=True):
+                p = truth.position_at(gid, float(stamp_s))
                 if p is not None:
-                    centre_err.append(float(np.linalg.norm(row[1:4] - p)))
+                    centre_err.append(float(np.linalg.norm(position - p)))
         else:
             centre_err.append(float(np.linalg.norm(inst.box.center_m - t.box.center_m)))
 
@@ -269,16 +269,17 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
     for inst in instances:
         if inst.class_name != "person":
             continue
-        rows = np.asarray(inst.data.get("trajectory", []), dtype=np.float64).reshape(-1, 7)
-        sp = np.hypot(rows[:, 4], rows[:, 5])
+        path = TrackTrajectory.from_rows(inst.data.get("trajectory"))
+        sp = path.speed_xy_mps
+        stamps = path.stamps_s
         speeds.extend(sp.tolist())
         gid = inst_truth[inst.uuid]
         if gid is None or gid not in truth.tracks:
             continue
         trk = truth.tracks[gid]
-        true_vx = np.interp(rows[:, 0], trk[:, 0], trk[:, 4])
-        true_sp = np.hypot(true_vx, np.interp(rows[:, 0], trk[:, 0], trk[:, 5]))
-        inside = (rows[:, 0] >= trk[0, 0]) & (rows[:, 0] <= trk[-1, 0]) & (true_sp > dynamic_speed_mps)
+        true_vx = np.interp(stamps, trk[:, 0], trk[:, 4])
+        true_sp = np.hypot(true_vx, np.interp(stamps, trk[:, 0], trk[:, 5]))
+        inside = (stamps >= trk[0, 0]) & (stamps <= trk[-1, 0]) & (true_sp > dynamic_speed_mps)
         moving_ours.extend(sp[inside].tolist())
         moving_truth.extend(true_sp[inside].tolist())
     sp_arr = np.asarray(speeds)

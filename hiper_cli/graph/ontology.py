@@ -18,6 +18,8 @@ from typing import Any
 
 import pyoxigraph as ox
 
+from hiper_cli.model import ROW_POSITION, ROW_STAMP
+
 __all__ = [
     "HIPER",
     "LAYER_OF_TYPE",
@@ -107,7 +109,7 @@ def _vec(values: Sequence[float]) -> ox.Literal:
 
 
 def speed_mps(doc: dict[str, Any]) -> float | None:
-    """Mean speed of an instance along ``data.trajectory`` rows [t, x, y, z, ...], if it has one
+    """Mean speed of an instance along its ``data.trajectory`` rows (``TRAJECTORY_COLUMNS``), if any
     (a document whose long trajectory is stored apart carries it as ``trajectory_speed_mps``)."""
     data = doc.get("data") or {}
     if "trajectory_speed_mps" in data and "trajectory" not in data:
@@ -117,8 +119,8 @@ def speed_mps(doc: dict[str, Any]) -> float | None:
     if len(rows) < 2:
         return None
     try:
-        dist = sum(math.dist(a[1:4], b[1:4]) for a, b in itertools.pairwise(rows))
-        dt = float(rows[-1][0]) - float(rows[0][0])
+        dist = sum(math.dist(a[ROW_POSITION], b[ROW_POSITION]) for a, b in itertools.pairwise(rows))
+        dt = float(rows[-1][ROW_STAMP]) - float(rows[0][ROW_STAMP])
     except (TypeError, ValueError, IndexError):  # not [t, x, y, z, ...] rows: no speed
         return None
     return dist / dt if dt > 0 else None

@@ -1,7 +1,7 @@
 """Long instance trajectories, stored apart from their instance document in chunks of rows.
 
 A tracked instance is upserted on every frame that observes it, with its whole trajectory
-(``data["trajectory"]``, one row ``[t, x, y, z, vx, vy, vz]`` per update). Kept in the
+(``data["trajectory"]``, one row of ``model.TRAJECTORY_COLUMNS`` per update). Kept in the
 document, a track seen for ten minutes at 30 Hz rewrites ~1.5 MB per frame. Beyond
 ``INLINE_ROWS`` rows the document keeps the row count and the mean speed
 (``trajectory_rows``, ``trajectory_speed_mps``) and the rows go to the ``trajectories`` table
@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.model import ROW_POSITION, ROW_STAMP
 
 __all__ = ["CHUNK_ROWS", "INLINE_ROWS", "SCHEMA", "TrajectoryStore"]
 
@@ -37,8 +38,8 @@ def _speed_mps(rows: list[Any]) -> float | None:
     """Mean speed along the rows (path length over duration), as ``ontology.speed_mps``; None
     for rows that are not [t, x, y, z, ...] numbers."""
     try:
-        xyz = np.asarray([r[1:4] for r in rows], dtype=np.float64)
-        dt = float(rows[-1][0]) - float(rows[0][0])
+        xyz = np.asarray([r[ROW_POSITION] for r in rows], dtype=np.float64)
+        dt = float(rows[-1][ROW_STAMP]) - float(rows[0][ROW_STAMP])
     except (TypeError, ValueError, IndexError):
         return None
     if len(rows) < 2 or dt <= 0 or xyz.shape != (len(rows), 3):

@@ -174,6 +174,11 @@ class ForegroundConfig:
     this much each, so a few confused detections cannot name a mostly unmatched track."""
 
     # --- tracking ---------------------------------------------------------------------------
+    motion_model: str = "constant_velocity"
+    """How a track moves (``motion.MOTION_MODELS``): the paper's constant-velocity Kalman filter."""
+    association: str = "hungarian"
+    """How observations are assigned to tracks (``association.ASSOCIATIONS``): ``hungarian``
+    (the paper's) or ``greedy``."""
     gate_m: float = 1.0
     """Hungarian assignment: an observation farther than this from a track cannot join it ..."""
     gate_sigmas: float = 4.0

@@ -1,27 +1,29 @@
 """3D multi-object tracking of foreground observations in the map frame.
 
-- Association: the Hungarian algorithm (scipy ``linear_sum_assignment``) on the distances
-  between the tracks' predicted centres and the observed centres, with a gate: ``gate_m``, or
+- Association: an assignment rule chosen by name (``association``: the paper's Hungarian
+  algorithm by default, see ``association.py``) on the distances between the tracks' predicted
+  centres and the observed centres, with a gate: ``gate_m``, or
   the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
   analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
   (up to ``max_gate_m``) so that a person who left the view is picked up again; only a track
   of a class in ``search_classes`` (people, and ``unknown``) that was moving when last seen
-  searches like that (a chair or a bed does not walk away while unseen:
-  a static track that widened its gate took a different object metres away when the robot
-  came back); a settled
-  track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
+  searches like that (a chair or a bed does not walk away while unseen: a static track that
+  widened its gate would take a different object metres away when the robot comes back); a
+  settled track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
   Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
   pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
   A track of a walker class (``walker_classes``) does not take a blob smaller than
   ``walker_min_size_ratio`` of the largest blob it took (a junk blob, a cup or a border fragment
   is not the person: such rows collapsed the person's speed).
-- Filter: a constant-velocity Kalman filter (filterpy) over position and velocity with white
+- Filter: a ``MotionModel`` per track chosen by name (``motion_model``, ``motion.py``; by
+  default a constant-velocity Kalman filter over position and velocity) with white
   acceleration noise (class-specific from the learned ``sigma_mps`` when known, else
   ``walker_accel_noise_mps2`` for walkers and ``accel_noise_mps2`` for the rest). A track's
   velocity is initialised from its first two observations (the paper started at zero, which
   biased the speeds low) with the matching covariance.
 - Unseen tracks: their velocity decays exponentially to zero (time constant
-  ``velocity_decay_s``) once they have been unseen for longer than two frames, so a missed
+  ``velocity_decay_s``) once they have been unseen for longer than the grace
+  (``velocity_decay_grace_s``, at least ``DECAY_GRACE_FRAMES`` frames), so a missed
   detection does not bias a moving track. A track only ages while its predicted centre is
   visible to the camera (in the image, not hidden behind nearer depth): a person who walks out
   of view keeps the identity for ``lost_max_s``.
@@ -41,13 +43,24 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import new_uuid
+from hiper_cli.errors import ConfigError
+from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, new_uuid
+from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
 
 FloatArray = NDArray[np.float64]
 UNKNOWN = "unknown"
+
+# Named constants of the tracker (not the paper's; chosen by measurement, see docs/foreground.md).
+MIN_PRIOR_SIGMA_MPS = 0.05  # a learned speed spread below this would freeze a class's filter
+DECAY_GRACE_FRAMES = 1.5  # the decay grace covers at least one missed frame at any frame rate
+LOST_AFTER_FRAMES = 2.5  # a track is lost after more than one missed frame (gap of 2 frames)
+EXTENT_GAIN = 0.2  # exponential smoothing of a track's box extent by each new observation
+MIN_VELOCITY_INIT_DT_S = 1e-6  # two observations closer in time give no velocity
+MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
 
 
 @dataclass(frozen=True)
@@ -74,7 +87,7 @@ class Track:
     """One tracked object; becomes an ``Instance`` once confirmed."""
 
     uuid: str
-    kf: object  # filterpy.kalman.KalmanFilter
+    motion: MotionModel  # the state estimate (``ForegroundConfig.motion_model``)
     first_s: float
     last_update_s: float
     last_time_s: float
@@ -92,6 +105,7 @@ class Track:
     min_class_share: float = 0.0
     score_sum: float = 0.0
     observation_uuids: list[str] = field(default_factory=list)
+    # one row per update: ``model.TRAJECTORY_COLUMNS`` (stamp, position, velocity; map frame)
     trajectory: list[list[float]] = field(default_factory=list)
     # per trajectory row: posterior covariance and the process noise (q, q_vertical) used
     covariances: list[FloatArray] = field(default_factory=list)
@@ -102,11 +116,11 @@ class Track:
 
     @property
     def position(self) -> FloatArray:
-        return np.asarray(self.kf.x[:3, 0], dtype=np.float64)  # type: ignore[attr-defined]
+        return np.asarray(self.motion.x[:3], dtype=np.float64)
 
     @property
     def velocity(self) -> FloatArray:
-        return np.asarray(self.kf.x[3:, 0], dtype=np.float64)  # type: ignore[attr-defined]
+        return np.asarray(self.motion.x[3:], dtype=np.float64)
 
     @property
     def class_name(self) -> str:
@@ -135,29 +149,6 @@ class Track:
 
 
 @lru_cache(maxsize=64)
-def _process_noise(dt: float, q: float, q_vertical: float) -> FloatArray:
-    """Q of the constant-velocity model with white acceleration of variance q (z: q_vertical).
-    Cached (most frames share one dt): read-only."""
-    Q = np.zeros((6, 6))
-    for axis in range(3):
-        var = q_vertical if axis == 2 else q
-        Q[axis, axis] = var * dt**4 / 4.0
-        Q[axis, axis + 3] = Q[axis + 3, axis] = var * dt**3 / 2.0
-        Q[axis + 3, axis + 3] = var * dt**2
-    Q.setflags(write=False)
-    return Q
-
-
-@lru_cache(maxsize=64)
-def _transition(dt: float) -> FloatArray:
-    """F of the constant-velocity model over ``dt``. Cached: read-only."""
-    F = np.eye(6)
-    F[:3, 3:] = np.eye(3) * dt
-    F.setflags(write=False)
-    return F
-
-
-@lru_cache(maxsize=64)
 def _decay_terms(
     dt: float, decay_s: float, prior: float, ratio: float
 ) -> tuple[float, FloatArray, FloatArray]:
@@ -175,7 +166,8 @@ def _decay_terms(
 
 
 def smooth_trajectory(track: Track) -> None:
-    """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place).
+    """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place), for the
+    constant-velocity model.
 
     The filter's estimates at the start of a track rest on few observations; once the track is
     closed every row can use all of them. Rows keep their stamps; positions and velocities
@@ -185,17 +177,17 @@ def smooth_trajectory(track: Track) -> None:
     n = len(rows)
     if n < 3 or len(track.covariances) != n:
         return
-    xs = [np.asarray(r[1:7], dtype=np.float64) for r in rows]
+    xs = [np.asarray(r[ROW_STATE], dtype=np.float64) for r in rows]
     Ps = [np.asarray(P, dtype=np.float64) for P in track.covariances]
     for k in range(n - 2, -1, -1):
-        dt = rows[k + 1][0] - rows[k][0]
+        dt = rows[k + 1][ROW_STAMP] - rows[k][ROW_STAMP]
         if dt <= 0:
             continue
         F = np.eye(6)
         F[:3, 3:] = np.eye(3) * dt
-        x_k, P_k = np.asarray(rows[k][1:7], dtype=np.float64), track.covariances[k]
+        x_k, P_k = np.asarray(rows[k][ROW_STATE], dtype=np.float64), track.covariances[k]
         x_pred = F @ x_k
-        P_pred = F @ P_k @ F.T + _process_noise(dt, *track.noises[k + 1])
+        P_pred = F @ P_k @ F.T + process_noise(dt, *track.noises[k + 1])
         try:
             C = P_k @ F.T @ np.linalg.inv(P_pred)
         except np.linalg.LinAlgError:
@@ -203,7 +195,7 @@ def smooth_trajectory(track: Track) -> None:
         xs[k] = x_k + C @ (xs[k + 1] - x_pred)
         Ps[k] = P_k + C @ (Ps[k + 1] - P_pred) @ C.T
     for row, x in zip(rows, xs, strict=True):
-        row[1:7] = x.tolist()
+        row[ROW_STATE] = x.tolist()
 
 
 def _was_moving(track: Track, config: ForegroundConfig) -> bool:
@@ -221,18 +213,19 @@ def _was_moving(track: Track, config: ForegroundConfig) -> bool:
 
 
 def _moving_rows(rows: list[list[float]], config: ForegroundConfig) -> bool:
-    if not rows or math.hypot(rows[-1][4], rows[-1][5]) <= config.moving_speed_mps:
+    if not rows or math.hypot(*rows[-1][ROW_VELOCITY][:2]) <= config.moving_speed_mps:
         return False
-    t_end = rows[-1][0]
+    t_end = rows[-1][ROW_STAMP]
     start = rows[0]
     for row in reversed(rows):
-        if t_end - row[0] >= config.moving_window_s:
+        if t_end - row[ROW_STAMP] >= config.moving_window_s:
             start = row
             break
-    span = t_end - start[0]
+    span = t_end - start[ROW_STAMP]
     if span < config.min_moving_span_s:
         return False
-    dx, dy = rows[-1][1] - start[1], rows[-1][2] - start[2]
+    (x_end, y_end), (x_start, y_start) = rows[-1][ROW_POSITION][:2], start[ROW_POSITION][:2]
+    dx, dy = x_end - x_start, y_end - y_start
     return math.hypot(dx, dy) / span > config.moving_speed_mps
 
 
@@ -242,46 +235,38 @@ def _size_m(extent_m: FloatArray) -> float:
 
 
 class Tracker:
-    """Hungarian association + constant-velocity Kalman filters (see the module docstring)."""
+    """Gated association + one motion model per track (see the module docstring)."""
 
     def __init__(
         self,
         config: ForegroundConfig,
         priors: Callable[[str], ClassPrior] | None = None,
     ) -> None:
+        if config.motion_model not in MOTION_MODELS:
+            raise ConfigError(f"motion_model {config.motion_model!r}: unknown; expected one of "
+                              f"{', '.join(MOTION_MODELS)}")
         self.config = config
+        self._assign = get_association(config.association)
         self.priors = priors or (lambda _name: ClassPrior())
         self.tracks: list[Track] = []  # live (tentative or confirmed)
         self.last_stamp_s: float | None = None
         self._frame_dt_s = 0.0
 
-    # --- Kalman pieces ----------------------------------------------------------------------
+    # --- motion ---------------------------------------------------------------------------
     def _accel_noise(self, class_name: str) -> float:
         prior = self.priors(class_name)
         if self.config.use_learned_priors and prior.sigma_mps is not None:
-            return max(float(prior.sigma_mps), 0.05) / self.config.prior_accel_time_s
+            return max(float(prior.sigma_mps), MIN_PRIOR_SIGMA_MPS) / self.config.prior_accel_time_s
         if class_name in self.config.walker_classes:
             return self.config.walker_accel_noise_mps2
         return self.config.accel_noise_mps2
-
-    def _new_kf(self, center: FloatArray) -> object:
-        from filterpy.kalman import KalmanFilter
-
-        kf = KalmanFilter(dim_x=6, dim_z=3)
-        kf.x = np.r_[center, np.zeros(3)].reshape(6, 1)
-        kf.H = np.hstack([np.eye(3), np.zeros((3, 3))])
-        r = self.config.measurement_noise_m**2
-        kf.R = np.eye(3) * r
-        kf.P = np.diag([r, r, r, 1.0, 1.0, 1.0])
-        return kf
 
     def _predict(self, track: Track, stamp_s: float) -> None:
         dt = stamp_s - track.last_time_s
         if dt <= 0:
             return
-        kf = track.kf
         q = self._accel_noise(track.class_name) ** 2
-        kf.predict(F=_transition(dt), Q=_process_noise(dt, q, q * self.config.vertical_noise_ratio**2))  # type: ignore[attr-defined]
+        track.motion.predict(dt, q, q * self.config.vertical_noise_ratio**2)
         track.last_time_s = stamp_s
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
@@ -294,9 +279,9 @@ class Tracker:
         decayed (near zero) velocity. A chair's does not (``velocity_relax_static``): its gate
         would grow to ``gate_m`` within half a second unseen.
         """
-        # The grace covers at least one missed frame at any frame rate (at 4 Hz one frame is
-        # 0.25 s, longer than the grace: every single miss decayed and unsettled the velocity).
-        grace = max(self.config.velocity_decay_grace_s, 1.5 * dt)
+        # At 4 Hz one frame (0.25 s) is longer than velocity_decay_grace_s: without the frame
+        # term every single miss would decay and unsettle the velocity.
+        grace = max(self.config.velocity_decay_grace_s, DECAY_GRACE_FRAMES * dt)
         if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
         relaxes = self.config.velocity_relax_static or track.class_name in self.config.search_classes
@@ -304,39 +289,36 @@ class Tracker:
         factor, scale, relax = _decay_terms(
             dt, self.config.velocity_decay_s, prior, self.config.vertical_noise_ratio**2
         )
-        kf = track.kf
-        kf.x[3:, 0] *= factor  # type: ignore[attr-defined]
-        kf.P = kf.P * scale + relax  # type: ignore[attr-defined]
+        track.motion.decay_velocity(factor, scale, relax)
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
-        kf = track.kf
+        motion = track.motion
         if not track.velocity_initialised and track.hits == 1:
             dt = stamp_s - track.last_update_s
-            if dt > 1e-6:
+            if dt > MIN_VELOCITY_INIT_DT_S:
                 # Two-point initialisation: v = (z2 - z1) / dt with its own covariance.
                 v = (m.center_map - track.first_center) / dt
                 r = self.config.measurement_noise_m**2
-                kf.x = np.r_[m.center_map, v].reshape(6, 1)  # type: ignore[attr-defined]
                 var_v = 2.0 * r / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
-                kf.P = np.diag([r, r, r, var_v, var_v, var_v])  # type: ignore[attr-defined]
+                motion.reset(np.r_[m.center_map, v], np.diag([r, r, r, var_v, var_v, var_v]))
                 track.velocity_initialised = True
                 if track.trajectory:  # the first row gets the velocity it could not know yet
-                    track.trajectory[0][4:7] = v.tolist()
-                    track.covariances[0] = np.array(kf.P, dtype=np.float64)  # type: ignore[attr-defined]
+                    track.trajectory[0][ROW_VELOCITY] = v.tolist()
+                    track.covariances[0] = np.array(motion.P, dtype=np.float64)
             else:
-                kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
+                motion.update(m.center_map)
         else:
-            kf.update(m.center_map.reshape(3, 1))  # type: ignore[attr-defined]
+            motion.update(m.center_map)
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
-        track.extent_m = 0.8 * track.extent_m + 0.2 * m.extent_map
+        track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * m.extent_map
         self._vote(track, m)
         if not track.confirmed and track.hits >= self.config.confirm_hits:
             track.confirmed = True
 
     def _vote(self, track: Track, m: Measurement) -> None:
-        weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, 1e-3)
+        weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
         track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
         track._class_name = None
@@ -345,7 +327,7 @@ class Tracker:
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
         q = self._accel_noise(track.class_name) ** 2
-        track.covariances.append(np.array(track.kf.P, dtype=np.float64))  # type: ignore[attr-defined]
+        track.covariances.append(np.array(track.motion.P, dtype=np.float64))
         track.noises.append((q, q * self.config.vertical_noise_ratio**2))
 
     # --- association ------------------------------------------------------------------------
@@ -364,7 +346,7 @@ class Tracker:
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
         if variance_m2 is None:
-            variance_m2 = float(np.linalg.eigvalsh(track.kf.P[:3, :3]).max())  # type: ignore[attr-defined]
+            variance_m2 = float(np.linalg.eigvalsh(track.motion.P[:3, :3]).max())
         sigma = math.sqrt(variance_m2 + cfg.measurement_noise_m**2)
         base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
         return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
@@ -377,16 +359,14 @@ class Tracker:
         return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
-        """(track index, measurement index) pairs of the gated Hungarian assignment."""
-        from scipy.optimize import linear_sum_assignment
-
+        """(track index, measurement index) pairs of the gated assignment (``association``)."""
         if not self.tracks or not measurements:
             return []
         pred = np.array([t.position for t in self.tracks])
         obs = np.array([m.center_map for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         # The filters' own uncertainty, all tracks in one eigenvalue call.
-        P = np.array([t.kf.P[:3, :3] for t in self.tracks])  # type: ignore[attr-defined]
+        P = np.array([t.motion.P[:3, :3] for t in self.tracks])
         variances = np.linalg.eigvalsh(P).max(axis=1)
         gates = np.array(
             [self._gate(t, stamp_s, float(v)) for t, v in zip(self.tracks, variances, strict=True)]
@@ -395,7 +375,7 @@ class Tracker:
         searched = cost > gates[:, 0:1]
         cfg = self.config
         # lost: more than one frame missed (picked up again after one miss, the gap is 2 frames)
-        grace = max(cfg.velocity_decay_grace_s, 2.5 * self._frame_dt_s)
+        grace = max(cfg.velocity_decay_grace_s, LOST_AFTER_FRAMES * self._frame_dt_s)
         classes = np.array([m.class_name for m in measurements], dtype=object)
         unknown = classes == UNKNOWN
         sizes = np.array([_size_m(m.extent_map) for m in measurements])
@@ -414,9 +394,7 @@ class Tracker:
                 # the person (the person cut by the border).
                 person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
                 allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
-        big = 1e6
-        rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
-        return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if allowed[r, c]]
+        return self._assign(cost, allowed)
 
     # --- one step ---------------------------------------------------------------------------
     def step(
@@ -480,7 +458,7 @@ class Tracker:
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
         track = Track(
             uuid=new_uuid(),
-            kf=self._new_kf(m.center_map),
+            motion=make_motion_model(self.config.motion_model, m.center_map, self.config.measurement_noise_m),
             first_s=stamp_s,
             last_update_s=stamp_s,
             last_time_s=stamp_s,
