@@ -178,7 +178,7 @@ def _run(
     reader = open_log(log_path)
     run = ForegroundRun(world=world, background_source=source)
     fg_ids = {i for i, t in truth.instances.items() if t.layer == "foreground"}
-    step = int(options.get("pixel_step", 4))
+    step = ForegroundConfig.from_options(**options).pixel_step
     frame_index = itertools.count()
 
     by_frame: dict[int, list[Observation]] = {}
@@ -377,9 +377,9 @@ def evaluate_foreground(
     root = Path(log_path)
     truth = load_truth(root)
     opts = {"detector": detector, "background_filter": background_filter, **options}
-    dyn = float(options.get("dynamic_speed_mps", 0.15))
-    main = _run(root, truth, opts, max_frames, background)
     fg_config = ForegroundConfig.from_options(**opts)
+    dyn = fg_config.dynamic_speed_mps
+    main = _run(root, truth, opts, max_frames, background)
     report: dict[str, Any] = {
         "log": str(root),
         "world": truth.world,

@@ -33,6 +33,8 @@ from hiper_cli.types import Frame
 __all__ = ["BackgroundStage", "observe"]
 
 FloatArray = NDArray[np.float64]
+MIN_PLANE_THICKNESS_M = 0.02  # a plane observation's box is at least this thick (2 σ of its fit)
+MIN_CONFIDENCE = 0.05  # the worst-fitting plane still gets this confidence
 
 
 def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
@@ -52,14 +54,14 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
         return None
     uv = pf.to_2d(contour_cam)
     lo, hi = uv.min(axis=0), uv.max(axis=0)
-    thickness = max(2.0 * seg.rms_m, 0.02)
+    thickness = max(2.0 * seg.rms_m, MIN_PLANE_THICKNESS_M)
     box = Box3D(pf.to_3d((lo + hi) / 2.0)[0], np.array([*(hi - lo), thickness]), pf.R)
     rows, cols = np.nonzero(seg.mask)
     pick = np.linspace(0, len(rows) - 1, min(cfg.pixel_sample, len(rows))).astype(int)
     pixels_uv = np.stack([cols[pick], rows[pick]], axis=1) * grid.stride
     centroid = grid.points_cam[seg.mask].mean(axis=0)
     z = float(centroid[2])
-    confidence = float(np.clip(1.0 - seg.rms_m / (cfg.inlier_m * max(z, 1.0)), 0.05, 1.0))
+    confidence = float(np.clip(1.0 - seg.rms_m / (cfg.inlier_m * max(z, 1.0)), MIN_CONFIDENCE, 1.0))
     return Observation(
         layer="background",
         class_name=class_name,

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import CORNER_SIGNS, Box3D, point_bounds
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import BackgroundFilterConfig
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = ["background_mask", "inside_boxes", "table_leg_boxes"]
@@ -38,7 +38,7 @@ def background_mask(
     camera: CameraIntrinsics,
     T_map_cam: FloatArray,
     boxes_map: Sequence[Box3D],
-    config: ForegroundConfig,
+    config: BackgroundFilterConfig,
 ) -> NDArray[np.bool_]:
     """``valid`` (h, w) without the grid samples inside ``boxes_map``; ``z`` (h, w) the
     samples' depths, ``rx``/``ry`` their rays (x/z, y/z), ``depth_m`` the full image (for the
@@ -140,7 +140,7 @@ _NEAR_Z_M = 0.05  # boxes are cut at this depth (or half min_depth_m) before pro
 
 def _box_rois(
     boxes: Sequence[Box3D], margin_m: float, camera: CameraIntrinsics, T_cam_map: FloatArray, step: int,
-    shape: tuple[int, int], config: ForegroundConfig,
+    shape: tuple[int, int], config: BackgroundFilterConfig,
 ) -> list[tuple[slice, slice] | None]:
     """For each box (grown by a margin), the rows and columns of the subsampled grid it can
     cover; None when it is out of view.
@@ -240,7 +240,7 @@ def _filter_background(
     camera: CameraIntrinsics,
     T_map_cam: FloatArray,
     step: int,
-    config: ForegroundConfig,
+    config: BackgroundFilterConfig,
     noise: FloatArray | None = None,
     rays_map: Sequence[FloatArray] | None = None,
 ) -> NDArray[np.bool_]:

@@ -1,41 +1,63 @@
-"""Options of the foreground stage: one frozen dataclass, the paper's constants as defaults."""
+"""Options of the foreground stage: frozen dataclasses, one per part, the paper's constants as defaults.
+
+The point-cloud parts build on each other as the steps do: ``SamplingConfig`` (which depth
+pixels) < ``BackgroundFilterConfig`` (dropping points of background instances) <
+``SegmentConfig`` (Algorithm 3: clustering, supports, table legs and tops) < ``RefineConfig``
+(trimming and joining blobs with the detections, which re-clusters). ``MatchConfig``
+(Algorithm 4) and ``TrackerConfig`` (3D tracking) stand alone. ``ForegroundConfig`` is all of
+them plus the detector's options. Each module is typed to take only the part it reads (the
+tracker a ``TrackerConfig``), so mypy keeps the parts apart; a ``ForegroundConfig`` is each. Options are
+flat names (``gate_m``) or dotted by part (``tracker.gate_m``, as in
+``-o foreground.tracker.gate_m=0.8``).
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, ClassVar
 
 from hiper_cli.errors import ConfigError
 from hiper_cli.perceive.foreground.classes import INDOOR_EXCLUDED
 
-__all__ = ["ForegroundConfig"]
+__all__ = [
+    "BackgroundFilterConfig",
+    "ForegroundConfig",
+    "MatchConfig",
+    "RefineConfig",
+    "SamplingConfig",
+    "SegmentConfig",
+    "TrackerConfig",
+]
+
+
+def _as_tuples(config: object, names: tuple[str, ...]) -> None:
+    """Store each named field as a tuple of strings ("a,b" from a command line splits)."""
+    for name in names:
+        value = getattr(config, name)
+        if isinstance(value, str):
+            value = tuple(v.strip() for v in value.split(",") if v.strip())
+        object.__setattr__(config, name, tuple(str(v) for v in value))
+
+
+def _nonnegative(config: object, names: tuple[str, ...]) -> None:
+    for name in names:
+        if getattr(config, name) < 0:
+            raise ConfigError(f"{name} must be >= 0, got {getattr(config, name)}")
+
+
+class _Part:
+    """The end of the ``__post_init__`` chain: each part checks its own fields."""
+
+    def __post_init__(self) -> None:
+        pass
 
 
 @dataclass(frozen=True)
-class ForegroundConfig:
-    """Everything the foreground stage (segmentation, matching, tracking) can be told.
-
-    Segmentation (Algorithm 3) works on an organised subsample of the depth image: every
+class SamplingConfig(_Part):
+    """Which depth pixels become points: an organised subsample of the depth image, every
     ``pixel_step``-th pixel in both directions (4 → 160×120 points for 640×480), far cheaper
-    than a voxel grid and with the same effect on density.
-    """
+    than a voxel grid and with the same effect on density, within a depth range."""
 
-    # --- detector ---------------------------------------------------------------------------
-    detector: str = "yolox"
-    """Registry name: ``yolox``, ``onnx:PATH``, ``log`` or ``truth``."""
-    min_detection_score: float = 0.3
-    """Detections below this score are ignored by the matching."""
-    detector_threads: bool = True
-    """Run the detector in a worker thread, concurrently with the point-cloud work."""
-    classes: tuple[str, ...] = ()
-    """Only these detector classes name blobs (empty: all); a per-environment class list."""
-    exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED
-    """Detector classes dropped before matching (the paper excluded classes not present, such as
-    boat and traffic light): outdoor COCO classes and ``dining table`` (tables are background)."""
-
-    # --- segmentation (Algorithm 3) ---------------------------------------------------------
-    background_filter: bool = True
-    """Remove points inside background instance boxes (off = the paper's ablation C4)."""
     pixel_step: int = 4
     """Downscale: keep every n-th pixel of the depth image in both directions."""
     min_depth_m: float = 0.3
@@ -45,6 +67,19 @@ class ForegroundConfig:
     max_depth_slack_m: float = 0.3
     """... and points up to this much farther are kept, so that an object standing across the
     limit keeps its far side (a hard cut at 5 m moved a far chair's centre towards the camera)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.pixel_step < 1:
+            raise ConfigError(f"pixel_step must be >= 1, got {self.pixel_step}")
+
+
+@dataclass(frozen=True)
+class BackgroundFilterConfig(SamplingConfig):
+    """Dropping the points that lie inside background instances (walls, floors, tables)."""
+
+    background_filter: bool = True
+    """Remove points inside background instance boxes (off = the paper's ablation C4)."""
     background_margin_m: float = 0.02
     """Background boxes are grown by this much on every side before filtering (0.05 cut thin
     parts that touch a wall or the floor, a bed's head board, from their objects; 0.015 let
@@ -69,6 +104,21 @@ class ForegroundConfig:
     table_leg_band_m: float = 0.0
     """Filter a band this wide under the edges of every background table top: its legs (0: off;
     needs accurate table boxes: with the background stage's table estimates it cut chairs)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _nonnegative(self, ("table_leg_band_m",))
+        if not 0.0 <= self.background_noise_min_cos <= 1.0:
+            raise ConfigError(
+                f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
+            )
+
+
+@dataclass(frozen=True)
+class SegmentConfig(BackgroundFilterConfig):
+    """Segmentation (Algorithm 3): Euclidean clusters of the filtered points, their supports,
+    then table legs, rims and unmapped table tops leave the blobs."""
+
     table_leg_cell_m: float = 0.05
     """Table legs leave the blobs (``legs.py``): points are binned horizontally in cells this
     wide (0: off) ..."""
@@ -129,7 +179,23 @@ class ForegroundConfig:
     pixels_per_observation: int = 48
     """Sample of pixel coordinates ``pixels_uv`` stored in each observation."""
 
-    # --- refinement with the detections (before Algorithm 4) -------------------------------
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.min_cluster_points < 1 or self.max_cluster_points < self.min_cluster_points:
+            raise ConfigError(
+                f"cluster sizes: need 1 <= min_cluster_points <= max_cluster_points, got "
+                f"{self.min_cluster_points} and {self.max_cluster_points}"
+            )
+        if self.cluster_tolerance_m <= 0:
+            raise ConfigError("cluster_tolerance_m and gate_m must be positive")
+        _nonnegative(self, ("table_rim_depth_m", "table_rim_reach_m"))
+        _as_tuples(self, ("unseen_table_skip_classes",))
+
+
+@dataclass(frozen=True)
+class RefineConfig(SegmentConfig):
+    """Refinement of the blobs with the detections, between segmentation and matching."""
+
     trim_iou: float = 0.3
     """A blob overlapping a detection box with at least this IoU loses its points outside the
     (grown) box, when they are at most ``trim_max_share`` of it (1: off) ..."""
@@ -163,17 +229,37 @@ class ForegroundConfig:
     """... unless the joined image box's IoU with the detection box is lower than before by
     more than this (a piece of an unmapped table top beside a chair's box)."""
 
-    # --- matching (Algorithm 4) -------------------------------------------------------------
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _nonnegative(self, ("split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac",
+                            "trim_margin_frac", "trim_depth_m"))
+        if not 0.0 < self.join_containment <= 1.0:
+            raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
+
+
+@dataclass(frozen=True)
+class MatchConfig(_Part):
+    """Matching blobs to detections (Algorithm 4)."""
+
     iou_threshold: float = 0.5
     """A blob takes a detection's class when the IoU of their image boxes exceeds this."""
     unknown_class: str = "unknown"
     keep_unknown: bool = True
     """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 0.0 <= self.iou_threshold <= 1.0:
+            raise ConfigError(f"iou_threshold must be in [0, 1], got {self.iou_threshold}")
+
+
+@dataclass(frozen=True)
+class TrackerConfig(_Part):
+    """3D multi-object tracking of the observations (``tracking.py``)."""
+
     unknown_vote_weight: float = 0.15
     """A track's class is the score-weighted vote of its observations; ``unknown`` ones weigh
     this much each, so a few confused detections cannot name a mostly unmatched track."""
-
-    # --- tracking ---------------------------------------------------------------------------
     motion_model: str = "constant_velocity"
     """How a track moves (``motion.MOTION_MODELS``): the paper's constant-velocity Kalman filter."""
     association: str = "hungarian"
@@ -273,49 +359,72 @@ class ForegroundConfig:
     """Size / altitude priors reject a class when a blob is outside [lo·(1-t), hi·(1+t)]."""
 
     def __post_init__(self) -> None:
-        if self.pixel_step < 1:
-            raise ConfigError(f"pixel_step must be >= 1, got {self.pixel_step}")
-        if not 0.0 <= self.iou_threshold <= 1.0:
-            raise ConfigError(f"iou_threshold must be in [0, 1], got {self.iou_threshold}")
-        if self.min_cluster_points < 1 or self.max_cluster_points < self.min_cluster_points:
-            raise ConfigError(
-                f"cluster sizes: need 1 <= min_cluster_points <= max_cluster_points, got "
-                f"{self.min_cluster_points} and {self.max_cluster_points}"
-            )
-        if self.cluster_tolerance_m <= 0 or self.gate_m <= 0:
+        super().__post_init__()
+        if self.gate_m <= 0:
             raise ConfigError("cluster_tolerance_m and gate_m must be positive")
-        nonnegative = (
-            "table_leg_band_m", "split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac",
-            "trim_margin_frac", "trim_depth_m", "table_rim_depth_m", "table_rim_reach_m",
-        )
-        for name in nonnegative:
-            if getattr(self, name) < 0:
-                raise ConfigError(f"{name} must be >= 0, got {getattr(self, name)}")
-        if not 0.0 < self.join_containment <= 1.0:
-            raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
-        if not 0.0 <= self.background_noise_min_cos <= 1.0:
-            raise ConfigError(
-                f"background_noise_min_cos must be in [0, 1], got {self.background_noise_min_cos}"
-            )
-        tuples = (
-            "classes", "exclude_classes", "search_classes", "unseen_table_skip_classes", "walker_classes",
-            "search_same_class",
-        )
-        for name in tuples:
-            value = getattr(self, name)
-            if isinstance(value, str):  # "a,b" from a command line
-                value = tuple(v.strip() for v in value.split(",") if v.strip())
-            object.__setattr__(self, name, tuple(str(v) for v in value))
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
+        _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
+
+
+def _own(cls: type, base: type | None) -> frozenset[str]:
+    """The fields ``cls`` adds to ``base``."""
+    names = {f.name for f in fields(cls)}
+    return frozenset(names - ({f.name for f in fields(base)} if base is not None else set()))
+
+
+@dataclass(frozen=True)
+class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
+    """Everything the foreground stage can be told: the detector's options and every part's.
+
+    ``PARTS``: the option names of each part, for dotted options (``tracker.gate_m``).
+    """
+
+    PARTS: ClassVar[dict[str, frozenset[str]]] = {
+        "segment": _own(SegmentConfig, BackgroundFilterConfig) | _own(SamplingConfig, None),
+        "background_filter": _own(BackgroundFilterConfig, SamplingConfig),
+        "refine": _own(RefineConfig, SegmentConfig),
+        "match": _own(MatchConfig, None),
+        "tracker": _own(TrackerConfig, None),
+    }
+
+    detector: str = "yolox"
+    """Registry name: ``yolox``, ``onnx:PATH``, ``log`` or ``truth``."""
+    min_detection_score: float = 0.3
+    """Detections below this score are ignored by the matching."""
+    detector_threads: bool = True
+    """Run the detector in a worker thread, concurrently with the point-cloud work."""
+    classes: tuple[str, ...] = ()
+    """Only these detector classes name blobs (empty: all); a per-environment class list."""
+    exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED
+    """Detector classes dropped before matching (the paper excluded classes not present, such as
+    boat and traffic light): outdoor COCO classes and ``dining table`` (tables are background)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _as_tuples(self, ("classes", "exclude_classes"))
 
     @classmethod
     def from_options(cls, **options: Any) -> ForegroundConfig:
-        """Build from keyword options; an unknown name raises ``ConfigError`` listing the known."""
+        """Build from keyword options, flat (``gate_m``) or dotted by part (``tracker.gate_m``);
+        an unknown name raises ``ConfigError`` listing the known ones."""
         known = {f.name for f in fields(cls)}
-        unknown = sorted(set(options) - known)
+        flat: dict[str, Any] = {}
+        for key, value in options.items():
+            part, dot, name = key.rpartition(".")
+            if dot:
+                if part not in cls.PARTS:
+                    raise ConfigError(f"foreground option {key!r}: unknown part {part!r}; expected one of "
+                                      f"{', '.join(cls.PARTS)}")
+                if name not in cls.PARTS[part]:
+                    raise ConfigError(f"foreground option {key!r}: {part} has no option {name!r}; expected "
+                                      f"one of {', '.join(sorted(cls.PARTS[part]))}")
+            if name in flat:
+                raise ConfigError(f"foreground option {name!r} given twice")
+            flat[name] = value
+        unknown = sorted(set(flat) - known)
         if unknown:
             raise ConfigError(
                 f"unknown foreground option(s) {unknown}; expected one of {', '.join(sorted(known))}"
             )
-        return cls(**options)
+        return cls(**flat)

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, point_bounds
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
 __all__ = ["drop_table_legs", "leg_points"]
@@ -41,7 +41,7 @@ FloatArray = NDArray[np.float64]
 
 
 def leg_points(
-    points_map: FloatArray, tables: Sequence[Box3D], config: ForegroundConfig, rims: bool = False
+    points_map: FloatArray, tables: Sequence[Box3D], config: SegmentConfig, rims: bool = False
 ) -> NDArray[np.bool_]:
     """Which of ``points_map`` (N, 3) belong to table legs (see the module docstring)."""
     legs = np.zeros(len(points_map), dtype=bool)
@@ -90,7 +90,7 @@ def leg_points(
     return legs
 
 
-def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: ForegroundConfig) -> float | None:
+def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: SegmentConfig) -> float | None:
     """The first of ``supports_z_m`` (support top heights, in order of preference; None: no
     support) that the blob's base is within the filter margin plus ``support_gap_m`` above."""
     base = float(blob.bounds_map[0][2])
@@ -103,7 +103,7 @@ def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: Foregr
 
 
 def drop_table_legs(
-    blobs: list[Blob], tables: Sequence[Box3D], config: ForegroundConfig, step: int, width: int, height: int,
+    blobs: list[Blob], tables: Sequence[Box3D], config: RefineConfig, step: int, width: int, height: int,
     rims: bool = False,
 ) -> list[Blob]:
     """``blobs`` without their table-leg points; a blob that was only legs is gone."""

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import Blob, sub_blob, support_below
 
@@ -65,7 +65,7 @@ def _nearest_label(
 
 
 def _split(
-    blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig
+    blob: Blob, boxes: FloatArray, areas: FloatArray, config: RefineConfig
 ) -> list[NDArray[np.int64]] | None:
     """Index groups of the points of ``blob``, or None when it stays whole."""
     inside = _inside(blob.pixels_uv, boxes)
@@ -111,7 +111,7 @@ def _split(
 
 def _trim(
     blob: Blob, iou: FloatArray, boxes: FloatArray, grown: FloatArray, step_pad: FloatArray,
-    config: ForegroundConfig,
+    config: RefineConfig,
 ) -> NDArray[np.int64] | None:
     """The points of ``blob`` inside the (grown) box of the detection it overlaps best (``iou``
     (K,) of its image box with ``boxes``), when that IoU reaches ``trim_iou`` and the points
@@ -132,7 +132,7 @@ def _trim(
     return keep if len(keep) >= config.min_cluster_points else None
 
 
-def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundConfig) -> int | None:
+def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: RefineConfig) -> int | None:
     """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
     share = np.count_nonzero(_inside(blob.pixels_uv, boxes), axis=0) / len(blob.pixels_uv)
     ok = np.flatnonzero(share >= config.join_containment)
@@ -141,7 +141,7 @@ def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: ForegroundC
     return int(ok[np.argmin(areas[ok])])
 
 
-def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
+def _close(a: Blob, b: Blob, config: RefineConfig) -> bool:
     from scipy.spatial import cKDTree
 
     # Boxes farther apart than the gap hold no points within it (distances are the same in the
@@ -161,7 +161,7 @@ def _close(a: Blob, b: Blob, config: ForegroundConfig) -> bool:
     return bool(np.isfinite(dist).any())
 
 
-def _fits_better(group: Sequence[Blob], blob: Blob, box_xyxy: FloatArray, config: ForegroundConfig) -> bool:
+def _fits_better(group: Sequence[Blob], blob: Blob, box_xyxy: FloatArray, config: RefineConfig) -> bool:
     """Whether adding ``blob`` to ``group`` keeps the group's image box at least as close to the
     detection box (IoU, up to ``join_max_iou_loss``): the torso and legs of a person cut by a
     table fill the person's box together, a piece of a table beside a chair's box does not."""
@@ -186,7 +186,7 @@ def _concat(blobs: Sequence[Blob], step: int, width: int, height: int) -> Blob:
 def refine_blobs(
     blobs: Sequence[Blob],
     detection_boxes_xyxy: FloatArray,
-    config: ForegroundConfig,
+    config: RefineConfig,
     width: int,
     height: int,
     support_boxes_map: Sequence[Box3D] = (),

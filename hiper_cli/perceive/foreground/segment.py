@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, point_bounds
 from hiper_cli.perceive.foreground.background_filter import background_mask
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import SegmentConfig
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
@@ -209,7 +209,7 @@ def _cluster_labels(
 
 
 def grid_components(
-    blob: Blob, sel: NDArray[np.int64], step: int, config: ForegroundConfig
+    blob: Blob, sel: NDArray[np.int64], step: int, config: SegmentConfig
 ) -> list[NDArray[np.int64]]:
     """The connected parts of the points ``sel`` of ``blob`` (indices into ``sel``), linked
     as the segmentation links points (``_cluster_labels`` on the blob's own sampling grid);
@@ -233,7 +233,7 @@ def grid_components(
 
 def _merge_fragments(
     member: NDArray[np.int64], starts: NDArray[np.int64], map_full: FloatArray, grid_w: int,
-    config: ForegroundConfig, min_size: int = 3,
+    config: SegmentConfig, min_size: int = 3,
 ) -> list[NDArray[np.int64]]:
     """The clusters of at least ``min_size`` points, small fragments folded into a much
     larger neighbouring cluster. The clusters are the consecutive slices of ``member`` (grid
@@ -291,7 +291,7 @@ def _merge_fragments(
 
 
 def support_below(
-    blob: Blob, supports: Sequence[Box3D], config: ForegroundConfig, image_height: int | None = None
+    blob: Blob, supports: Sequence[Box3D], config: SegmentConfig, image_height: int | None = None
 ) -> float | None:
     """Top height of the support the blob stands on, if its base is within the filter margin
     plus ``support_gap_m`` above it (thin legs and feet lose their lowest samples to the margin
@@ -324,7 +324,7 @@ def segment(
     camera: CameraIntrinsics,
     T_map_cam: FloatArray,
     background_boxes_map: Sequence[Box3D],
-    config: ForegroundConfig,
+    config: SegmentConfig,
     support_boxes_map: Sequence[Box3D] = (),
     keep_fragments: bool = False,
 ) -> tuple[list[Blob], SegmentStats]:

@@ -31,6 +31,11 @@ __all__ = ["ForegroundStage"]
 
 FloatArray = NDArray[np.float64]
 SUPPORT_CLASSES = ("floor", "table")
+# Named constants (not the paper's): chosen so that they never bind on the simulated worlds.
+HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
+SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
+MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this span
+OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -44,11 +49,11 @@ def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
             continue
         lo, hi = inst.box.aabb()
         plane = inst.data.get("plane_map")
-        if plane is not None and len(plane) == 4 and abs(float(plane[2])) > 0.9:
+        if plane is not None and len(plane) == 4 and abs(float(plane[2])) > HORIZONTAL_PLANE_MIN_NZ:
             a, b, c, d = (float(v) for v in plane)
             cx, cy = (lo[:2] + hi[:2]) / 2.0
             top = -(a * cx + b * cy + d) / c
-            if lo[2] - 0.05 <= top <= hi[2]:
+            if lo[2] - SUPPORT_TOP_BELOW_BOX_M <= top <= hi[2]:
                 hi = hi.copy()
                 hi[2] = top
                 lo = lo.copy()
@@ -131,7 +136,7 @@ class ForegroundStage:
         alt = self._priors.get(("altitude", class_name))
         if alt and "lo_m" in alt and "hi_m" in alt:
             lo, hi = float(alt["lo_m"]), float(alt["hi_m"])
-            slack = tol * max(hi - lo, 0.2)
+            slack = tol * max(hi - lo, MIN_ALTITUDE_SPAN_M)
             if not lo - slack <= float(blob.center_map[2]) <= hi + slack:
                 return False
         return True
@@ -327,7 +332,7 @@ class ForegroundStage:
             ui = np.clip(u.astype(int), 0, cam.width - 1)
             vi = np.clip(v.astype(int), 0, cam.height - 1)
             measured = depth[vi, ui]
-            occluded = (measured > 0) & (measured < z - 0.5)
+            occluded = (measured > 0) & (measured < z - OCCLUSION_MARGIN_M)
             return np.asarray(ok & ~occluded)
 
         return visible

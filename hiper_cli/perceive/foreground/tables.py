@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
 from hiper_cli.perceive.foreground.legs import leg_points, standing_on
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
@@ -45,7 +45,7 @@ def _column_tops(points_map: FloatArray, cell_m: float) -> FloatArray:
     return np.asarray(tops[inverse])
 
 
-def unseen_table_top(points_map: FloatArray, config: ForegroundConfig) -> Box3D | None:
+def unseen_table_top(points_map: FloatArray, config: SegmentConfig) -> Box3D | None:
     """The top of a table the background layer has not mapped yet, if the points (N, 3) of a
     blob hold one: the most populated horizontal slab between ``unseen_table_min_height_m``
     and ``unseen_table_max_height_m``, of the columns (``table_leg_cell_m`` cells) that end
@@ -88,7 +88,7 @@ def _minor_extent_m(points_xy: FloatArray) -> float:
     return float(p95 - p5)
 
 
-def table_points(points_map: FloatArray, top: Box3D, config: ForegroundConfig) -> NDArray[np.bool_]:
+def table_points(points_map: FloatArray, top: Box3D, config: SegmentConfig) -> NDArray[np.bool_]:
     """Which points (N, 3) are the table's top (within its footprint grown by
     ``table_leg_reach_m``, two slab bins of its top height, in columns that end there) or its
     legs (``leg_points``)."""
@@ -104,7 +104,7 @@ def table_points(points_map: FloatArray, top: Box3D, config: ForegroundConfig) -
 
 
 def drop_unseen_tables(
-    blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: ForegroundConfig,
+    blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
     width: int, height: int,
 ) -> list[Blob]:
     """``blobs`` without the tops and legs of tables found in them (see the module docstring);
@@ -133,7 +133,7 @@ def drop_unseen_tables(
 
 
 def _part(
-    blob: Blob, sel: NDArray[np.int64], top: Box3D, config: ForegroundConfig, width: int, height: int
+    blob: Blob, sel: NDArray[np.int64], top: Box3D, config: SegmentConfig, width: int, height: int
 ) -> Blob:
     """A part of ``blob`` as a blob of its own, standing on the table top, on the floor below the
     blob (as the segmentation found it), or on nothing known."""

@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
-from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
@@ -198,7 +198,7 @@ def smooth_trajectory(track: Track) -> None:
         row[ROW_STATE] = x.tolist()
 
 
-def _was_moving(track: Track, config: ForegroundConfig) -> bool:
+def _was_moving(track: Track, config: TrackerConfig) -> bool:
     """Whether the track was moving when last updated: its filtered velocity then and its
     filtered displacement over the last ``moving_window_s`` (at least ``min_moving_span_s`` of
     history) both exceed ``moving_speed_mps``. Either alone is fooled: the velocity by noise,
@@ -212,7 +212,7 @@ def _was_moving(track: Track, config: ForegroundConfig) -> bool:
     return moving
 
 
-def _moving_rows(rows: list[list[float]], config: ForegroundConfig) -> bool:
+def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:
     if not rows or math.hypot(*rows[-1][ROW_VELOCITY][:2]) <= config.moving_speed_mps:
         return False
     t_end = rows[-1][ROW_STAMP]
@@ -239,7 +239,7 @@ class Tracker:
 
     def __init__(
         self,
-        config: ForegroundConfig,
+        config: TrackerConfig,
         priors: Callable[[str], ClassPrior] | None = None,
     ) -> None:
         if config.motion_model not in MOTION_MODELS:
