@@ -81,10 +81,9 @@ class BackgroundFilterConfig(SamplingConfig):
     background_filter: bool = True
     """Remove points inside background instance boxes (off = the paper's ablation C4)."""
     background_margin_m: float = 0.02
-    """Background boxes are grown by this much on every side before filtering (0.05 cut thin
-    parts that touch a wall or the floor, a bed's head board, from their objects; 0.015 let
-    more wall noise through as blobs: false positives and identity switches on the tuning
-    logs) ..."""
+    """Background boxes are grown by this much on every side before filtering: wider cuts thin
+    parts that touch a wall or the floor (a bed's head board) from their objects, narrower lets
+    wall noise through as blobs ..."""
     background_margin_per_m2: float = 0.0015
     """... plus this times the squared depth (structured-light depth noise grows with z²)."""
     background_noise_along_ray: bool = True
@@ -136,7 +135,7 @@ class SegmentConfig(BackgroundFilterConfig):
     (the background layer knows the top as a plane; the few centimetres of edge under it
     survive the filter, and at 4-5 m, with the cluster tolerance grown to 0.3 m, they joined a
     chair to the cups on the table) and leaves the blob with the legs; the rest is clustered
-    again (0: off). House 881: localisation 0.0162 -> 0.0150 m."""
+    again (0: off)."""
     table_rim_above_m: float = 0.01
     table_rim_reach_m: float = 0.1
     """Rim cells count this far outside the mapped top, and the legs under them too."""
@@ -164,9 +163,8 @@ class SegmentConfig(BackgroundFilterConfig):
     """... when its centre is this close to that cluster's box (grazing sides, heads)."""
     support_gap_m: float = 0.1
     """A blob whose base is at most the filter margin plus this above a floor or table top
-    stands on it: its box reaches down to the support (0.25 m, to catch chairs whose thin legs
-    lose their lowest samples, moved the centre away from what the sensor sees: worse on the
-    tuning logs)."""
+    stands on it: its box reaches down to the support (a wider gap, to catch chairs whose thin
+    legs lose their lowest samples, moves the centre away from what the sensor sees)."""
     support_edge_band_m: float = 0.01
     """... unless its lowest points (within this of its lowest) reach the image's lower edge: its
     base is out of view (a chair cut there by its front legs, its back feet in view, stands)."""
@@ -218,9 +216,8 @@ class RefineConfig(SegmentConfig):
     join_containment: float = 0.8
     """Share of a blob's pixels that must lie in the (grown) detection box to join ..."""
     detection_margin_frac: float = 0.1
-    """... the box grown by this share of its size on every side (detector jitter: a chair's
-    seat cut off by its own back at the image's lower edge stayed apart with 0; 0.1, as for
-    trimming, lowered identity switches on the tuning logs by 12 %) ..."""
+    """... the box grown by this share of its size on every side (detector jitter: without it a
+    chair's seat cut off by its own back at the image's lower edge stays apart) ..."""
     join_depth_m: float = 0.25
     """... their median depths at most this far apart ..."""
     join_gap_m: float = 0.3
@@ -319,8 +316,8 @@ class TrackerConfig(_Part):
     velocity_relax_static: bool = False
     """... also for tracks of classes that do not search (``search_classes``), if true. False:
     a chair's or a cup's only decays, and its gate does not grow to ``gate_m`` within half a
-    second unseen (the piece of a chair leaving the view took the cup on the table 0.85 m away:
-    a false positive on house 894)."""
+    second unseen (else the piece of a chair leaving the view can take the cup on the table
+    0.85 m away)."""
     velocity_decay_grace_s: float = 0.1
     """No decay for this long after the last update (a missed detection must not slow a walker)."""
     accel_noise_mps2: float = 1.0
