@@ -17,7 +17,8 @@ FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "house_small"
 
 def test_golden_table_iii_on_the_fixture():
     report = evaluate_foreground(FIXTURE, detector="truth", ablation=False, background="truth")
-    ours = report["ours"]
+    ours = report.ours
+    assert report.to_dict()["ours"] is ours
     assert ours["classification"] == {"chair": {"tp": 3, "fp": 0}, "person": {"tp": 1, "fp": 0}}
     assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (3, 7, 103)
     assert ours["identity_switches"] == 3 and ours["truth_instances_seen"] == 7

@@ -53,11 +53,11 @@ def foreground(
         max_frames=max_frames or None, background=background, **options,
     )
     if json_out:
-        print_json(report)
+        print_json(report.to_dict())
         return
     from hiper_cli.commands._tables import show_foreground_eval
 
-    show_foreground_eval(console(), report)
+    show_foreground_eval(console(), report.to_dict())
 
 
 def register(app: typer.Typer) -> None:
