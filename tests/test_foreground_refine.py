@@ -85,7 +85,7 @@ def test_touching_people_are_split_by_their_detections():
     for b in out:
         hit = ids[b.pixels_uv[:, 1], b.pixels_uv[:, 0]]
         assert np.mean(hit == np.bincount(hit).argmax()) > 0.95  # each part is one person
-    assert sorted(float(b.center_map[1]) for b in out) == pytest.approx([-0.25, 0.25], abs=0.05)
+    assert sorted(float(b.center_map_m[1]) for b in out) == pytest.approx([-0.25, 0.25], abs=0.05)
     assert len(_refine(blobs, frame.detections.xyxy, ForegroundConfig(pixel_step=2))) == 1  # off by default
 
 

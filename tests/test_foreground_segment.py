@@ -30,10 +30,10 @@ def test_person_stands_on_the_floor_after_filtering():
     (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg, floor)
     assert blob.points_map[:, 2].min() > 0.05  # the filter cut the feet with the floor ...
     assert blob.support_z_m == pytest.approx(0.0)
-    assert blob.extent_map[2] == pytest.approx(1.7, abs=0.05)  # ... the box reaches down again
-    assert blob.center_map[2] == pytest.approx(0.85, abs=0.03)
+    assert blob.extent_map_m[2] == pytest.approx(1.7, abs=0.05)  # ... the box reaches down again
+    assert blob.center_map_m[2] == pytest.approx(0.85, abs=0.03)
     (no_support,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg)
-    assert no_support.support_z_m is None and no_support.center_map[2] > 0.87
+    assert no_support.support_z_m is None and no_support.center_map_m[2] > 0.87
 
 
 def test_a_head_above_a_gap_joins_its_body():

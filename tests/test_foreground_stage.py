@@ -53,15 +53,15 @@ def test_background_filter_leaves_only_the_person():
     cfg = ForegroundConfig(pixel_step=2)
     blobs, stats = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
     assert stats.after_background < stats.points / 3
-    centres = sorted(b.center_map[1] for b in blobs)
+    centres = sorted(b.center_map_m[1] for b in blobs)
     assert len(blobs) == 2 and centres == pytest.approx([0.0, 1.0], abs=0.05)
     # Without the filter (C4) the person merges with the floor into one rejected cluster and
     # strips of far floor become blobs.
     off = ForegroundConfig(pixel_step=2, background_filter=False)
     blobs_off, stats_off = segment(frame.depth_m, CAMERA, frame.T_map_cam, [], off)
     assert stats_off.after_background == stats.points
-    assert not any(np.linalg.norm(b.center_map[:2] - [2.85, 0.0]) < 0.2 for b in blobs_off)
-    assert any(b.extent_map[2] < 0.05 for b in blobs_off)
+    assert not any(np.linalg.norm(b.center_map_m[:2] - [2.85, 0.0]) < 0.2 for b in blobs_off)
+    assert any(b.extent_map_m[2] < 0.05 for b in blobs_off)
 
 
 def test_walker_becomes_one_dynamic_person_with_its_speed():

@@ -76,7 +76,7 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
             "pixels_uv": pixels_uv.astype(int).tolist(),
             "area_m2": area,
             "rms_m": seg.rms_m,
-            "n_points": seg.n_points,
+            "num_points": seg.n_points,
             "method": cfg.method,
         },
     )

@@ -73,7 +73,7 @@ class Blob:
         return lo, hi
 
     @property
-    def center_map(self) -> FloatArray:
+    def center_map_m(self) -> FloatArray:
         """Where the blob is, map frame: the centroid of its points horizontally (robust to
         depth noise, which moves the box's extreme points) and the middle of its vertical
         extent (the box centre height, independent of how densely each part was sampled)."""
@@ -85,7 +85,7 @@ class Blob:
         return centre
 
     @property
-    def extent_map(self) -> FloatArray:
+    def extent_map_m(self) -> FloatArray:
         lo, hi = self.bounds_map
         extent = hi - lo
         z_lo, z_hi = self._z_range()

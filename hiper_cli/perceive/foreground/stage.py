@@ -130,14 +130,14 @@ class ForegroundStage:
         tol = self.config.prior_tolerance
         size = self._priors.get(("size", class_name))
         if size and "lo_m3" in size and "hi_m3" in size:
-            volume = float(np.prod(blob.extent_map))
+            volume = float(np.prod(blob.extent_map_m))
             if not float(size["lo_m3"]) * (1 - tol) <= volume <= float(size["hi_m3"]) * (1 + tol):
                 return False
         alt = self._priors.get(("altitude", class_name))
         if alt and "lo_m" in alt and "hi_m" in alt:
             lo, hi = float(alt["lo_m"]), float(alt["hi_m"])
             slack = tol * max(hi - lo, MIN_ALTITUDE_SPAN_M)
-            if not lo - slack <= float(blob.center_map[2]) <= hi + slack:
+            if not lo - slack <= float(blob.center_map_m[2]) <= hi + slack:
                 return False
         return True
 
@@ -224,7 +224,7 @@ class ForegroundStage:
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
             measurements.append(
-                Measurement(blob.center_map, blob.extent_map, match.class_name, match.score, obs.uuid)
+                Measurement(blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid)
             )
         t_match = time.perf_counter()
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
@@ -284,7 +284,7 @@ class ForegroundStage:
                 "image_box_xyxy": [float(v) for v in blob.image_box_xyxy],
                 "points_cam": np.round(blob.points_cam[pts_idx], 4).tolist(),
                 "pixels_uv": blob.pixels_uv[pix_idx].tolist(),
-                "center_map": [float(v) for v in blob.center_map],
+                "center_map": [float(v) for v in blob.center_map_m],
                 "num_points": n,
                 "detection": detection,
             },
@@ -300,7 +300,7 @@ class ForegroundStage:
                 layer="foreground",
                 class_name=track.class_name,
                 box=box,
-                first_seen_s=track.first_s,
+                first_seen_s=track.first_seen_s,
                 last_seen_s=track.last_update_s,
                 uuid=track.uuid,
                 observation_uuids=track.observation_uuids,

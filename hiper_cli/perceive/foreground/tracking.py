@@ -67,8 +67,8 @@ MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a litt
 class Measurement:
     """One observed blob for the tracker: centre and extent in the map frame."""
 
-    center_map: FloatArray
-    extent_map: FloatArray
+    center_map_m: FloatArray
+    extent_map_m: FloatArray
     class_name: str
     score: float
     observation_uuid: str
@@ -88,7 +88,7 @@ class Track:
 
     uuid: str
     motion: MotionModel  # the state estimate (``ForegroundConfig.motion_model``)
-    first_s: float
+    first_seen_s: float
     last_update_s: float
     last_time_s: float
     extent_m: FloatArray
@@ -297,22 +297,22 @@ class Tracker:
             dt = stamp_s - track.last_update_s
             if dt > MIN_VELOCITY_INIT_DT_S:
                 # Two-point initialisation: v = (z2 - z1) / dt with its own covariance.
-                v = (m.center_map - track.first_center) / dt
+                v = (m.center_map_m - track.first_center) / dt
                 r = self.config.measurement_noise_m**2
                 var_v = 2.0 * r / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
-                motion.reset(np.r_[m.center_map, v], np.diag([r, r, r, var_v, var_v, var_v]))
+                motion.reset(np.r_[m.center_map_m, v], np.diag([r, r, r, var_v, var_v, var_v]))
                 track.velocity_initialised = True
                 if track.trajectory:  # the first row gets the velocity it could not know yet
                     track.trajectory[0][ROW_VELOCITY] = v.tolist()
                     track.covariances[0] = np.array(motion.P, dtype=np.float64)
             else:
-                motion.update(m.center_map)
+                motion.update(m.center_map_m)
         else:
-            motion.update(m.center_map)
+            motion.update(m.center_map_m)
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
-        track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * m.extent_map
+        track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * m.extent_map_m
         self._vote(track, m)
         if not track.confirmed and track.hits >= self.config.confirm_hits:
             track.confirmed = True
@@ -323,7 +323,7 @@ class Tracker:
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
         track._class_name = None
         track.score_sum += m.score
-        track.max_size_m = max(track.max_size_m, _size_m(m.extent_map))
+        track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
         q = self._accel_noise(track.class_name) ** 2
@@ -363,7 +363,7 @@ class Tracker:
         if not self.tracks or not measurements:
             return []
         pred = np.array([t.position for t in self.tracks])
-        obs = np.array([m.center_map for m in measurements])
+        obs = np.array([m.center_map_m for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         # The filters' own uncertainty, all tracks in one eigenvalue call.
         P = np.array([t.motion.P[:3, :3] for t in self.tracks])
@@ -378,8 +378,8 @@ class Tracker:
         grace = max(cfg.velocity_decay_grace_s, LOST_AFTER_FRAMES * self._frame_dt_s)
         classes = np.array([m.class_name for m in measurements], dtype=object)
         unknown = classes == UNKNOWN
-        sizes = np.array([_size_m(m.extent_map) for m in measurements])
-        half_extents = np.array([m.extent_map for m in measurements]) / 2.0
+        sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
+        half_extents = np.array([m.extent_map_m for m in measurements]) / 2.0
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             if self._settled(t):
@@ -458,12 +458,13 @@ class Tracker:
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
         track = Track(
             uuid=new_uuid(),
-            motion=make_motion_model(self.config.motion_model, m.center_map, self.config.measurement_noise_m),
-            first_s=stamp_s,
+            motion=make_motion_model(self.config.motion_model, m.center_map_m,
+                                     self.config.measurement_noise_m),
+            first_seen_s=stamp_s,
             last_update_s=stamp_s,
             last_time_s=stamp_s,
-            extent_m=np.asarray(m.extent_map, dtype=np.float64).copy(),
-            first_center=np.asarray(m.center_map, dtype=np.float64).copy(),
+            extent_m=np.asarray(m.extent_map_m, dtype=np.float64).copy(),
+            first_center=np.asarray(m.center_map_m, dtype=np.float64).copy(),
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
         )
