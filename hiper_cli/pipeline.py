@@ -302,7 +302,7 @@ def perceive(
     if resume:
         session = kb.resumable_session(env, str(path))
         if session is None:
-            past = [s for s in kb.docs.sessions() if s.env_uuid == env.uuid and s.log_path == str(path)]
+            past = [s for s in kb.sessions(env.uuid) if s.log_path == str(path)]
             if past:
                 raise KnowledgeBaseError(
                     f"{path}: nothing to resume, its last session ({past[-1].id}) in environment "

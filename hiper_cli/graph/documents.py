@@ -31,6 +31,7 @@ from typing import Any
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.graph.lookups import Lookups
 from hiper_cli.graph.trajectories import SCHEMA as TRAJECTORIES_SCHEMA
 from hiper_cli.graph.trajectories import TrajectoryStore
 
@@ -198,7 +199,7 @@ def _box_meets(doc: dict[str, Any], lo: Sequence[float], hi: Sequence[float]) ->
     return True
 
 
-class DocumentStore(ChangeFeed):
+class DocumentStore(ChangeFeed, Lookups):
     """JSON documents in one SQLite file. Writes happen inside ``transaction()``."""
 
     def __init__(self, path: Path, *, read_only: bool = False) -> None:

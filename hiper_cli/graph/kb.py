@@ -35,6 +35,7 @@ from hiper_cli.graph.ontology import (
     meta_graph,
     node,
 )
+from hiper_cli.graph.reads import KbReads
 from hiper_cli.graph.scenegraph import DetachedGraph, LocalGraph, SparqlGraph, open_graph
 from hiper_cli.graph.sync import SyncReport, sync_graph
 from hiper_cli.model import LAYERS, Analysis, Box3D, Environment, FrameResult, Instance, Observation, World
@@ -119,8 +120,9 @@ def _value(term: Any) -> Any:
     return str(term)
 
 
-class KnowledgeBase:
-    """Open with ``open_kb``. Not thread-safe; one writer process at a time."""
+class KnowledgeBase(KbReads):
+    """Open with ``open_kb``. Not thread-safe; one writer process at a time. The typed reads
+    of the query layer come from ``KbReads`` (``reads.py``)."""
 
     def __init__(
         self,

@@ -12,13 +12,13 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
 import pyoxigraph as ox
 
-from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.errors import KnowledgeBaseError, QueryError
 from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
 
 __all__ = ["DetachedGraph", "GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
@@ -29,7 +29,8 @@ _TRUE = ox.Literal("true", datatype=ox.NamedNode("http://www.w3.org/2001/XMLSche
 # Below this many bytes of N-Quads a transactional load is as fast as the bulk loader (which
 # writes new files on every call) and keeps the write atomic.
 BULK_MIN_BYTES = 1 << 20
-_INTEGER = ox.NamedNode("http://www.w3.org/2001/XMLSchema#integer")
+_XSD = "http://www.w3.org/2001/XMLSchema#"
+_INTEGER = ox.NamedNode(_XSD + "integer")
 _PREFIXES = f"PREFIX hiper: <{HIPER}>\nPREFIX prov: <{PROV}>\nPREFIX sosa: <http://www.w3.org/ns/sosa/>\n"
 
 
@@ -76,9 +77,16 @@ class GraphBackend(Protocol):
 
     def clear(self, graphs: Sequence[ox.NamedNode]) -> None: ...
 
-    def query(self, sparql: str) -> list[dict[str, Any]]:
+    def query(self, sparql: str, bindings: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
         """SELECT results as rows of {variable: pyoxigraph term}. The hiper, prov and sosa
-        prefixes are predeclared."""
+        prefixes are predeclared. ``bindings`` give variables a value before evaluation (a
+        template's variables, never text pasted into it); bound variables must be projected."""
+        ...
+
+    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
+        """A SELECT, ASK, CONSTRUCT or DESCRIBE query over the union of all graphs, serialised
+        as ``media_type`` (a SPARQL results or RDF media type); (body, media type). Updates
+        are refused with ``QueryError``."""
         ...
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]: ...
@@ -183,11 +191,22 @@ class LocalGraph:
         for g in graphs:
             self._store.clear_graph(g)
 
-    def query(self, sparql: str) -> list[dict[str, Any]]:
+    def query(self, sparql: str, bindings: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
         try:
+            if bindings:
+                subs = {ox.Variable(k): term(v) for k, v in bindings.items()}
+                return _solutions(self._store.query(_PREFIXES + sparql, substitutions=subs))
             return _solutions(self._store.query(_PREFIXES + sparql))
         except SyntaxError as err:
             raise KnowledgeBaseError(f"SPARQL query does not parse: {err}") from err
+
+    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
+        readonly_check(sparql)
+        try:
+            result = self._store.query(_PREFIXES + sparql, use_default_graph_as_union=True)
+        except SyntaxError as err:
+            raise QueryError(f"SPARQL query does not parse: {err}") from err
+        return serialize_results(result, media_type)
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
         out: list[ox.Quad] = []
@@ -303,10 +322,19 @@ class SparqlGraph:
         if graphs:
             self._update(" ;\n".join(f"CLEAR SILENT GRAPH {g}" for g in graphs))
 
-    def query(self, sparql: str) -> list[dict[str, Any]]:
+    def query(self, sparql: str, bindings: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
+        if bindings:
+            sparql = values_bound(sparql, bindings)
         raw = self._post("query", _PREFIXES + sparql, "application/sparql-query",
                          accept="application/sparql-results+json")
         return _solutions(ox.parse_query_results(raw, format=ox.QueryResultsFormat.JSON))
+
+    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
+        readonly_check(sparql)
+        try:
+            return self._post("query", _PREFIXES + sparql, "application/sparql-query", accept=media_type), media_type
+        except KnowledgeBaseError as err:
+            raise QueryError(str(err)) from err
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
         out: list[ox.Quad] = []
@@ -340,6 +368,72 @@ class DetachedGraph:
 
     def close(self) -> None:
         pass
+
+
+def term(value: Any) -> Any:
+    """A pyoxigraph term for a binding: terms as they are, floats as xsd:double, ints as
+    xsd:integer, bools as xsd:boolean, anything else as a plain string literal."""
+    if isinstance(value, ox.NamedNode | ox.Literal | ox.BlankNode):
+        return value
+    if isinstance(value, bool):
+        return ox.Literal("true" if value else "false", datatype=ox.NamedNode(_XSD + "boolean"))
+    if isinstance(value, int):
+        return ox.Literal(str(value), datatype=_INTEGER)
+    if isinstance(value, float):
+        return ox.Literal(repr(value), datatype=ox.NamedNode(_XSD + "double"))
+    return ox.Literal(str(value))
+
+
+def values_bound(sparql: str, bindings: Mapping[str, Any]) -> str:
+    """The query with a ``VALUES`` row of the bindings opening its WHERE group, for endpoints
+    (the SPARQL 1.1 Protocol has no bindings). Values are serialised RDF terms (quotes and
+    brackets escaped by pyoxigraph), so they cannot change the query's structure."""
+    import re
+
+    match = re.search(r"\bWHERE\s*\{", sparql, flags=re.IGNORECASE)
+    if match is None:
+        raise QueryError("a bound query needs a 'WHERE {' group to bind its variables in")
+    names = " ".join(f"?{ox.Variable(k).value}" for k in bindings)
+    row = " ".join(str(term(v)) for v in bindings.values())
+    return f"{sparql[: match.end()]} VALUES ({names}) {{ ({row}) }} {sparql[match.end():]}"
+
+
+_UPDATE_WORDS = ("INSERT", "DELETE", "LOAD", "CLEAR", "CREATE", "DROP", "COPY", "MOVE", "ADD")
+
+
+def readonly_check(sparql: str) -> None:
+    """Refuse SPARQL updates: the text must parse as a query (checked on an empty store)."""
+    try:
+        ox.Store().query(_PREFIXES + sparql)
+    except SyntaxError as err:
+        words = [w for w in _UPDATE_WORDS if w in sparql.upper().split()]
+        if words:
+            raise QueryError(f"SPARQL update ({', '.join(words)}) refused: the scene graph is read-only "
+                             "here; send a SELECT, ASK, CONSTRUCT or DESCRIBE query") from err
+        raise QueryError(f"SPARQL query does not parse: {err}") from err
+
+
+RESULT_FORMATS = {
+    "application/sparql-results+json": ox.QueryResultsFormat.JSON,
+    "application/sparql-results+xml": ox.QueryResultsFormat.XML,
+    "text/csv": ox.QueryResultsFormat.CSV,
+    "text/tab-separated-values": ox.QueryResultsFormat.TSV,
+}
+GRAPH_FORMATS = {
+    "text/turtle": ox.RdfFormat.TURTLE,
+    "application/n-triples": ox.RdfFormat.N_TRIPLES,
+    "application/rdf+xml": ox.RdfFormat.RDF_XML,
+}
+
+
+def serialize_results(result: Any, media_type: str) -> tuple[bytes, str]:
+    """Serialise pyoxigraph query results: solutions and booleans in a SPARQL results format
+    (JSON unless ``media_type`` names another), triples in an RDF format (Turtle unless)."""
+    if isinstance(result, ox.QueryTriples):
+        media = media_type if media_type in GRAPH_FORMATS else "text/turtle"
+        return bytes(result.serialize(format=GRAPH_FORMATS[media]) or b""), media
+    media = media_type if media_type in RESULT_FORMATS else "application/sparql-results+json"
+    return bytes(result.serialize(format=RESULT_FORMATS[media]) or b""), media
 
 
 def open_graph(location: str | Path, *, read_only: bool = False) -> LocalGraph | SparqlGraph:

@@ -1,0 +1,95 @@
+"""A query as typed data: what the plain-words grammar produces and the verbs consume.
+
+``QuerySpec`` says which instances (classes, layer, state, time window, confidence, space);
+``QueryConfig`` holds the constants of the geometry (field of view, default radii, support
+tolerances, goal standoff) with their defaults.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+from hiper_cli.errors import QueryError
+from hiper_cli.query.geometry import Frustum
+
+__all__ = ["SORTS", "STATES", "Near", "On", "QueryConfig", "QuerySpec"]
+
+Sort = Literal["distance", "last_seen", "first_seen", "confidence"]
+SORTS: tuple[str, ...] = ("distance", "last_seen", "first_seen", "confidence")
+STATES: tuple[str, ...] = ("static", "dynamic")
+
+
+@dataclass(frozen=True)
+class QueryConfig:
+    """``near_radius_m``: "near X" without a radius; ``pass_radius_m``: how close "passed
+    here" is; ``support_gap_m``/``support_margin_m``: an object stands on a support when its
+    bottom is that close to the support's top and its centre inside the support's footprint
+    grown by the margin; ``goal_standoff_m``: a goal pose's distance from the object's
+    footprint; ``now_window_s``: "now" means seen within this long before now;
+    ``view_gap_s``: observations further apart end a stretch of "time in view"."""
+
+    frustum: Frustum = field(default_factory=Frustum)
+    near_radius_m: float = 1.0
+    pass_radius_m: float = 1.0
+    support_gap_m: float = 0.12
+    support_margin_m: float = 0.05
+    support_classes: tuple[str, ...] = ("table",)
+    goal_standoff_m: float = 0.6
+    now_window_s: float = 2.0
+    view_gap_s: float = 1.0
+
+
+@dataclass(frozen=True)
+class Near:
+    """Within ``radius_m`` of the reference pose (``target`` "me") or of any instance of the
+    class ``target``."""
+
+    target: str
+    radius_m: float
+
+    def __post_init__(self) -> None:
+        if not self.radius_m >= 0:
+            raise QueryError(f"radius {self.radius_m} m: must be zero or positive")
+
+
+@dataclass(frozen=True)
+class On:
+    """Standing on an instance of ``class_name``; only the closest one when ``closest``."""
+
+    class_name: str
+    closest: bool = False
+
+
+@dataclass(frozen=True)
+class QuerySpec:
+    """Which instances a query selects. Empty ``classes`` = any class (of ``layer`` if set).
+    Times are stamps (s): an instance passes when it was seen at some time in [since, until]."""
+
+    classes: tuple[str, ...] = ()
+    layer: str | None = None
+    state: str | None = None
+    since_s: float | None = None
+    until_s: float | None = None
+    min_confidence: float = 0.0
+    in_fov: bool = False
+    near: Near | None = None
+    on: On | None = None
+    passed_here: bool = False
+    sort: str | None = None
+    limit: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.state is not None and self.state not in STATES:
+            raise QueryError(f"state {self.state!r}: expected one of {', '.join(STATES)}")
+        if self.sort is not None and self.sort not in SORTS:
+            raise QueryError(f"sort {self.sort!r}: expected one of {', '.join(SORTS)}")
+        if self.layer is not None and self.layer not in ("background", "foreground"):
+            raise QueryError(f"layer {self.layer!r}: expected background or foreground")
+        if self.limit is not None and self.limit < 1:
+            raise QueryError(f"limit {self.limit}: must be at least 1")
+        if self.since_s is not None and self.until_s is not None and self.since_s > self.until_s:
+            raise QueryError(f"time window {self.since_s} .. {self.until_s} s: starts after it ends")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)

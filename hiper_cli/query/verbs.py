@@ -1,0 +1,149 @@
+"""The query verbs of the library, the same ones the CLI, the grammar and (later) the MCP tools
+use: ``find``, ``count``, ``last_seen``, ``when``, ``passed_here``, ``trajectory``.
+
+Each takes the knowledge base, what to look for (a class name or words such as "mugs",
+"people", "objects"), filters, and where the query is asked from (``pose`` x, y, z, yaw, or
+the robot's pose at ``at_s``; ``now_s`` defaults to the KB's last stamp).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.errors import QueryError
+from hiper_cli.graph.kb import KnowledgeBase
+from hiper_cli.query import engine
+from hiper_cli.query.engine import Context, make_context
+from hiper_cli.query.results import Hit, Sighting, Trajectory
+from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
+from hiper_cli.query.vocabulary import ANY_FOREGROUND, CLASS_NAMES, resolve_class
+
+__all__ = ["count", "find", "last_seen", "passed_here", "spec_for", "trajectory", "when"]
+
+Pose = tuple[float, float, float, float]
+
+
+def _classes(what: str | None) -> tuple[tuple[str, ...], str | None]:
+    """(classes, layer) for a class name or words; () = any class."""
+    if what is None:
+        return (), None
+    name = resolve_class(what)
+    if name is None:
+        raise QueryError(f"unknown class {what!r}; expected a COCO or hiper class such as "
+                         f"{', '.join(CLASS_NAMES[:6])}, ... (plurals and synonyms like 'mugs' work)")
+    return ((), "foreground") if name == ANY_FOREGROUND else ((name,), None)
+
+
+def spec_for(
+    what: str | None = None, *, near: str | None = None, radius_m: float | None = None,
+    in_fov: bool = False, on: str | None = None, on_closest: bool = False, since_s: float | None = None,
+    until_s: float | None = None, state: str | None = None, min_confidence: float = 0.0,
+    sort: str | None = None, limit: int | None = None, config: QueryConfig | None = None,
+) -> QuerySpec:
+    """The ``QuerySpec`` of the verbs' keyword arguments (``near`` "me" or class words)."""
+    cfg = config or QueryConfig()
+    classes, layer = _classes(what)
+    near_spec = None
+    if near is not None or radius_m is not None:
+        target = "me" if near in (None, "me", "here") else _classes(near)[0]
+        if not isinstance(target, str) and not target:
+            raise QueryError(f"near {near!r}: name one class (e.g. 'table') or 'me'")
+        near_spec = Near(target if isinstance(target, str) else target[0],
+                         cfg.near_radius_m if radius_m is None else float(radius_m))
+    on_spec = None
+    if on is not None:
+        on_classes = _classes(on)[0]
+        if len(on_classes) != 1:
+            raise QueryError(f"on {on!r}: name one support class, e.g. 'table'")
+        on_spec = On(on_classes[0], on_closest)
+    if state == "moving":
+        state = "dynamic"
+    return QuerySpec(classes=classes, layer=layer, state=state, since_s=since_s, until_s=until_s,
+                     min_confidence=min_confidence, in_fov=in_fov, near=near_spec, on=on_spec, sort=sort,
+                     limit=limit)
+
+
+def _context(kb: KnowledgeBase, pose: Pose | None, at_s: float | None, now_s: float | None,
+             config: QueryConfig | None) -> Context:
+    return make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
+
+
+def find(
+    kb: KnowledgeBase, what: str | None = None, *, pose: Pose | None = None, at_s: float | None = None,
+    now_s: float | None = None, config: QueryConfig | None = None, evidence: bool = True, **filters: Any,
+) -> list[Hit]:
+    """The instances matching ``what`` and the filters of ``spec_for`` (near, radius_m,
+    in_fov, on, on_closest, since_s, until_s, state, min_confidence, sort, limit), nearest
+    first unless ``sort`` says otherwise."""
+    ctx = _context(kb, pose, at_s, now_s, config)
+    spec = spec_for(what, config=ctx.config, **filters)
+    return engine.hits(ctx, engine.select(ctx, spec), evidence=evidence)
+
+
+def count(
+    kb: KnowledgeBase, what: str | None = None, *, pose: Pose | None = None, at_s: float | None = None,
+    now_s: float | None = None, config: QueryConfig | None = None, **filters: Any,
+) -> int:
+    """How many instances ``find`` would return (without fetching their details)."""
+    ctx = _context(kb, pose, at_s, now_s, config)
+    return len(engine.select(ctx, spec_for(what, config=ctx.config, **filters)))
+
+
+def last_seen(
+    kb: KnowledgeBase, what: str, *, pose: Pose | None = None, at_s: float | None = None,
+    now_s: float | None = None, config: QueryConfig | None = None, **filters: Any,
+) -> Hit | None:
+    """The most recently seen instance of ``what`` (None when there is none)."""
+    found = find(kb, what, pose=pose, at_s=at_s, now_s=now_s, config=config,
+                 **{**filters, "sort": "last_seen", "limit": 1})
+    return found[0] if found else None
+
+
+def _in_view_s(stamps: list[float], gap_s: float) -> float:
+    if len(stamps) < 2:
+        return 0.0
+    dt = np.diff(np.asarray(stamps))
+    return float(dt[dt <= gap_s].sum())
+
+
+def when(kb: KnowledgeBase, uuid: str, *, now_s: float | None = None,
+         config: QueryConfig | None = None) -> Sighting:
+    """First and last sighting and time in view of one instance."""
+    ctx = _context(kb, None, None, now_s, config)
+    d = engine.details(ctx, f"urn:uuid:{uuid}")
+    if d is None:
+        raise QueryError(f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'")
+    stamps = kb.observation_stamps_of(uuid)
+    return Sighting(uuid, d["class"], d["first"], d["last"], _in_view_s(stamps, ctx.config.view_gap_s),
+                    d["count"], ctx.now_s)
+
+
+def passed_here(ctx: Context, spec: QuerySpec) -> tuple[float, Hit] | None:
+    """The last time an instance of ``spec`` was observed within the config's
+    ``pass_radius_m`` (horizontally) of the reference position, and that instance."""
+    r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
+    x, y = ctx.reference.x_m, ctx.reference.y_m
+    until = spec.until_s if spec.until_s is not None else ctx.now_s
+    best: tuple[float, str] | None = None
+    for class_name in spec.classes or (None,):
+        for p in ctx.kb.observations_near((x - r, y - r, -1e6), (x + r, y + r, 1e6), class_name):
+            ok = (p.center_map_m[0] - x) ** 2 + (p.center_map_m[1] - y) ** 2 <= r * r
+            ok = ok and p.stamp_s <= until and (spec.since_s is None or p.stamp_s >= spec.since_s)
+            if ok and p.instance_uuid and (best is None or p.stamp_s > best[0]):
+                best = (p.stamp_s, p.instance_uuid)
+    if best is None:
+        return None
+    found = engine.hits(ctx, engine.Candidates([f"urn:uuid:{best[1]}"], np.zeros((1, 3)), np.zeros((1, 3)),
+                                               np.zeros(1)))
+    return (best[0], found[0]) if found else None
+
+
+def trajectory(kb: KnowledgeBase, uuid: str) -> Trajectory:
+    """The map-frame track of one instance (empty for background instances)."""
+    inst = kb.instance(uuid)
+    if inst is None:
+        raise QueryError(f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'")
+    rows = inst.data.get("trajectory") or []
+    return Trajectory(uuid, inst.class_name, tuple(tuple(float(v) for v in row) for row in rows))
