@@ -7,7 +7,9 @@ query that disagrees with the truth is the query layer's fault."""
 
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -91,3 +93,16 @@ def build_truth_kb(log: Path, kb_path: Path) -> TruthKb:
         kb.end_session(session)
     camera = json.loads((log / "camera.json").read_text())
     return TruthKb(kb_path, truth, {tid: i.uuid for tid, i in instances.items()}, seen, poses, camera)
+
+
+@cache
+def house_truth_kb() -> TruthKb:
+    """The house log (40 s at 4 Hz, 160×120, seed 4) and its truth KB, built once per test
+    session in a temporary directory."""
+    from hiper_cli.sim import RenderConfig, SimConfig, simulate
+
+    root = Path(tempfile.mkdtemp(prefix="hiper-query-house-"))
+    simulate("house", seconds=40, seed=4, out=root / "log",
+             config=SimConfig(rate_hz=4, mapping_s=15, render=RenderConfig(width=160, height=120),
+                              png_compression=1))
+    return build_truth_kb(root / "log", root / "kb.hiper")

@@ -13,17 +13,12 @@ from hiper_cli.graph import open_kb
 from hiper_cli.query import ask
 from hiper_cli.query.geometry import Frustum
 from hiper_cli.query.spec import QueryConfig
-from hiper_cli.sim import RenderConfig, SimConfig, simulate
-from tests.query_truth_kb import TruthKb, build_truth_kb
+from tests.query_truth_kb import TruthKb, house_truth_kb
 
 
 @pytest.fixture(scope="module")
-def house(tmp_path_factory) -> TruthKb:
-    root = tmp_path_factory.mktemp("house")
-    simulate("house", seconds=40, seed=4, out=root / "log",
-             config=SimConfig(rate_hz=4, mapping_s=15, render=RenderConfig(width=160, height=120),
-                              png_compression=1))
-    return build_truth_kb(root / "log", root / "kb.hiper")
+def house() -> TruthKb:
+    return house_truth_kb()
 
 
 def _config(h: TruthKb) -> QueryConfig:

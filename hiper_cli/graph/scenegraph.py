@@ -402,7 +402,12 @@ _UPDATE_WORDS = ("INSERT", "DELETE", "LOAD", "CLEAR", "CREATE", "DROP", "COPY", 
 
 
 def readonly_check(sparql: str) -> None:
-    """Refuse SPARQL updates: the text must parse as a query (checked on an empty store)."""
+    """Refuse SPARQL updates (the text must parse as a query, checked on an empty store) and
+    federated ``SERVICE`` calls (a read-only endpoint must not fetch other URLs)."""
+    import re
+
+    if re.search(r"\bSERVICE\s+(SILENT\s+)?[<?$]", sparql, flags=re.IGNORECASE):
+        raise QueryError("SPARQL SERVICE (federated query) refused: only this knowledge base is queried")
     try:
         ox.Store().query(_PREFIXES + sparql)
     except SyntaxError as err:

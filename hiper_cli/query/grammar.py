@@ -22,12 +22,12 @@ from hiper_cli.query.results import ANSWER_KINDS
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
 from hiper_cli.query.vocabulary import ANY_FOREGROUND, class_words, resolve_class, singular
 
-__all__ = ["UNDERSTOOD", "ParsedQuery", "parse"]
+__all__ = ["UNDERSTOOD", "ParsedQuery", "parse", "parse_time", "with_limit"]
 
 UNDERSTOOD = (
     "classes (cup, chair, person, table, bottle, ... singular or plural; synonyms such as mug, sofa, "
     "people; 'objects' for all); space: in FOV, closest/nearest, within R m of X|me, near X, "
-    "on the [closest] X, pass here; time: now, last N seconds|minutes|hours, since HH:MM, "
+    "on the (closest) X, pass here; time: now, last N seconds|minutes|hours, since HH:MM, "
     "between HH:MM and HH:MM, before/after HH:MM, today, yesterday, last seen, first seen; "
     "state: moving, static; questions: how many, where, when, how long, is there, go to"
 )
@@ -278,7 +278,7 @@ class _Parser:
 
     # -- the parse -------------------------------------------------------------------------
 
-    def run(self) -> ParsedQuery:
+    def run(self, *, suggest: bool = True) -> ParsedQuery:
         rules: list[Callable[[int], int]] = [self.questions, self.times, self.space, self.state,
                                              self.confidence, self.noun]
         i = 0
@@ -290,7 +290,8 @@ class _Parser:
                 used = 1
             i += used
         if self.unknown:
-            raise QueryError(_unknown_message(self.text, self.unknown, self.now_s, self.cfg))
+            raise QueryError(_unknown_message(self.text, self.unknown, self.now_s, self.cfg) if suggest
+                             else f"cannot read {self.unknown}")
         if not self.t:
             raise QueryError(f'empty query; ask e.g. "cups in FOV" or "how many chairs"; understood: {UNDERSTOOD}')
         return self.build()
@@ -340,7 +341,7 @@ def _unknown_message(text: str, unknown: list[str], now_s: float, cfg: QueryConf
             fixed.append(token)
     suggestion = " ".join(fixed)
     try:
-        _Parser(suggestion, now_s, cfg).run()
+        _Parser(suggestion, now_s, cfg).run(suggest=False)
     except QueryError:
         suggestion = "cups in FOV"
     quoted = ", ".join(f'"{w}"' for w in dict.fromkeys(unknown))
@@ -350,3 +351,9 @@ def _unknown_message(text: str, unknown: list[str], now_s: float, cfg: QueryConf
 def with_limit(parsed: ParsedQuery, limit: int | None) -> ParsedQuery:
     """The parsed query with another result limit (the CLI's --limit)."""
     return replace(parsed, spec=replace(parsed.spec, limit=limit)) if limit is not None else parsed
+
+
+def parse_time(text: str, now_s: float) -> float | None:
+    """A time of day ('10:00', '3pm', on the UTC day of ``now_s``) or an ISO date-time, as a
+    stamp (s); None when it is neither."""
+    return _clock(text.strip().lower(), now_s)
