@@ -56,7 +56,8 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         shown = engine.hits(ctx, cands.take(np.arange(min(5, len(cands)))))
         return make(value=len(cands) > 0, hits=tuple(shown),
                       text=("yes: " + "; ".join(_describe(h, ctx.now_s) for h in shown)) if shown else "no")
-    found_hits = engine.hits(ctx, cands)
+    total = len(cands)
+    found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
     if not found_hits:
         return make(count=0, text=f"no {what} found")
     first = found_hits[0]
@@ -72,11 +73,11 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         goal = goal_for(ctx, first)
         text = _describe(first, ctx.now_s) + f"; goal ({goal.x_m:.2f}, {goal.y_m:.2f}, yaw {goal.yaw_rad:.2f})"
         return make(hits=tuple(found_hits), goal=goal, text=text)
-    text = f"{len(found_hits)} {what}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
-    if len(found_hits) > 3:
-        text += f"; +{len(found_hits) - 3} more"
+    text = f"{total} {what}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
+    if total > 3:
+        text += f"; +{total - 3} more" + (f" ({len(found_hits)} listed)" if total > len(found_hits) else "")
     goal = goal_for(ctx, first) if spec.sort == "distance" and spec.limit == 1 else None
-    return make(hits=tuple(found_hits), count=len(found_hits), goal=goal, text=text)
+    return make(hits=tuple(found_hits), count=total, goal=goal, text=text)
 
 
 def ask(

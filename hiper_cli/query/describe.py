@@ -1,6 +1,6 @@
 """``describe``: a compact summary of a scene sized for an LLM prompt (a few hundred words):
-layers and counts per class, the time span, recent movers and the learned features that
-``hiper analyze`` stored (none yet: said so)."""
+layers and counts per class, the time span, recent movers (from the instance index) and the
+learned features that ``hiper analyze`` stored (``queries/analyses.rq``; none yet: said so)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,10 @@ import json
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from hiper_cli.graph.kb import KnowledgeBase
+from hiper_cli.query.index import instance_index
 from hiper_cli.query.results import TimeValue, ago_text, iso_time
 from hiper_cli.query.templates import template
 
@@ -82,14 +85,17 @@ def describe(kb: KnowledgeBase, *, now_s: float | None = None, recent_s: float =
     span = kb.stamp_span()
     now = now_s if now_s is not None else (span[1] if span else 0.0)
     prefix = f"urn:hiper:kb:{kb.kb_id}:"
-    classes = tuple(
-        ClassCount(r["layer"].value.rsplit("#", 1)[-1], r["class"].value, int(r["n"].value),
-                   float(r["firstSeen"].value), float(r["lastSeen"].value))
-        for r in kb.query_bound(template("class_counts"), {"graphPrefix": prefix}))
-    movers = tuple(
-        {"uuid": r["i"].value.removeprefix("urn:uuid:"), "class": r["class"].value,
-         "last_seen_s": float(r["last"].value), "speed_mps": float(r["speed"].value) if "speed" in r else None}
-        for r in kb.query_bound(template("movers"), {"graphPrefix": prefix, "since": float(now - recent_s)}))
+    idx = instance_index(kb)
+    groups: dict[tuple[str, str], list[int]] = {}
+    for k in range(len(idx)):
+        groups.setdefault((str(idx.layers[k]), str(idx.classes[k])), []).append(k)
+    classes = tuple(sorted(
+        (ClassCount(layer, name, len(rows), float(idx.first_s[rows].min()), float(idx.last_s[rows].max()))
+         for (layer, name), rows in groups.items()), key=lambda c: (c.layer, -c.count, c.class_name)))
+    recent = np.flatnonzero((idx.states == "dynamic") & (idx.last_s >= now - recent_s))
+    recent = recent[np.argsort(-idx.last_s[recent], kind="stable")][:10]
+    movers = tuple({"uuid": idx.uuids[k], "class": str(idx.classes[k]), "last_seen_s": float(idx.last_s[k]),
+                    "speed_mps": None if np.isnan(idx.speeds[k]) else float(idx.speeds[k])} for k in recent)
     features = tuple(
         {"uuid": r["a"].value.removeprefix("urn:uuid:"), "kind": r["kind"].value, "class": r["class"].value,
          "t_start_s": float(r["tStart"].value), "t_end_s": float(r["tEnd"].value),

@@ -1,7 +1,7 @@
-"""How a ``QuerySpec`` is answered: a SPARQL prefilter (``queries/candidates.rq``, bound
-values only) or, for a spatial query over every class, the documents' R*Tree; then the exact
-geometry in numpy (``geometry.py``); then the details of the survivors (``instance.rq``),
-their support and their evidence observations.
+"""How a ``QuerySpec`` is answered: the non-spatial filters over the instance summaries that
+the named SPARQL query ``queries/instances.rq`` returned (``index.py``, one read per graph
+version), then the exact geometry in numpy (``geometry.py``: frustum, distances, support),
+then the typed hits with their support and evidence observations (the documents' links).
 """
 
 from __future__ import annotations
@@ -11,32 +11,38 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import pyoxigraph as ox
 
 from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.graph.ontology import HIPER
 from hiper_cli.query import geometry as geo
 from hiper_cli.query.results import Hit, ReferencePose, Support
 from hiper_cli.query.spec import QueryConfig, QuerySpec
-from hiper_cli.query.templates import template
+from hiper_cli.query.index import InstanceIndex, instance_index
 
-__all__ = ["Candidates", "Context", "make_context", "select"]
+__all__ = ["Candidates", "Context", "candidates_of", "details", "hits", "make_context", "prefilter", "select"]
 
-_FAR_S = 1.0e18
 
 
 @dataclass
 class Context:
     """One query's surroundings: the KB, ``now`` (s), the reference pose and the config.
-    Caches instance details and support instances for the duration of one query."""
+    ``index`` holds the KB's instance summaries (``index.py``)."""
 
     kb: KnowledgeBase
     now_s: float
     reference: ReferencePose
     config: QueryConfig
-    _details: dict[str, dict[str, Any]] = field(default_factory=dict)
-    _supports: dict[str, Candidates] = field(default_factory=dict)
+    index: InstanceIndex = field(default=None)  # type: ignore[assignment]
+    _rows: dict[str, int] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.index is None:
+            self.index = instance_index(self.kb)
+
+    def row_of(self, uuid: str) -> int | None:
+        if not self._rows and len(self.index):
+            self._rows.update({u: k for k, u in enumerate(self.index.uuids)})
+        return self._rows.get(uuid)
 
     @property
     def T_map_cam(self) -> np.ndarray:
@@ -85,125 +91,61 @@ def make_context(
 
 @dataclass
 class Candidates:
-    """Instances as arrays: node IRIs (N,), box centres and extents (N, 3), last seen (N,)."""
+    """A subset of the instance index: row numbers (N,) with their boxes (N, 3) and last
+    sightings (N,) at hand for the geometry."""
 
-    iris: list[str]
-    centers: np.ndarray
-    extents: np.ndarray
-    last_s: np.ndarray
+    index: InstanceIndex
+    rows: np.ndarray
 
-    @classmethod
-    def empty(cls) -> Candidates:
-        return cls([], np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0))
+    @property
+    def centers(self) -> np.ndarray:
+        return self.index.centers[self.rows]
+
+    @property
+    def extents(self) -> np.ndarray:
+        return self.index.extents[self.rows]
+
+    @property
+    def last_s(self) -> np.ndarray:
+        return self.index.last_s[self.rows]
+
+    @property
+    def uuids(self) -> list[str]:
+        return [self.index.uuids[k] for k in self.rows]
 
     def take(self, mask_or_index: Any) -> Candidates:
-        idx = np.flatnonzero(mask_or_index) if np.asarray(mask_or_index).dtype == bool else mask_or_index
-        return Candidates([self.iris[k] for k in idx], self.centers[idx], self.extents[idx], self.last_s[idx])
+        return Candidates(self.index, self.rows[np.asarray(mask_or_index)])
 
     def __len__(self) -> int:
-        return len(self.iris)
+        return len(self.rows)
 
 
-def _bindings(ctx: Context, spec: QuerySpec, class_name: str | None) -> dict[str, Any]:
+def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
+    """The instances passing the non-spatial filters of ``spec`` (class, layer, state, time
+    window, confidence)."""
+    idx = ctx.index
     until = spec.until_s if spec.until_s is not None else ctx.now_s
-    b: dict[str, Any] = {
-        "graphPrefix": ctx.graph_prefix,
-        "since": float(spec.since_s) if spec.since_s is not None else -_FAR_S,
-        "until": float(until),
-        "minConfidence": float(spec.min_confidence),
-    }
-    if class_name is not None:
-        b["class"] = class_name
-    if spec.layer is not None:
-        b["layer"] = ox.NamedNode(HIPER + spec.layer)
-    if spec.state is not None:
-        b["state"] = spec.state
-    return b
-
-
-def _rows_to_candidates(rows: list[dict[str, Any]]) -> Candidates:
-    if not rows:
-        return Candidates.empty()
-    centers = np.array([geo.parse_vector(r["center"].value) for r in rows])
-    extents = np.array([geo.parse_vector(r["extent"].value) for r in rows])
-    last = np.array([float(r["last"].value) for r in rows])
-    return Candidates([r["i"].value for r in rows], centers, extents, last)
-
-
-def prefilter(ctx: Context, spec: QuerySpec, box: tuple[np.ndarray, np.ndarray] | None = None) -> Candidates:
-    """The instances passing the non-spatial filters. With no class but a bounding ``box``
-    (lo, hi), the documents' R*Tree picks the candidates and their graph nodes are checked."""
-    sparql = template("candidates")
+    mask = (idx.first_s <= until) & (idx.confidence >= spec.min_confidence)
+    if spec.since_s is not None:
+        mask &= idx.last_s >= spec.since_s
     if spec.classes:
-        rows = [r for c in spec.classes for r in ctx.kb.query_bound(sparql, _bindings(ctx, spec, c))]
-        return _rows_to_candidates(rows)
-    if box is None:
-        return _rows_to_candidates(ctx.kb.query_bound(sparql, _bindings(ctx, spec, None)))
-    uuids = ctx.kb.instance_uuids_in(box[0], box[1])
-    keep = []
-    for uuid in uuids:
-        d = details(ctx, f"urn:uuid:{uuid}")
-        if d is not None and _passes(ctx, spec, d):
-            keep.append(d)
-    if not keep:
-        return Candidates.empty()
-    return Candidates([d["iri"] for d in keep], np.array([d["center"] for d in keep]),
-                      np.array([d["extent"] for d in keep]), np.array([d["last"] for d in keep]))
+        mask &= np.isin(idx.classes, list(spec.classes))
+    if spec.layer is not None:
+        mask &= idx.layers == spec.layer
+    if spec.state is not None:
+        mask &= idx.states == spec.state
+    return Candidates(idx, np.flatnonzero(mask))
 
 
-def _passes(ctx: Context, spec: QuerySpec, d: dict[str, Any]) -> bool:
-    until = spec.until_s if spec.until_s is not None else ctx.now_s
-    return ((spec.layer is None or d["layer"] == spec.layer) and (spec.state is None or d["state"] == spec.state)
-            and (spec.since_s is None or d["last"] >= spec.since_s) and d["first"] <= until
-            and d["confidence"] >= spec.min_confidence)
-
-
-def details(ctx: Context, iri: str) -> dict[str, Any] | None:
-    """The graph's record of one instance node (cached per query), None if it has none."""
-    if iri in ctx._details:
-        return ctx._details[iri]
-    rows = ctx.kb.query_bound(template("instance"), {"i": ox.NamedNode(iri)})
-    if not rows:
-        return None
-    r = rows[0]
-    d = {
-        "iri": iri, "uuid": r["uuid"].value, "class": r["class"].value,
-        "layer": r["layer"].value.rsplit("#", 1)[-1],
-        "first": float(r["first"].value), "last": float(r["last"].value), "state": r["state"].value,
-        "confidence": float(r["confidence"].value), "center": geo.parse_vector(r["center"].value),
-        "extent": geo.parse_vector(r["extent"].value), "count": int(r["count"].value),
-        "speed": float(r["speed"].value) if "speed" in r else None,
-    }
-    ctx._details[iri] = d
-    return d
+def details(ctx: Context, uuid: str) -> dict[str, Any] | None:
+    """The summary of one instance (None when the graph has no such instance)."""
+    k = ctx.row_of(uuid)
+    return None if k is None else ctx.index.row(k)
 
 
 def supports(ctx: Context, class_name: str) -> Candidates:
-    """Every instance of a support class (e.g. the tables), cached per query."""
-    if class_name not in ctx._supports:
-        spec = QuerySpec(classes=(class_name,), until_s=_FAR_S)
-        ctx._supports[class_name] = prefilter(ctx, spec)
-    return ctx._supports[class_name]
-
-
-def _spatial_box(ctx: Context, spec: QuerySpec) -> tuple[np.ndarray, np.ndarray] | None:
-    """An axis-aligned map box that holds every possible answer of a spatial query."""
-    p = np.array([ctx.reference.x_m, ctx.reference.y_m, ctx.reference.z_m])
-    big = 1.0e6
-    if spec.near is not None and spec.near.target == "me":
-        r = spec.near.radius_m
-        return np.array([p[0] - r, p[1] - r, -big]), np.array([p[0] + r, p[1] + r, big])
-    if spec.in_fov:
-        r = ctx.config.frustum.range_m
-        return p - r, p + r
-    if spec.on is not None:
-        sup = _support_targets(ctx, spec)
-        if len(sup) == 0:
-            return np.zeros(3), np.zeros(3) - 1.0  # empty box
-        lo = (sup.centers - sup.extents / 2.0).min(axis=0)
-        hi = (sup.centers + sup.extents / 2.0).max(axis=0)
-        return lo - [0.1, 0.1, 0.0], hi + [0.1, 0.1, 2.5]
-    return None
+    """Every instance of a support class (e.g. the tables), seen at any time."""
+    return Candidates(ctx.index, np.flatnonzero(ctx.index.classes == class_name))
 
 
 def _support_targets(ctx: Context, spec: QuerySpec) -> Candidates:
@@ -225,76 +167,87 @@ def _spatial_mask(ctx: Context, spec: QuerySpec, cands: Candidates) -> np.ndarra
         else:
             others = supports(ctx, spec.near.target)
             near = np.zeros(len(cands), dtype=bool)
-            for k in range(len(others)):
-                gap = geo.box_gap_m(cands.centers, cands.extents, others.centers[k], others.extents[k])
-                near |= (gap <= spec.near.radius_m) & (np.array(cands.iris) != others.iris[k])
+            centers, extents = cands.centers, cands.extents
+            for k, row in enumerate(others.rows):
+                gap = geo.box_gap_m(centers, extents, others.centers[k], others.extents[k])
+                near |= (gap <= spec.near.radius_m) & (cands.rows != row)
             mask &= near
     if spec.on is not None:
         on = np.zeros(len(cands), dtype=bool)
         sup = _support_targets(ctx, spec)
+        centers, extents = cands.centers, cands.extents
         for k in range(len(sup)):
-            on |= geo.standing_on(cands.centers, cands.extents, sup.centers[k], sup.extents[k],
+            on |= geo.standing_on(centers, extents, sup.centers[k], sup.extents[k],
                                   ctx.config.support_gap_m, ctx.config.support_margin_m)
-        mask &= on
+        mask &= on & ~np.isin(cands.rows, sup.rows)
     return mask
 
 
 def select(ctx: Context, spec: QuerySpec) -> Candidates:
-    """The instances answering ``spec``, sorted and limited (no details fetched yet)."""
-    box = _spatial_box(ctx, spec) if not spec.classes else None
-    cands = prefilter(ctx, spec, box)
+    """The instances answering ``spec``, sorted (nearest first unless ``spec.sort`` says
+    otherwise) and limited."""
+    cands = prefilter(ctx, spec)
     cands = cands.take(_spatial_mask(ctx, spec, cands))
-    order = np.arange(len(cands))
+    idx = ctx.index
     if spec.sort in (None, "distance"):
         order = np.argsort(geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents), kind="stable")
     elif spec.sort == "last_seen":
         order = np.argsort(-cands.last_s, kind="stable")
+    elif spec.sort == "first_seen":
+        order = np.argsort(idx.first_s[cands.rows], kind="stable")
+    else:
+        order = np.argsort(-idx.confidence[cands.rows], kind="stable")
     cands = cands.take(order)
-    if spec.sort in ("first_seen", "confidence"):
-        key = "first" if spec.sort == "first_seen" else "confidence"
-        rows = [details(ctx, i) for i in cands.iris]
-        index = sorted(range(len(rows)), key=lambda k: (rows[k] or {}).get(key, 0.0),
-                       reverse=spec.sort == "confidence")
-        cands = cands.take(np.array(index, dtype=int))
     if spec.limit is not None:
         cands = cands.take(np.arange(min(spec.limit, len(cands))))
     return cands
 
 
-def support_of(ctx: Context, center: np.ndarray, extent: np.ndarray, own_iri: str) -> Support | None:
-    """The support instance an object stands on, else the floor when its bottom is near the
-    floor's top, else None."""
-    cfg = ctx.config
+def supports_of(ctx: Context, cands: Candidates) -> list[Support | None]:
+    """What each candidate stands on: a support instance (``config.support_classes``), else
+    the floor when its bottom is near the floor's top, else None."""
+    cfg, idx = ctx.config, ctx.index
+    out: list[Support | None] = [None] * len(cands)
+    centers, extents = cands.centers, cands.extents
     for class_name in cfg.support_classes:
         sup = supports(ctx, class_name)
-        for k in range(len(sup)):
-            if sup.iris[k] != own_iri and geo.standing_on(center[None], extent[None], sup.centers[k],
-                                                         sup.extents[k], cfg.support_gap_m,
-                                                         cfg.support_margin_m)[0]:
-                return Support(class_name, sup.iris[k].removeprefix("urn:uuid:"))
+        on = geo.standing_on_any(centers, extents, sup.centers, sup.extents, cfg.support_gap_m,
+                                 cfg.support_margin_m) & (cands.rows[:, None] != sup.rows[None, :])
+        for n, s in zip(*np.nonzero(on), strict=True):
+            if out[n] is None:
+                out[n] = Support(class_name, idx.uuids[sup.rows[s]])
     floors = supports(ctx, "floor")
     floor_top = float((floors.centers[:, 2] + floors.extents[:, 2] / 2).max()) if len(floors) else 0.0
-    if abs(center[2] - extent[2] / 2.0 - floor_top) <= cfg.support_gap_m and own_iri not in floors.iris:
-        uuid = floors.iris[0].removeprefix("urn:uuid:") if len(floors) else None
-        return Support("floor", uuid)
-    return None
+    bottoms = centers[:, 2] - extents[:, 2] / 2.0 if len(cands) else np.zeros(0)
+    for n in range(len(cands)):
+        if out[n] is None and abs(bottoms[n] - floor_top) <= cfg.support_gap_m and cands.rows[n] not in floors.rows:
+            out[n] = Support("floor", idx.uuids[floors.rows[0]] if len(floors) else None)
+    return out
 
 
 def hits(ctx: Context, cands: Candidates, *, evidence: bool = True) -> list[Hit]:
-    """Typed hits with details, distance, support and (``evidence``) observation uuids."""
-    rows = [details(ctx, iri) for iri in cands.iris]
-    found = [r for r in rows if r is not None]
-    links = ctx.kb.observation_uuids_of([r["uuid"] for r in found]) if evidence and found else {}
+    """Typed hits with summary, distance, support and (``evidence``) observation uuids."""
+    links = ctx.kb.observation_uuids_of(cands.uuids) if evidence and len(cands) else {}
+    dists = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
+    layers = ctx.index.layers[cands.rows]
+    fg = np.flatnonzero(layers == "foreground")
+    support: list[Support | None] = [None] * len(cands)
+    for n, s in zip(fg.tolist(), supports_of(ctx, cands.take(fg)), strict=True):
+        support[n] = s
     out = []
-    for r in found:
-        c, e = np.array(r["center"]), np.array(r["extent"])
-        dist = float(geo.footprint_distance_m(ctx.xy, c[None], e[None])[0])
+    for n, (row, dist) in enumerate(zip(cands.rows.tolist(), dists.tolist(), strict=True)):
+        r = ctx.index.row(row)
         out.append(Hit(
             uuid=r["uuid"], class_name=r["class"], layer=r["layer"], center_map_m=r["center"],
             extent_m=r["extent"], first_seen_s=r["first"], last_seen_s=r["last"],
             observation_count=r["count"], confidence=r["confidence"], state=r["state"],
-            speed_mps=r["speed"], distance_m=round(dist, 4),
-            support=support_of(ctx, c, e, r["iri"]) if r["layer"] == "foreground" else None,
+            speed_mps=r["speed"], distance_m=round(dist, 4), support=support[n],
             evidence_uuids=tuple(links.get(r["uuid"], ())),
         ))
     return out
+
+
+def candidates_of(ctx: Context, uuids: list[str]) -> Candidates:
+    """The candidates for known instance uuids (unknown ones dropped)."""
+    rows = [k for u in uuids if (k := ctx.row_of(u)) is not None]
+    return Candidates(ctx.index, np.array(rows, dtype=np.int64))

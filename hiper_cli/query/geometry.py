@@ -23,6 +23,7 @@ __all__ = [
     "in_frustum",
     "parse_vector",
     "standing_on",
+    "standing_on_any",
 ]
 
 F64 = NDArray[np.float64]
@@ -98,15 +99,24 @@ def standing_on(
     centers_m: F64, extents_m: F64, support_center_m: F64, support_extent_m: F64,
     gap_m: float, margin_m: float,
 ) -> NDArray[np.bool_]:
-    """Which boxes stand on a support: their bottom within ``gap_m`` of the support's top and
-    their footprint centre inside the support's footprint grown by ``margin_m``."""
-    if len(centers_m) == 0:
-        return np.zeros(0, dtype=bool)
+    """Which boxes stand on one support: their bottom within ``gap_m`` of the support's top
+    and their footprint centre inside the support's footprint grown by ``margin_m``."""
+    return standing_on_any(centers_m, extents_m, support_center_m[None], support_extent_m[None],
+                           gap_m, margin_m)[:, 0]
+
+
+def standing_on_any(
+    centers_m: F64, extents_m: F64, support_centers_m: F64, support_extents_m: F64,
+    gap_m: float, margin_m: float,
+) -> NDArray[np.bool_]:
+    """(N, S): whether box n stands on support s (``standing_on`` for S supports at once)."""
+    if len(centers_m) == 0 or len(support_centers_m) == 0:
+        return np.zeros((len(centers_m), len(support_centers_m)), dtype=bool)
     bottom = centers_m[:, 2] - extents_m[:, 2] / 2.0
-    top = support_center_m[2] + support_extent_m[2] / 2.0
-    inside = np.all(np.abs(centers_m[:, :2] - support_center_m[:2]) <= support_extent_m[:2] / 2.0 + margin_m,
-                    axis=1)
-    return np.asarray(inside & (np.abs(bottom - top) <= gap_m))
+    top = support_centers_m[:, 2] + support_extents_m[:, 2] / 2.0
+    reach = support_extents_m[None, :, :2] / 2.0 + margin_m
+    inside = np.all(np.abs(centers_m[:, None, :2] - support_centers_m[None, :, :2]) <= reach, axis=2)
+    return np.asarray(inside & (np.abs(bottom[:, None] - top[None, :]) <= gap_m))
 
 
 def goal_in_front(

@@ -27,7 +27,9 @@ class QueryConfig:
     bottom is that close to the support's top and its centre inside the support's footprint
     grown by the margin; ``goal_standoff_m``: a goal pose's distance from the object's
     footprint; ``now_window_s``: "now" means seen within this long before now;
-    ``view_gap_s``: observations further apart end a stretch of "time in view"."""
+    ``view_gap_s``: observations further apart end a stretch of "time in view";
+    ``max_hits``: a list answer without a limit details at most this many hits (its
+    ``count`` still counts all)."""
 
     frustum: Frustum = field(default_factory=Frustum)
     near_radius_m: float = 1.0
@@ -38,6 +40,7 @@ class QueryConfig:
     goal_standoff_m: float = 0.6
     now_window_s: float = 2.0
     view_gap_s: float = 1.0
+    max_hits: int = 50
 
 
 @dataclass(frozen=True)

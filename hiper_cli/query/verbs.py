@@ -112,7 +112,7 @@ def when(kb: KnowledgeBase, uuid: str, *, now_s: float | None = None,
          config: QueryConfig | None = None) -> Sighting:
     """First and last sighting and time in view of one instance."""
     ctx = _context(kb, None, None, now_s, config)
-    d = engine.details(ctx, f"urn:uuid:{uuid}")
+    d = engine.details(ctx, uuid)
     if d is None:
         raise QueryError(f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'")
     stamps = kb.observation_stamps_of(uuid)
@@ -135,8 +135,7 @@ def passed_here(ctx: Context, spec: QuerySpec) -> tuple[float, Hit] | None:
                 best = (p.stamp_s, p.instance_uuid)
     if best is None:
         return None
-    found = engine.hits(ctx, engine.Candidates([f"urn:uuid:{best[1]}"], np.zeros((1, 3)), np.zeros((1, 3)),
-                                               np.zeros(1)))
+    found = engine.hits(ctx, engine.candidates_of(ctx, [best[1]]))
     return (best[0], found[0]) if found else None
 
 

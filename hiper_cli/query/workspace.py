@@ -14,7 +14,6 @@ from numpy.typing import NDArray
 
 from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.query import engine
 from hiper_cli.query.engine import make_context
 
 __all__ = ["Primitive", "Workspace", "workspace"]
@@ -96,11 +95,12 @@ def workspace(
                          f"or a smaller --size (at most {MAX_VOXELS} voxels)")
     lo, hi = center - size / 2.0, center + size / 2.0
     ctx = make_context(kb)
-    rows = [r for u in kb.instance_uuids_in(lo, hi) if (r := engine.details(ctx, f"urn:uuid:{u}")) is not None]
-    meets = [r for r in rows if np.all(np.array(r["center"]) - np.array(r["extent"]) / 2 <= hi)
-             and np.all(np.array(r["center"]) + np.array(r["extent"]) / 2 >= lo)]
+    idx = ctx.index
+    meets = np.flatnonzero(np.all(idx.centers - idx.extents / 2 <= hi, axis=1)
+                           & np.all(idx.centers + idx.extents / 2 >= lo, axis=1))
+    rows = [idx.row(k) for k in meets]
     background = []
-    for r in sorted((r for r in meets if r["layer"] == "background"), key=lambda r: r["uuid"]):
+    for r in sorted((r for r in rows if r["layer"] == "background"), key=lambda r: r["uuid"]):
         c, e = np.array(r["center"]), np.array(r["extent"])
         clo, chi = np.maximum(c - e / 2, lo), np.minimum(c + e / 2, hi)
         inst = kb.instance(r["uuid"])
@@ -109,7 +109,7 @@ def workspace(
                                     tuple(((clo + chi) / 2).round(4).tolist()),  # type: ignore[arg-type]
                                     tuple((chi - clo).round(4).tolist()),  # type: ignore[arg-type]
                                     tuple(float(v) for v in plane) if plane else None))  # type: ignore[arg-type]
-    foreground = sorted((r for r in meets if r["layer"] == "foreground"), key=lambda r: r["uuid"])
+    foreground = sorted((r for r in rows if r["layer"] == "foreground"), key=lambda r: r["uuid"])
     classes = tuple(sorted({r["class"] for r in foreground}))
     occupancy = np.full(tuple(shape), -1, dtype=np.int16)
     axes = [lo[k] + (np.arange(shape[k]) + 0.5) * resolution_m for k in range(3)]
