@@ -42,7 +42,9 @@ class TruthKb:
 
 
 def _tum(path: Path) -> list[list[str]]:
-    return [line.split() for line in path.read_text().splitlines() if line.strip() and not line.startswith("#")]
+    return [
+        line.split() for line in path.read_text().splitlines() if line.strip() and not line.startswith("#")
+    ]
 
 
 def build_truth_kb(log: Path, kb_path: Path) -> TruthKb:
@@ -75,11 +77,25 @@ def build_truth_kb(log: Path, kb_path: Path) -> TruthKb:
                 box_map = ti.box if pos is None else Box3D(pos, ti.box.extent_m, ti.box.R)
                 inst = instances.get(tid)
                 if inst is None:
-                    inst = Instance(ti.layer, ti.class_name, box_map, stamp, stamp,  # type: ignore[arg-type]
-                                    state=ti.state, confidence=0.9)  # type: ignore[arg-type]
+                    inst = Instance(
+                        ti.layer,
+                        ti.class_name,
+                        box_map,
+                        stamp,
+                        stamp,  # type: ignore[arg-type]
+                        state=ti.state,
+                        confidence=0.9,
+                    )  # type: ignore[arg-type]
                     instances[tid] = inst
-                obs = Observation(ti.layer, ti.class_name, 0.9, stamp, pose_id,  # type: ignore[arg-type]
-                                  box_map.transformed(T_cam_map), instance_uuid=inst.uuid)
+                obs = Observation(
+                    ti.layer,
+                    ti.class_name,
+                    0.9,
+                    stamp,
+                    pose_id,  # type: ignore[arg-type]
+                    box_map.transformed(T_cam_map),
+                    instance_uuid=inst.uuid,
+                )
                 inst.box, inst.last_seen_s = box_map, stamp
                 inst.observation_uuids.append(obs.uuid)
                 if ti.state == "dynamic" and pos is not None:
@@ -102,7 +118,13 @@ def house_truth_kb() -> TruthKb:
     from hiper_cli.sim import RenderConfig, SimConfig, simulate
 
     root = Path(tempfile.mkdtemp(prefix="hiper-query-house-"))
-    simulate("house", seconds=40, seed=4, out=root / "log",
-             config=SimConfig(rate_hz=4, mapping_s=15, render=RenderConfig(width=160, height=120),
-                              png_compression=1))
+    simulate(
+        "house",
+        seconds=40,
+        seed=4,
+        out=root / "log",
+        config=SimConfig(
+            rate_hz=4, mapping_s=15, render=RenderConfig(width=160, height=120), png_compression=1
+        ),
+    )
     return build_truth_kb(root / "log", root / "kb.hiper")

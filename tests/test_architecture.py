@@ -25,12 +25,16 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # recognition: log readers (the simulator's truth format included), stages, detectors
     "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib"),
     # the knowledge base stores what perceive produced
-    "graph": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor",
-              "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    "graph": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.serve", "hiper_cli.pipeline",
+              "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     # interpretation of a knowledge base
     "analyze": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim", *_UI),
     # questions over perceive types, the graph and the analyses
-    "query": ("hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    "query": ("hiper_cli.serve", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+              "hiper_cli.evaluate", *_UI),
+    # the SPARQL endpoint over a knowledge base's graph
+    "serve": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+              "hiper_cli.evaluate", *_UI),
     # the simulator writes logs (perceive.logs writers), never reads a knowledge base
     "sim": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
             "hiper_cli.reanchor", "hiper_cli.evaluate", *_UI),

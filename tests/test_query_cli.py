@@ -20,10 +20,20 @@ from hiper_cli.query.templates import template
 from tests.query_truth_kb import house_truth_kb
 
 runner = CliRunner()
-EXAMPLES = ("cups in FOV", "closest table", "people moving in the last 10 minutes",
-            "where was the bottle last seen", "how many chairs", "objects on the closest table",
-            "when did a person last pass here", "is there a cup on the table", "go to the couch",
-            "how long was the person in view", "chairs within 2 m of me", "mugs near the table")
+EXAMPLES = (
+    "cups in FOV",
+    "closest table",
+    "people moving in the last 10 minutes",
+    "where was the bottle last seen",
+    "how many chairs",
+    "objects on the closest table",
+    "when did a person last pass here",
+    "is there a cup on the table",
+    "go to the couch",
+    "how long was the person in view",
+    "chairs within 2 m of me",
+    "mugs near the table",
+)
 COUNT_QUERY = """SELECT ?class (COUNT(?i) AS ?n) WHERE { GRAPH ?g { ?i a hiper:Instance ;
   hiper:className ?class } } GROUP BY ?class ORDER BY ?class"""
 
@@ -70,14 +80,16 @@ def test_table_output_and_one_line_errors(kb_path):
 
 
 def test_pose_and_at_options(kb_path):
-    far = runner.invoke(app, ["query", "chairs within 1 m of me", "--kb", kb_path, "--pose", "-50,-50,1.2,0",
-                              "--json"])
+    far = runner.invoke(
+        app, ["query", "chairs within 1 m of me", "--kb", kb_path, "--pose", "-50,-50,1.2,0", "--json"]
+    )
     assert json.loads(far.output)["hits"] == []
     assert json.loads(far.output)["reference"]["source"] == "given"
     bad = runner.invoke(app, ["query", "closest chair", "--kb", kb_path, "--pose", "1,2"])
     assert bad.exit_code == 1 and "x,y,z,yaw" in bad.output.replace("\n", "")
-    early = json.loads(runner.invoke(app, ["query", "how many chairs", "--kb", kb_path, "--at", "0.5",
-                                           "--json"]).output)
+    early = json.loads(
+        runner.invoke(app, ["query", "how many chairs", "--kb", kb_path, "--at", "0.5", "--json"]).output
+    )
     late = json.loads(runner.invoke(app, ["query", "how many chairs", "--kb", kb_path, "--json"]).output)
     assert early["now"]["stamp_s"] == 0.5 and early["count"] < late["count"]
 
@@ -93,8 +105,12 @@ def test_sparql_file_and_stdin_are_read_only(kb_path, tmp_path):
     stdin = runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path, "--json"], input=COUNT_QUERY)
     assert json.loads(stdin.output) == json.loads(result.output)
     before = _quads(kb_path)
-    for update in ("INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } }", "DROP ALL",
-                   "DELETE WHERE { GRAPH ?g { ?s ?p ?o } }", "CLEAR ALL"):
+    for update in (
+        "INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } }",
+        "DROP ALL",
+        "DELETE WHERE { GRAPH ?g { ?s ?p ?o } }",
+        "CLEAR ALL",
+    ):
         refused = runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path], input=update)
         assert refused.exit_code == 1 and "refused" in refused.output
     assert _quads(kb_path) == before
@@ -107,9 +123,14 @@ def ask_count(kb_path: str, words: str) -> int:
     return count
 
 
-INJECTIONS = ['cup" } INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } } #', "cup' } DROP ALL #",
-              'cup"@en . } } DELETE WHERE { ?s ?p ?o } #', "}}} UNION { ?i ?p ?o }", 'cup\\" }',
-              "cup\n} DROP ALL"]
+INJECTIONS = [
+    'cup" } INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } } #',
+    "cup' } DROP ALL #",
+    'cup"@en . } } DELETE WHERE { ?s ?p ?o } #',
+    "}}} UNION { ?i ?p ?o }",
+    'cup\\" }',
+    "cup\n} DROP ALL",
+]
 
 
 @pytest.mark.parametrize("value", INJECTIONS)
@@ -143,8 +164,9 @@ def test_serve_answers_an_external_client_like_query_sparql(kb_path):
     from hiper_cli.serve import SparqlEndpoint
 
     prefixed = "PREFIX hiper: <https://w3id.org/hiper#>\n" + COUNT_QUERY
-    cli = json.loads(runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path, "--json"],
-                                   input=COUNT_QUERY).output)
+    cli = json.loads(
+        runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path, "--json"], input=COUNT_QUERY).output
+    )
     expected = [(r["class"]["value"], int(r["n"]["value"])) for r in cli["results"]["bindings"]]
     with open_kb_for_reading(kb_path) as kb, SparqlEndpoint(kb, "127.0.0.1", 0) as endpoint:
         assert endpoint.url.startswith("http://127.0.0.1:")
@@ -162,10 +184,13 @@ def test_serve_answers_an_external_client_like_query_sparql(kb_path):
         with urllib.request.urlopen(urllib.request.Request(url, headers={"Accept": "text/csv"})) as response:
             csv_rows = response.read().decode().splitlines()
         assert csv_rows[0] == "class,n" and len(csv_rows) == len(expected) + 1
-        for body, ctype in (("DROP ALL", "application/sparql-update"), ("update=DROP%20ALL",
-                                                                         "application/x-www-form-urlencoded")):
-            request = urllib.request.Request(endpoint.url, data=body.encode(), method="POST",
-                                             headers={"Content-Type": ctype})
+        for body, ctype in (
+            ("DROP ALL", "application/sparql-update"),
+            ("update=DROP%20ALL", "application/x-www-form-urlencoded"),
+        ):
+            request = urllib.request.Request(
+                endpoint.url, data=body.encode(), method="POST", headers={"Content-Type": ctype}
+            )
             with pytest.raises(urllib.error.HTTPError) as err:
                 urllib.request.urlopen(request)
             assert err.value.code == 403
@@ -191,8 +216,22 @@ def test_workspace_around_a_table(kb_path):
     h = house_truth_kb()
     (table,) = [t for t, ti in h.truth.instances.items() if ti.name == "table_0"]
     c = h.truth.instances[table].box.center_m
-    result = runner.invoke(app, ["query", "workspace", "--center", f"{c[0]},{c[1]},0.8", "--size", "2.0",
-                                 "--resolution", "0.05", "--kb", kb_path, "--json"])
+    result = runner.invoke(
+        app,
+        [
+            "query",
+            "workspace",
+            "--center",
+            f"{c[0]},{c[1]},0.8",
+            "--size",
+            "2.0",
+            "--resolution",
+            "0.05",
+            "--kb",
+            kb_path,
+            "--json",
+        ],
+    )
     assert result.exit_code == 0, result.output
     data = json.loads(result.output)
     assert "table" in {p["class"] for p in data["background"]}
@@ -206,11 +245,13 @@ def test_workspace_around_a_table(kb_path):
 
 
 def test_query_help_imports_no_heavy_module():
-    code = ("import sys; sys.argv = ['hiper', 'query', '--help']\n"
-            "from hiper_cli.cli import main\n"
-            "try:\n    main()\nexcept SystemExit:\n    pass\n"
-            "heavy = {'numpy', 'pyoxigraph', 'rdflib', 'scipy', 'open3d', 'cv2', 'sqlite3', 'jsonschema'}\n"
-            "print(sorted(m for m in sys.modules if m.split('.')[0] in heavy), file=sys.stderr)")
+    code = (
+        "import sys; sys.argv = ['hiper', 'query', '--help']\n"
+        "from hiper_cli.cli import main\n"
+        "try:\n    main()\nexcept SystemExit:\n    pass\n"
+        "heavy = {'numpy', 'pyoxigraph', 'rdflib', 'scipy', 'open3d', 'cv2', 'sqlite3', 'jsonschema'}\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in heavy), file=sys.stderr)"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "Example:" in done.stdout
     assert done.stderr.strip() == "[]"

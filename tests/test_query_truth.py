@@ -23,8 +23,11 @@ def house() -> TruthKb:
 
 def _config(h: TruthKb) -> QueryConfig:
     w, hgt, fx, fy = (h.camera[k] for k in ("width", "height", "fx", "fy"))
-    return QueryConfig(frustum=Frustum(math.degrees(2 * math.atan(w / 2 / fx)),
-                                       math.degrees(2 * math.atan(hgt / 2 / fy)), 5.0))
+    return QueryConfig(
+        frustum=Frustum(
+            math.degrees(2 * math.atan(w / 2 / fx)), math.degrees(2 * math.atan(hgt / 2 / fy)), 5.0
+        )
+    )
 
 
 def _seen_by(h: TruthKb, stamp: float) -> set[int]:
@@ -60,7 +63,9 @@ def test_cups_in_fov(house):
     cups = set(_of_class(h, "cup"))
     stamp = max(t for tid in cups & set(h.seen) for t in h.seen[tid])
     T = dict(h.poses)[stamp]
-    expected = {tid for tid in cups & _seen_by(h, stamp) if _in_image(h, T, h.truth.instances[tid].box.center_m)}
+    expected = {
+        tid for tid in cups & _seen_by(h, stamp) if _in_image(h, T, h.truth.instances[tid].box.center_m)
+    }
     assert expected, "the chosen frame must show a cup"
     with open_kb(h.path) as kb:
         answer = ask(kb, "cups in FOV", at_s=stamp, config=_config(h))
@@ -72,7 +77,7 @@ def test_closest_table(house):
     h = house
     with open_kb(h.path) as kb:
         answer = ask(kb, "closest table")
-    stamp, T = h.poses[-1]
+    _stamp, T = h.poses[-1]
     tables = [tid for tid in _of_class(h, "table") if tid in h.seen]
     expected = min(tables, key=lambda tid: _footprint_distance(T[:2, 3], h.truth.instances[tid].box))
     assert _ids(h, answer) == {expected}
@@ -82,8 +87,11 @@ def test_closest_table(house):
 def test_people_moving_in_the_last_10_minutes(house):
     h = house
     now = h.poses[-1][0]
-    expected = {tid for tid in _of_class(h, "person")
-                if tid in h.seen and h.truth.instances[tid].state == "dynamic" and h.seen[tid][-1] >= now - 600}
+    expected = {
+        tid
+        for tid in _of_class(h, "person")
+        if tid in h.seen and h.truth.instances[tid].state == "dynamic" and h.seen[tid][-1] >= now - 600
+    }
     assert expected
     with open_kb(h.path) as kb:
         assert _ids(h, ask(kb, "people moving in the last 10 minutes")) == expected
@@ -126,7 +134,7 @@ def test_objects_on_the_closest_table(house):
         ti = h.truth.instances[tid]
         if ti.layer != "foreground" or ti.state != "static":
             continue
-        blo, bhi = ti.box.aabb()
+        blo, _bhi = ti.box.aabb()
         c = ti.box.center_m
         if lo[0] <= c[0] <= hi[0] and lo[1] <= c[1] <= hi[1] and abs(blo[2] - hi[2]) < 0.05:
             expected.add(tid)

@@ -16,8 +16,9 @@ __all__ = ["register"]
 def describe_command(
     kb: Annotated[str, typer.Option("--kb", help=KB_HELP)] = "scene.hiper",
     kb_docs: Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)] = None,
-    recent_s: Annotated[float, typer.Option("--recent-s", help="Movers seen in this many seconds before "
-                                            "the KB's last stamp.")] = 300.0,
+    recent_s: Annotated[
+        float, typer.Option("--recent-s", help="Movers seen in this many seconds before the KB's last stamp.")
+    ] = 300.0,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Summarise a scene: layers, counts per class, recent movers, learned features, time span.

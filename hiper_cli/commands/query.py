@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 from typing import Annotated, Any
 
-import click
 import typer
 from typer.core import TyperGroup
 
@@ -22,19 +21,24 @@ class _AskByDefault(TyperGroup):
     """``hiper query WORDS...`` runs the ``ask`` subcommand: the first word that is no
     subcommand name starts a plain-words query."""
 
-    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
         if args and args[0] not in self.commands and args[0] not in ("--help", "-h"):
             args = ["ask", *args]
         return super().parse_args(ctx, args)
 
 
 query_app = HiperTyper(
-    name="query", cls=_AskByDefault, no_args_is_help=True, add_completion=False,
-    help=("Ask the scene memory in plain words or SPARQL; typed answers as a table or --json.\n\n"
-          "Plain words: classes (cups, people, objects), in FOV, closest, within 2 m of me, near the "
-          "table, on the closest table, moving/static, last 10 minutes, since 10:00, how many, where, "
-          "when, how long, is there, go to.\n\n"
-          'Example: hiper query "cups in FOV" --kb house.hiper --json'),
+    name="query",
+    cls=_AskByDefault,
+    no_args_is_help=True,
+    add_completion=False,
+    help=(
+        "Ask the scene memory in plain words or SPARQL; typed answers as a table or --json.\n\n"
+        "Plain words: classes (cups, people, objects), in FOV, closest, within 2 m of me, near the "
+        "table, on the closest table, moving/static, last 10 minutes, since 10:00, how many, where, "
+        "when, how long, is there, go to.\n\n"
+        'Example: hiper query "cups in FOV" --kb house.hiper --json'
+    ),
 )
 
 KbOption = Annotated[str, typer.Option("--kb", help=KB_HELP)]
@@ -74,15 +78,26 @@ def ask_command(
     words: Annotated[list[str] | None, typer.Argument(help="The query in plain words.")] = None,
     kb: KbOption = "scene.hiper",
     kb_docs: KbDocsOption = None,
-    pose: Annotated[str | None, typer.Option("--pose", help="Reference pose x,y,z,yaw (m, rad, map frame); "
-                                             "default: the robot's last pose.")] = None,
-    at: Annotated[str | None, typer.Option("--at", help="Ask from the robot's pose at this time (s, HH:MM "
-                                           "or ISO).")] = None,
-    now: Annotated[str | None, typer.Option("--now", help="'now' for relative times (default: --at, else "
-                                            "the KB's last stamp).")] = None,
+    pose: Annotated[
+        str | None,
+        typer.Option(
+            "--pose", help="Reference pose x,y,z,yaw (m, rad, map frame); default: the robot's last pose."
+        ),
+    ] = None,
+    at: Annotated[
+        str | None, typer.Option("--at", help="Ask from the robot's pose at this time (s, HH:MM or ISO).")
+    ] = None,
+    now: Annotated[
+        str | None,
+        typer.Option("--now", help="'now' for relative times (default: --at, else the KB's last stamp)."),
+    ] = None,
     limit: Annotated[int | None, typer.Option("--limit", help="At most this many hits.")] = None,
-    sparql: Annotated[str | None, typer.Option("--sparql", help="Run a read-only SPARQL query from FILE "
-                                               "('-': stdin) instead of plain words.")] = None,
+    sparql: Annotated[
+        str | None,
+        typer.Option(
+            "--sparql", help="Run a read-only SPARQL query from FILE ('-': stdin) instead of plain words."
+        ),
+    ] = None,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Answer a plain-words query, or a read-only SPARQL query with --sparql.
@@ -102,8 +117,14 @@ def ask_command(
 
         span = knowledge.stamp_span()
         last = span[1] if span else 0.0
-        answer = ask(knowledge, " ".join(words), pose=_floats(pose, 4, "--pose", "x,y,z,yaw (m, m, m, rad)"),  # type: ignore[arg-type]
-                     at_s=_stamp(at, "--at", last), now_s=_stamp(now, "--now", last), limit=limit)
+        answer = ask(
+            knowledge,
+            " ".join(words),
+            pose=_floats(pose, 4, "--pose", "x,y,z,yaw (m, m, m, rad)"),  # type: ignore[arg-type]
+            at_s=_stamp(at, "--at", last),
+            now_s=_stamp(now, "--now", last),
+            limit=limit,
+        )
     if as_json:
         print_json(answer.to_dict())
         return
@@ -114,7 +135,9 @@ def _read(path: Path) -> str:
     try:
         return path.read_text(encoding="utf-8")
     except OSError as err:
-        raise QueryError(f"{path}: cannot read the SPARQL file ({err.strerror}); pass a .rq file or '-'") from err
+        raise QueryError(
+            f"{path}: cannot read the SPARQL file ({err.strerror}); pass a .rq file or '-'"
+        ) from err
 
 
 def _print_sparql(body: bytes, as_json: bool) -> None:
@@ -149,10 +172,17 @@ def _render_answer(answer: Any) -> None:
     table = Table("class", "uuid", "position m", "distance m", "last seen", "state", "speed m/s", "on", "obs")
     for h in answer.hits:
         x, y, z = h.center_map_m
-        table.add_row(h.class_name, h.uuid[:8], f"{x:.2f} {y:.2f} {z:.2f}", f"{h.distance_m:.2f}",
-                      ago_text(h.last_seen_s, answer.now_s), h.state,
-                      "" if h.speed_mps is None else f"{h.speed_mps:.2f}",
-                      "" if h.support is None else h.support.class_name, str(h.observation_count))
+        table.add_row(
+            h.class_name,
+            h.uuid[:8],
+            f"{x:.2f} {y:.2f} {z:.2f}",
+            f"{h.distance_m:.2f}",
+            ago_text(h.last_seen_s, answer.now_s),
+            h.state,
+            "" if h.speed_mps is None else f"{h.speed_mps:.2f}",
+            "" if h.support is None else h.support.class_name,
+            str(h.observation_count),
+        )
     out.print(table)
 
 
@@ -185,8 +215,10 @@ def workspace_command(
 
     out = console()
     occupied = int((ws.occupancy >= 0).sum())
-    out.print(f"[bold]workspace[/] {ws.size_m} m at {ws.center_m}: {len(ws.background)} background shapes, "
-              f"{len(ws.foreground_uuids)} objects, {occupied} of {ws.occupancy.size} voxels occupied")
+    out.print(
+        f"[bold]workspace[/] {ws.size_m} m at {ws.center_m}: {len(ws.background)} background shapes, "
+        f"{len(ws.foreground_uuids)} objects, {occupied} of {ws.occupancy.size} voxels occupied"
+    )
     table = Table("layer", "class", "shape / voxels", "dynamics")
     for p in ws.background:
         table.add_row("background", p.class_name, p.shape, "")
@@ -217,13 +249,16 @@ def bench_command(
     from rich.table import Table
 
     out = console()
-    out.print(f"[bold]{report['counts']}[/] (built in {report['build_s']} s); first query of a process "
-              f"reads the instance index: {report['cold']['index_wall_ms']} ms "
-              f"({report['cold']['index_cpu_ms']} ms CPU); load average {report['load_average'][0]:.1f}")
+    out.print(
+        f"[bold]{report['counts']}[/] (built in {report['build_s']} s); first query of a process "
+        f"reads the instance index: {report['cold']['index_wall_ms']} ms "
+        f"({report['cold']['index_cpu_ms']} ms CPU); load average {report['load_average'][0]:.1f}"
+    )
     table = Table("query form", "p50 ms", "p95 ms", "max ms", "p95 CPU ms")
     for name, p in report["forms"].items():
-        table.add_row(name, f"{p['p50_ms']:.1f}", f"{p['p95_ms']:.1f}", f"{p['max_ms']:.1f}",
-                      f"{p['cpu_p95_ms']:.1f}")
+        table.add_row(
+            name, f"{p['p50_ms']:.1f}", f"{p['p95_ms']:.1f}", f"{p['max_ms']:.1f}", f"{p['cpu_p95_ms']:.1f}"
+        )
     out.print(table)
 
 

@@ -16,8 +16,9 @@ __all__ = ["register"]
 def serve_command(
     kb: Annotated[str, typer.Option("--kb", help=KB_HELP)] = "scene.hiper",
     kb_docs: Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)] = None,
-    host: Annotated[str, typer.Option("--host", help="Address to bind (0.0.0.0 exposes it to the "
-                                      "network).")] = "127.0.0.1",
+    host: Annotated[
+        str, typer.Option("--host", help="Address to bind (0.0.0.0 exposes it to the network).")
+    ] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", help="TCP port (0: any free one).")] = 7879,
 ) -> None:
     """Serve the knowledge base's scene graph read-only over the SPARQL 1.1 Protocol:
@@ -30,8 +31,9 @@ def serve_command(
 
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         endpoint = SparqlEndpoint(knowledge, host, port)
-        console().print(f"serving {knowledge.location} read-only at [bold]{endpoint.url}[/] (Ctrl-C stops)",
-                        )
+        console().print(
+            f"serving {knowledge.location} read-only at [bold]{endpoint.url}[/] (Ctrl-C stops)",
+        )
         try:
             endpoint.serve_forever()
         except KeyboardInterrupt:

@@ -38,15 +38,19 @@ class Lookups:
         """(uuid, instance uuid, stamp_s, x, y, z) of the observations whose map box centre lies
         in [lo, hi] (of class ``class_name`` when given)."""
         cell = self._grid_cell_m
-        where = ("(g.min_x + g.max_x) / 2 BETWEEN ? AND ? AND (g.min_y + g.max_y) / 2 BETWEEN ? AND ? "
-                 "AND (g.min_z + g.max_z) / 2 BETWEEN ? AND ?")
+        where = (
+            "(g.min_x + g.max_x) / 2 BETWEEN ? AND ? AND (g.min_y + g.max_y) / 2 BETWEEN ? AND ? "
+            "AND (g.min_z + g.max_z) / 2 BETWEEN ? AND ?"
+        )
         params: list[Any] = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
         if class_name is not None:
             where += " AND d.class = ?"
             params.append(class_name)
-        select = ("SELECT d.uuid, d.instance_uuid, d.stamp_s, (g.min_x + g.max_x) / 2, "
-                  "(g.min_y + g.max_y) / 2, (g.min_z + g.max_z) / 2 FROM {table} g "
-                  "CROSS JOIN docs d ON d.id = g.id WHERE ")
+        select = (
+            "SELECT d.uuid, d.instance_uuid, d.stamp_s, (g.min_x + g.max_x) / 2, "
+            "(g.min_y + g.max_y) / 2, (g.min_z + g.max_z) / 2 FROM {table} g "
+            "CROSS JOIN docs d ON d.id = g.id WHERE "
+        )
         out = list(self._db.execute(select.format(table="obs_cells_new") + where, params))
         ix0, ix1 = math.floor(lo[0] / cell), math.floor(hi[0] / cell)
         iy0, iy1 = math.floor(lo[1] / cell), math.floor(hi[1] / cell)
@@ -70,7 +74,9 @@ class Lookups:
             marks = ",".join("?" * len(chunk))
             rows = self._db.execute(
                 f"SELECT instance_uuid, observation_uuid FROM all_links WHERE instance_uuid IN ({marks}) "
-                "GROUP BY instance_uuid, observation_uuid ORDER BY MIN(seq), observation_uuid", chunk)
+                "GROUP BY instance_uuid, observation_uuid ORDER BY MIN(seq), observation_uuid",
+                chunk,
+            )
             for inst, obs in rows:
                 out[str(inst)].append(str(obs))
         return out
@@ -80,7 +86,8 @@ class Lookups:
         rows = self._db.execute(
             "SELECT d.stamp_s FROM docs d WHERE d.uuid IN "
             "(SELECT observation_uuid FROM all_links WHERE instance_uuid = ?) ORDER BY d.stamp_s",
-            (instance_uuid,))
+            (instance_uuid,),
+        )
         return [float(t) for (t,) in rows if t is not None]
 
     def pose_before(self, stamp_s: float | None = None) -> tuple[int, int, float, list[list[float]]] | None:
@@ -89,18 +96,22 @@ class Lookups:
         if stamp_s is None:
             row = self._db.execute(
                 "SELECT session_id, pose_id, stamp_s, T_map_cam FROM poses ORDER BY stamp_s DESC, "
-                "session_id DESC LIMIT 1").fetchone()
+                "session_id DESC LIMIT 1"
+            ).fetchone()
         else:
             row = self._db.execute(
                 "SELECT session_id, pose_id, stamp_s, T_map_cam FROM poses WHERE stamp_s <= ? "
-                "ORDER BY stamp_s DESC, session_id DESC LIMIT 1", (float(stamp_s),)).fetchone()
+                "ORDER BY stamp_s DESC, session_id DESC LIMIT 1",
+                (float(stamp_s),),
+            ).fetchone()
         return None if row is None else (int(row[0]), int(row[1]), float(row[2]), json.loads(row[3]))
 
     def poses_between(self, t0_s: float, t1_s: float) -> list[tuple[float, list[list[float]]]]:
         """(stamp_s, T_map_cam) of every recorded pose in [t0_s, t1_s], in time order."""
         rows = self._db.execute(
             "SELECT stamp_s, T_map_cam FROM poses WHERE stamp_s BETWEEN ? AND ? ORDER BY stamp_s",
-            (float(t0_s), float(t1_s)))
+            (float(t0_s), float(t1_s)),
+        )
         return [(float(t), json.loads(T)) for t, T in rows]
 
     def stamp_span(self) -> tuple[float, float] | None:

@@ -89,8 +89,10 @@ class KbReads:
         self, lo: Sequence[float], hi: Sequence[float], class_name: str | None = None
     ) -> list[ObservationPoint]:
         """Observations whose map-box centre lies in the axis-aligned box [lo, hi] (m)."""
-        return [ObservationPoint(u, i, t, (x, y, z))
-                for u, i, t, x, y, z in self.docs.observation_points_in(lo, hi, class_name)]
+        return [
+            ObservationPoint(u, i, t, (x, y, z))
+            for u, i, t, x, y, z in self.docs.observation_points_in(lo, hi, class_name)
+        ]
 
     def instance_uuids_in(self, lo: Sequence[float], hi: Sequence[float]) -> list[str]:
         """Instances whose map box may meet [lo, hi] (an index prefilter: boxes grown 0.25 m)."""
@@ -98,13 +100,19 @@ class KbReads:
 
     def analyses(self, kind: str | None = None, class_name: str | None = None) -> list[Analysis]:
         """Learned features (``hiper analyze``), newest window last."""
-        return [a for a in (Analysis.from_dict(d) for d in self.docs.find(type="analysis", class_name=class_name))
-                if kind is None or a.kind == kind]
+        return [
+            a
+            for a in (Analysis.from_dict(d) for d in self.docs.find(type="analysis", class_name=class_name))
+            if kind is None or a.kind == kind
+        ]
 
     def query_bound(self, sparql: str, bindings: Mapping[str, Any]) -> list[dict[str, Any]]:
         """SPARQL SELECT with variables bound to values (never pasted into the text)."""
         return list(self.graph.query(sparql, bindings))
 
-    def run_readonly(self, sparql: str, media_type: str = "application/sparql-results+json") -> tuple[bytes, str]:
+    def run_readonly(
+        self, sparql: str, media_type: str = "application/sparql-results+json"
+    ) -> tuple[bytes, str]:
         """Any read-only SPARQL query over all graphs, serialised; updates refused."""
-        return tuple(self.graph.run_readonly(sparql, media_type))  # type: ignore[return-value]
+        body, media = self.graph.run_readonly(sparql, media_type)
+        return bytes(body), str(media)

@@ -332,7 +332,8 @@ class SparqlGraph:
     def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
         readonly_check(sparql)
         try:
-            return self._post("query", _PREFIXES + sparql, "application/sparql-query", accept=media_type), media_type
+            body = self._post("query", _PREFIXES + sparql, "application/sparql-query", accept=media_type)
+            return body, media_type
         except KnowledgeBaseError as err:
             raise QueryError(str(err)) from err
 

@@ -26,9 +26,15 @@ __all__ = ["QUERY_FORMS", "QueryBenchConfig", "build_bench_kb", "run_query_bench
 
 AREA_M = 40.0
 TIMELINE_S = 10_800.0
-QUERY_FORMS = ("cups in FOV", "closest table", "people moving in the last 10 minutes",
-               "where was the bottle last seen", "how many chairs", "objects on the closest table",
-               "when did a person last pass here")
+QUERY_FORMS = (
+    "cups in FOV",
+    "closest table",
+    "people moving in the last 10 minutes",
+    "where was the bottle last seen",
+    "how many chairs",
+    "objects on the closest table",
+    "when did a person last pass here",
+)
 
 
 @dataclass(frozen=True)
@@ -42,12 +48,16 @@ class QueryBenchConfig:
 
 def _percentiles(samples_s: list[float]) -> dict[str, float]:
     xs = sorted(samples_s)
-    return {"p50_ms": round(1000 * statistics.median(xs), 2),
-            "p95_ms": round(1000 * xs[min(len(xs) - 1, math.ceil(0.95 * len(xs)) - 1)], 2),
-            "max_ms": round(1000 * xs[-1], 2)}
+    return {
+        "p50_ms": round(1000 * statistics.median(xs), 2),
+        "p95_ms": round(1000 * xs[min(len(xs) - 1, math.ceil(0.95 * len(xs)) - 1)], 2),
+        "max_ms": round(1000 * xs[-1], 2),
+    }
 
 
-def build_bench_kb(path: Path, config: QueryBenchConfig, progress: Callable[[int, int], None] | None = None) -> None:
+def build_bench_kb(
+    path: Path, config: QueryBenchConfig, progress: Callable[[int, int], None] | None = None
+) -> None:
     """Fill a fresh knowledge base at ``path`` with the synthetic building."""
     import numpy as np
 
@@ -69,18 +79,50 @@ def build_bench_kb(path: Path, config: QueryBenchConfig, progress: Callable[[int
         if kind < 0.35:  # on a table
             cls = rng.choice(("cup", "bottle", "book", "laptop"))
             h = {"cup": 0.1, "bottle": 0.3, "book": 0.04, "laptop": 0.03}[cls]
-            specs.append(("foreground", cls, "static", (x + rng.uniform(-0.5, 0.5), y + rng.uniform(-0.3, 0.3),
-                                                        0.75 + h / 2), (0.1, 0.1, h), 0.0))
+            specs.append(
+                (
+                    "foreground",
+                    cls,
+                    "static",
+                    (x + rng.uniform(-0.5, 0.5), y + rng.uniform(-0.3, 0.3), 0.75 + h / 2),
+                    (0.1, 0.1, h),
+                    0.0,
+                )
+            )
         elif kind < 0.6:
-            specs.append(("foreground", "chair", "static", (x + rng.choice((-0.9, 0.9)), y + rng.uniform(-0.4, 0.4),
-                                                            0.46), (0.44, 0.44, 0.92), 0.0))
+            specs.append(
+                (
+                    "foreground",
+                    "chair",
+                    "static",
+                    (x + rng.choice((-0.9, 0.9)), y + rng.uniform(-0.4, 0.4), 0.46),
+                    (0.44, 0.44, 0.92),
+                    0.0,
+                )
+            )
         elif kind < 0.8:
-            specs.append(("foreground", "person", "dynamic", (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 0.85),
-                          (0.6, 0.6, 1.7), rng.uniform(0.3, 1.4)))
+            specs.append(
+                (
+                    "foreground",
+                    "person",
+                    "dynamic",
+                    (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 0.85),
+                    (0.6, 0.6, 1.7),
+                    rng.uniform(0.3, 1.4),
+                )
+            )
         else:
             cls = rng.choice(("tv", "couch", "potted plant", "bed", "shelf"))
-            specs.append(("foreground", cls, "static", (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 0.5),
-                          (0.8, 0.5, 1.0), 0.0))
+            specs.append(
+                (
+                    "foreground",
+                    cls,
+                    "static",
+                    (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 0.5),
+                    (0.8, 0.5, 1.0),
+                    0.0,
+                )
+            )
     per = max(1, config.observations // len(specs))
     with open_kb(path) as kb:
         env = kb.environment("bench")
@@ -92,14 +134,31 @@ def build_bench_kb(path: Path, config: QueryBenchConfig, progress: Callable[[int
             heading = rng.uniform(-math.pi, math.pi)
             v = np.array([math.cos(heading), math.sin(heading), 0.0]) * speed
             centers = [np.array(c) + v * (t - t0) for t in stamps]
-            traj = [[t, *p.tolist(), *v.tolist()] for t, p in zip(stamps[::10], centers[::10], strict=True)] \
-                if state == "dynamic" else []
-            inst = Instance(layer, cls, Box3D(centers[-1], np.array(e)), stamps[0], stamps[-1],  # type: ignore[arg-type]
-                            state=state, confidence=round(rng.uniform(0.5, 1.0), 3),  # type: ignore[arg-type]
-                            data={"trajectory": traj} if traj else {})
+            traj = (
+                [[t, *p.tolist(), *v.tolist()] for t, p in zip(stamps[::10], centers[::10], strict=True)]
+                if state == "dynamic"
+                else []
+            )
+            inst = Instance(
+                layer,  # type: ignore[arg-type]
+                cls,
+                Box3D(centers[-1], np.array(e)),
+                stamps[0],
+                stamps[-1],
+                state=state,  # type: ignore[arg-type]
+                confidence=round(rng.uniform(0.5, 1.0), 3),
+                data={"trajectory": traj} if traj else {},
+            )
             for t, p in zip(stamps, centers, strict=True):
-                obs = Observation(layer, cls, inst.confidence, t, pose_id, Box3D(p, np.array(e)),  # type: ignore[arg-type]
-                                  instance_uuid=inst.uuid)
+                obs = Observation(
+                    layer,  # type: ignore[arg-type]
+                    cls,
+                    inst.confidence,
+                    t,
+                    pose_id,
+                    Box3D(p, np.array(e)),
+                    instance_uuid=inst.uuid,
+                )
                 inst.observation_uuids.append(obs.uuid)
                 result.observations.append(obs)
             result.instances.append(inst)
@@ -108,9 +167,12 @@ def build_bench_kb(path: Path, config: QueryBenchConfig, progress: Callable[[int
                 T[:3, 3] = (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 1.2)
                 # optical z axis level, looking along a random yaw
                 yaw = rng.uniform(-math.pi, math.pi)
-                T[:3, :3] = np.array([[math.sin(yaw), 0, math.cos(yaw)], [-math.cos(yaw), 0, math.sin(yaw)],
-                                      [0, -1, 0]])
-                kb.write_frame(session, result, pose_id=pose_id, stamp_s=TIMELINE_S * pose_id / 500, T_map_cam=T)
+                T[:3, :3] = np.array(
+                    [[math.sin(yaw), 0, math.cos(yaw)], [-math.cos(yaw), 0, math.sin(yaw)], [0, -1, 0]]
+                )
+                kb.write_frame(
+                    session, result, pose_id=pose_id, stamp_s=TIMELINE_S * pose_id / 500, T_map_cam=T
+                )
                 written += len(result.observations)
                 result, pose_id = FrameResult(), pose_id + 1
                 if progress:
@@ -121,7 +183,9 @@ def build_bench_kb(path: Path, config: QueryBenchConfig, progress: Callable[[int
 
 
 def run_query_bench(
-    config: QueryBenchConfig, *, kb_path: Path | None = None,
+    config: QueryBenchConfig,
+    *,
+    kb_path: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Build (or reuse, when ``kb_path`` holds one) the synthetic KB and time every form."""
@@ -150,7 +214,10 @@ def run_query_bench(
         def pose() -> tuple[float, float, float, float]:
             return (rng.uniform(0, AREA_M), rng.uniform(0, AREA_M), 1.2, rng.uniform(-math.pi, math.pi))
 
-        cases: dict[str, Callable[[], Any]] = {q: (lambda q=q: ask(kb, q, pose=pose())) for q in QUERY_FORMS}
+        def asking(words: str) -> Callable[[], Any]:
+            return lambda: ask(kb, words, pose=pose())
+
+        cases: dict[str, Callable[[], Any]] = {q: asking(q) for q in QUERY_FORMS}
         cases["when(uuid)"] = lambda: when(kb, rng.choice(people))
         cases["trajectory(uuid)"] = lambda: trajectory(kb, rng.choice(people))
         cases["workspace 1 m"] = lambda: workspace(kb, pose()[:3], 1.0)
@@ -160,8 +227,10 @@ def run_query_bench(
         index_module._CACHE.clear()
         w0, c0 = time.perf_counter(), time.process_time()
         index_module.instance_index(kb)
-        cold = {"index_wall_ms": round(1000 * (time.perf_counter() - w0), 1),
-                "index_cpu_ms": round(1000 * (time.process_time() - c0), 1)}
+        cold = {
+            "index_wall_ms": round(1000 * (time.perf_counter() - w0), 1),
+            "index_cpu_ms": round(1000 * (time.process_time() - c0), 1),
+        }
         for name, fn in cases.items():
             fn()  # warm the stores' caches once per form
             wall, cpu = [], []
@@ -173,5 +242,12 @@ def run_query_bench(
             forms[name] = {**_percentiles(wall), "cpu_p95_ms": _percentiles(cpu)["p95_ms"]}
     if tmp is not None:
         tmp.cleanup()
-    return {"config": asdict(config), "kb": str(kb_path), "counts": counts, "build_s": round(build_s, 1),
-            "cold": cold, "load_average": list(os.getloadavg()), "forms": forms}
+    return {
+        "config": asdict(config),
+        "kb": str(kb_path),
+        "counts": counts,
+        "build_s": round(build_s, 1),
+        "cold": cold,
+        "load_average": list(os.getloadavg()),
+        "forms": forms,
+    }

@@ -27,8 +27,13 @@ class ClassCount:
     last_seen_s: float
 
     def to_dict(self) -> dict[str, Any]:
-        return {"layer": self.layer, "class": self.class_name, "count": self.count,
-                "first_seen_s": self.first_seen_s, "last_seen_s": self.last_seen_s}
+        return {
+            "layer": self.layer,
+            "class": self.class_name,
+            "count": self.count,
+            "first_seen_s": self.first_seen_s,
+            "last_seen_s": self.last_seen_s,
+        }
 
 
 @dataclass(frozen=True)
@@ -44,36 +49,63 @@ class Description:
 
     @property
     def text(self) -> str:
-        lines = [f"Scene memory {self.kb}: environments {', '.join(self.environments) or 'none'}, "
-                 f"{self.sessions} session(s)."]
+        lines = [
+            f"Scene memory {self.kb}: environments {', '.join(self.environments) or 'none'}, "
+            f"{self.sessions} session(s)."
+        ]
         if self.span_s:
             t0, t1 = self.span_s
-            lines.append(f"Time span {iso_time(t0)} .. {iso_time(t1)} ({t1 - t0:.0f} s); now {iso_time(self.now_s)}.")
+            lines.append(
+                f"Time span {iso_time(t0)} .. {iso_time(t1)} ({t1 - t0:.0f} s); now {iso_time(self.now_s)}."
+            )
         for layer in ("background", "foreground"):
             parts = [f"{c.count} {c.class_name}" for c in self.classes if c.layer == layer]
             lines.append(f"{layer.capitalize()}: {', '.join(parts) if parts else 'nothing'}.")
         if self.movers:
-            lines.append("Recent movers: " + "; ".join(
-                f"{m['class']} {m['uuid'][:8]} seen {ago_text(m['last_seen_s'], self.now_s)}"
-                + (f" at {m['speed_mps']:.2f} m/s" if m["speed_mps"] is not None else "") for m in self.movers) + ".")
+            lines.append(
+                "Recent movers: "
+                + "; ".join(
+                    f"{m['class']} {m['uuid'][:8]} seen {ago_text(m['last_seen_s'], self.now_s)}"
+                    + (f" at {m['speed_mps']:.2f} m/s" if m["speed_mps"] is not None else "")
+                    for m in self.movers
+                )
+                + "."
+            )
         else:
             lines.append("Recent movers: none.")
         if self.features:
-            lines.append("Learned features: " + "; ".join(
-                f"{f['kind']} {f['class']}: " + ", ".join(f"{k} {_short(v)}" for k, v in list(f["values"].items())[:5])
-                for f in self.features[:12]) + ".")
+            lines.append(
+                "Learned features: "
+                + "; ".join(
+                    f"{f['kind']} {f['class']}: "
+                    + ", ".join(f"{k} {_short(v)}" for k, v in list(f["values"].items())[:5])
+                    for f in self.features[:12]
+                )
+                + "."
+            )
         else:
             lines.append("Learned features: none (run 'hiper analyze features').")
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"format": "hiper-describe", "version": 1, "kb": self.kb, "environments": list(self.environments),
-                "sessions": self.sessions,
-                "span": None if self.span_s is None else {"first": TimeValue(self.span_s[0], self.now_s).to_dict(),
-                                                          "last": TimeValue(self.span_s[1], self.now_s).to_dict()},
-                "now": TimeValue(self.now_s, self.now_s).to_dict(),
-                "classes": [c.to_dict() for c in self.classes], "recent_movers": list(self.movers),
-                "features": list(self.features), "text": self.text}
+        return {
+            "format": "hiper-describe",
+            "version": 1,
+            "kb": self.kb,
+            "environments": list(self.environments),
+            "sessions": self.sessions,
+            "span": None
+            if self.span_s is None
+            else {
+                "first": TimeValue(self.span_s[0], self.now_s).to_dict(),
+                "last": TimeValue(self.span_s[1], self.now_s).to_dict(),
+            },
+            "now": TimeValue(self.now_s, self.now_s).to_dict(),
+            "classes": [c.to_dict() for c in self.classes],
+            "recent_movers": list(self.movers),
+            "features": list(self.features),
+            "text": self.text,
+        }
 
 
 def _short(value: Any) -> str:
@@ -89,17 +121,46 @@ def describe(kb: KnowledgeBase, *, now_s: float | None = None, recent_s: float =
     groups: dict[tuple[str, str], list[int]] = {}
     for k in range(len(idx)):
         groups.setdefault((str(idx.layers[k]), str(idx.classes[k])), []).append(k)
-    classes = tuple(sorted(
-        (ClassCount(layer, name, len(rows), float(idx.first_s[rows].min()), float(idx.last_s[rows].max()))
-         for (layer, name), rows in groups.items()), key=lambda c: (c.layer, -c.count, c.class_name)))
+    classes = tuple(
+        sorted(
+            (
+                ClassCount(
+                    layer, name, len(rows), float(idx.first_s[rows].min()), float(idx.last_s[rows].max())
+                )
+                for (layer, name), rows in groups.items()
+            ),
+            key=lambda c: (c.layer, -c.count, c.class_name),
+        )
+    )
     recent = np.flatnonzero((idx.states == "dynamic") & (idx.last_s >= now - recent_s))
     recent = recent[np.argsort(-idx.last_s[recent], kind="stable")][:10]
-    movers = tuple({"uuid": idx.uuids[k], "class": str(idx.classes[k]), "last_seen_s": float(idx.last_s[k]),
-                    "speed_mps": None if np.isnan(idx.speeds[k]) else float(idx.speeds[k])} for k in recent)
+    movers = tuple(
+        {
+            "uuid": idx.uuids[k],
+            "class": str(idx.classes[k]),
+            "last_seen_s": float(idx.last_s[k]),
+            "speed_mps": None if np.isnan(idx.speeds[k]) else float(idx.speeds[k]),
+        }
+        for k in recent
+    )
     features = tuple(
-        {"uuid": r["a"].value.removeprefix("urn:uuid:"), "kind": r["kind"].value, "class": r["class"].value,
-         "t_start_s": float(r["tStart"].value), "t_end_s": float(r["tEnd"].value),
-         "values": json.loads(r["values"].value)}
-        for r in kb.query_bound(template("analyses"), {"graphPrefix": prefix}))
-    return Description(kb.location, tuple(e.name for e in kb.environments()), len(kb.sessions()), span, now,
-                       classes, movers, features)
+        {
+            "uuid": r["a"].value.removeprefix("urn:uuid:"),
+            "kind": r["kind"].value,
+            "class": r["class"].value,
+            "t_start_s": float(r["tStart"].value),
+            "t_end_s": float(r["tEnd"].value),
+            "values": json.loads(r["values"].value),
+        }
+        for r in kb.query_bound(template("analyses"), {"graphPrefix": prefix})
+    )
+    return Description(
+        kb.location,
+        tuple(e.name for e in kb.environments()),
+        len(kb.sessions()),
+        span,
+        now,
+        classes,
+        movers,
+        features,
+    )

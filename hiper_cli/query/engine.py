@@ -15,12 +15,11 @@ import numpy as np
 from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query import geometry as geo
+from hiper_cli.query.index import InstanceIndex, instance_index
 from hiper_cli.query.results import Hit, ReferencePose, Support
 from hiper_cli.query.spec import QueryConfig, QuerySpec
-from hiper_cli.query.index import InstanceIndex, instance_index
 
 __all__ = ["Candidates", "Context", "candidates_of", "details", "hits", "make_context", "prefilter", "select"]
-
 
 
 @dataclass
@@ -84,8 +83,15 @@ def make_context(
             ref = ReferencePose(0.0, 0.0, 0.0, 0.0, None, "origin", tuple(tuple(r) for r in T.tolist()))
         else:
             p = robot.position_map_m
-            ref = ReferencePose(float(p[0]), float(p[1]), float(p[2]), robot.yaw_rad, robot.stamp_s, "robot",
-                                tuple(tuple(r) for r in robot.T_map_cam.tolist()))
+            ref = ReferencePose(
+                float(p[0]),
+                float(p[1]),
+                float(p[2]),
+                robot.yaw_rad,
+                robot.stamp_s,
+                "robot",
+                tuple(tuple(r) for r in robot.T_map_cam.tolist()),
+            )
     return Context(kb, float(now_s), ref, config or QueryConfig())
 
 
@@ -177,8 +183,14 @@ def _spatial_mask(ctx: Context, spec: QuerySpec, cands: Candidates) -> np.ndarra
         sup = _support_targets(ctx, spec)
         centers, extents = cands.centers, cands.extents
         for k in range(len(sup)):
-            on |= geo.standing_on(centers, extents, sup.centers[k], sup.extents[k],
-                                  ctx.config.support_gap_m, ctx.config.support_margin_m)
+            on |= geo.standing_on(
+                centers,
+                extents,
+                sup.centers[k],
+                sup.extents[k],
+                ctx.config.support_gap_m,
+                ctx.config.support_margin_m,
+            )
         mask &= on & ~np.isin(cands.rows, sup.rows)
     return mask
 
@@ -211,8 +223,9 @@ def supports_of(ctx: Context, cands: Candidates) -> list[Support | None]:
     centers, extents = cands.centers, cands.extents
     for class_name in cfg.support_classes:
         sup = supports(ctx, class_name)
-        on = geo.standing_on_any(centers, extents, sup.centers, sup.extents, cfg.support_gap_m,
-                                 cfg.support_margin_m) & (cands.rows[:, None] != sup.rows[None, :])
+        on = geo.standing_on_any(
+            centers, extents, sup.centers, sup.extents, cfg.support_gap_m, cfg.support_margin_m
+        ) & (cands.rows[:, None] != sup.rows[None, :])
         for n, s in zip(*np.nonzero(on), strict=True):
             if out[n] is None:
                 out[n] = Support(class_name, idx.uuids[sup.rows[s]])
@@ -220,7 +233,11 @@ def supports_of(ctx: Context, cands: Candidates) -> list[Support | None]:
     floor_top = float((floors.centers[:, 2] + floors.extents[:, 2] / 2).max()) if len(floors) else 0.0
     bottoms = centers[:, 2] - extents[:, 2] / 2.0 if len(cands) else np.zeros(0)
     for n in range(len(cands)):
-        if out[n] is None and abs(bottoms[n] - floor_top) <= cfg.support_gap_m and cands.rows[n] not in floors.rows:
+        if (
+            out[n] is None
+            and abs(bottoms[n] - floor_top) <= cfg.support_gap_m
+            and cands.rows[n] not in floors.rows
+        ):
             out[n] = Support("floor", idx.uuids[floors.rows[0]] if len(floors) else None)
     return out
 
@@ -237,13 +254,24 @@ def hits(ctx: Context, cands: Candidates, *, evidence: bool = True) -> list[Hit]
     out = []
     for n, (row, dist) in enumerate(zip(cands.rows.tolist(), dists.tolist(), strict=True)):
         r = ctx.index.row(row)
-        out.append(Hit(
-            uuid=r["uuid"], class_name=r["class"], layer=r["layer"], center_map_m=r["center"],
-            extent_m=r["extent"], first_seen_s=r["first"], last_seen_s=r["last"],
-            observation_count=r["count"], confidence=r["confidence"], state=r["state"],
-            speed_mps=r["speed"], distance_m=round(dist, 4), support=support[n],
-            evidence_uuids=tuple(links.get(r["uuid"], ())),
-        ))
+        out.append(
+            Hit(
+                uuid=r["uuid"],
+                class_name=r["class"],
+                layer=r["layer"],
+                center_map_m=r["center"],
+                extent_m=r["extent"],
+                first_seen_s=r["first"],
+                last_seen_s=r["last"],
+                observation_count=r["count"],
+                confidence=r["confidence"],
+                state=r["state"],
+                speed_mps=r["speed"],
+                distance_m=round(dist, 4),
+                support=support[n],
+                evidence_uuids=tuple(links.get(r["uuid"], ())),
+            )
+        )
     return out
 
 

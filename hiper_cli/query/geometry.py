@@ -41,8 +41,10 @@ class Frustum:
 
     def __post_init__(self) -> None:
         if not (0 < self.hfov_deg < 180 and 0 < self.vfov_deg < 180 and self.range_m > 0):
-            raise QueryError(f"field of view {self.hfov_deg}° × {self.vfov_deg}°, range {self.range_m} m: "
-                             "angles must be in (0, 180) and the range positive")
+            raise QueryError(
+                f"field of view {self.hfov_deg}° × {self.vfov_deg}°, range {self.range_m} m: "
+                "angles must be in (0, 180) and the range positive"
+            )
 
 
 def parse_vector(text: str) -> tuple[float, float, float]:
@@ -58,9 +60,9 @@ def camera_from_yaw(x_m: float, y_m: float, z_m: float, yaw_rad: float) -> F64:
     forward, x right, y down)."""
     c, s = math.cos(yaw_rad), math.sin(yaw_rad)
     T = np.eye(4)
-    T[:3, 0] = (s, -c, 0.0)   # x: right
+    T[:3, 0] = (s, -c, 0.0)  # x: right
     T[:3, 1] = (0.0, 0.0, -1.0)  # y: down
-    T[:3, 2] = (c, s, 0.0)    # z: forward
+    T[:3, 2] = (c, s, 0.0)  # z: forward
     T[:3, 3] = (x_m, y_m, z_m)
     return T
 
@@ -96,18 +98,27 @@ def box_gap_m(centers_m: F64, extents_m: F64, other_center_m: F64, other_extent_
 
 
 def standing_on(
-    centers_m: F64, extents_m: F64, support_center_m: F64, support_extent_m: F64,
-    gap_m: float, margin_m: float,
+    centers_m: F64,
+    extents_m: F64,
+    support_center_m: F64,
+    support_extent_m: F64,
+    gap_m: float,
+    margin_m: float,
 ) -> NDArray[np.bool_]:
     """Which boxes stand on one support: their bottom within ``gap_m`` of the support's top
     and their footprint centre inside the support's footprint grown by ``margin_m``."""
-    return standing_on_any(centers_m, extents_m, support_center_m[None], support_extent_m[None],
-                           gap_m, margin_m)[:, 0]
+    return standing_on_any(
+        centers_m, extents_m, support_center_m[None], support_extent_m[None], gap_m, margin_m
+    )[:, 0]
 
 
 def standing_on_any(
-    centers_m: F64, extents_m: F64, support_centers_m: F64, support_extents_m: F64,
-    gap_m: float, margin_m: float,
+    centers_m: F64,
+    extents_m: F64,
+    support_centers_m: F64,
+    support_extents_m: F64,
+    gap_m: float,
+    margin_m: float,
 ) -> NDArray[np.bool_]:
     """(N, S): whether box n stands on support s (``standing_on`` for S supports at once)."""
     if len(centers_m) == 0 or len(support_centers_m) == 0:

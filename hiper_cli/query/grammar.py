@@ -31,21 +31,128 @@ UNDERSTOOD = (
     "between HH:MM and HH:MM, before/after HH:MM, today, yesterday, last seen, first seen; "
     "state: moving, static; questions: how many, where, when, how long, is there, go to"
 )
-FILLER = frozenset("the a an of is are was were be been did do does there that which what who show list "
-                   "find me give tell all any some please currently in at with and by".split())
-_TIME_UNITS = {"s": 1, "sec": 1, "secs": 1, "second": 1, "seconds": 1, "min": 60, "mins": 60, "minute": 60,
-               "minutes": 60, "h": 3600, "hr": 3600, "hrs": 3600, "hour": 3600, "hours": 3600, "d": 86400,
-               "day": 86400, "days": 86400}
-_LENGTH_UNITS = {"m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0, "cm": 0.01,
-                 "ft": 0.3048, "feet": 0.3048, "foot": 0.3048}
+FILLER = frozenset(
+    [
+        "the",
+        "a",
+        "an",
+        "of",
+        "is",
+        "are",
+        "was",
+        "were",
+        "be",
+        "been",
+        "did",
+        "do",
+        "does",
+        "there",
+        "that",
+        "which",
+        "what",
+        "who",
+        "show",
+        "list",
+        "find",
+        "me",
+        "give",
+        "tell",
+        "all",
+        "any",
+        "some",
+        "please",
+        "currently",
+        "in",
+        "at",
+        "with",
+        "and",
+        "by",
+    ]
+)
+_TIME_UNITS = {
+    "s": 1,
+    "sec": 1,
+    "secs": 1,
+    "second": 1,
+    "seconds": 1,
+    "min": 60,
+    "mins": 60,
+    "minute": 60,
+    "minutes": 60,
+    "h": 3600,
+    "hr": 3600,
+    "hrs": 3600,
+    "hour": 3600,
+    "hours": 3600,
+    "d": 86400,
+    "day": 86400,
+    "days": 86400,
+}
+_LENGTH_UNITS = {
+    "m": 1.0,
+    "meter": 1.0,
+    "meters": 1.0,
+    "metre": 1.0,
+    "metres": 1.0,
+    "cm": 0.01,
+    "ft": 0.3048,
+    "feet": 0.3048,
+    "foot": 0.3048,
+}
 _MOVING = {"moving", "walking", "dynamic", "running", "driving"}
 _STATIC = {"static", "still", "stationary", "parked", "standing"}
 _ME = {"me", "here", "robot", "you", "us"}
 _FOV = {"fov", "view", "sight"}
-_KEYWORDS = (set(_TIME_UNITS) | set(_LENGTH_UNITS) | _MOVING | _STATIC | _ME | _FOV | set(FILLER)
-             | set("how many long where when go to navigate take closest nearest within near next beside "
-                   "around on first last past seen since between before after today yesterday now visible "
-                   "front pass passed confidence above over least field".split()))
+_KEYWORDS = (
+    set(_TIME_UNITS)
+    | set(_LENGTH_UNITS)
+    | _MOVING
+    | _STATIC
+    | _ME
+    | _FOV
+    | set(FILLER)
+    | set(
+        [
+            "how",
+            "many",
+            "long",
+            "where",
+            "when",
+            "go",
+            "to",
+            "navigate",
+            "take",
+            "closest",
+            "nearest",
+            "within",
+            "near",
+            "next",
+            "beside",
+            "around",
+            "on",
+            "first",
+            "last",
+            "past",
+            "seen",
+            "since",
+            "between",
+            "before",
+            "after",
+            "today",
+            "yesterday",
+            "now",
+            "visible",
+            "front",
+            "pass",
+            "passed",
+            "confidence",
+            "above",
+            "over",
+            "least",
+            "field",
+        ]
+    )
+)
 
 
 @dataclass(frozen=True)
@@ -137,11 +244,20 @@ class _Parser:
     # -- rules: each returns the number of tokens it read (0: not this rule) ----------------
 
     def questions(self, i: int) -> int:
-        for words, kind in ((("how", "many"), "count"), (("how", "long"), "duration"), (("where",), "location"),
-                            (("when",), "time"), (("is", "there"), "yes_no"), (("are", "there"), "yes_no"),
-                            (("was", "there"), "yes_no"), (("were", "there"), "yes_no"),
-                            (("go", "to"), "goal"), (("navigate", "to"), "goal"), (("take", "me", "to"), "goal"),
-                            (("drive", "to"), "goal")):
+        for words, kind in (
+            (("how", "many"), "count"),
+            (("how", "long"), "duration"),
+            (("where",), "location"),
+            (("when",), "time"),
+            (("is", "there"), "yes_no"),
+            (("are", "there"), "yes_no"),
+            (("was", "there"), "yes_no"),
+            (("were", "there"), "yes_no"),
+            (("go", "to"), "goal"),
+            (("navigate", "to"), "goal"),
+            (("take", "me", "to"), "goal"),
+            (("drive", "to"), "goal"),
+        ):
             if self.at(i, *words):
                 self.answer = self.answer or kind
                 return len(words)
@@ -185,7 +301,7 @@ class _Parser:
             self.set("since_s", start)
             self.set("until_s", min(start + 86400, self.now_s))
             return 1
-        if i < len(t) and t[i] in ("now",) or self.at(i, "right", "now"):
+        if (i < len(t) and t[i] in ("now",)) or self.at(i, "right", "now"):
             self.set("since_s", self.now_s - self.cfg.now_window_s)
             return 2 if t[i] == "right" else 1
         return 0
@@ -207,8 +323,12 @@ class _Parser:
             self.set("sort", "distance")
             self.fields.setdefault("limit", 1)
             return 1
-        if self.at(i, "within") and i + 2 < len(t) and (n := _number(t[i + 1])) is not None \
-                and t[i + 2] in _LENGTH_UNITS:
+        if (
+            self.at(i, "within")
+            and i + 2 < len(t)
+            and (n := _number(t[i + 1])) is not None
+            and t[i + 2] in _LENGTH_UNITS
+        ):
             k = i + 3 + (1 if i + 3 < len(t) and t[i + 3] in ("of", "from") else 0)
             target = self.target_at(k) if k < len(t) else None
             self.set("near", Near(target[0] if target else "me", n * _LENGTH_UNITS[t[i + 2]]))
@@ -228,13 +348,24 @@ class _Parser:
                 return 0
             self.set("on", On(found[0], closest))
             return j + closest + found[1] - i
-        for words in (("pass", "here"), ("passed", "here"), ("pass", "by", "here"), ("passed", "by", "here"),
-                      ("come", "by", "here"), ("came", "by", "here"), ("walk", "by", "here"),
-                      ("walked", "by", "here"), ("pass", "by"), ("passed", "by"), ("been", "here")):
-            if self.at(i, *words):
+        passes: tuple[tuple[str, ...], ...] = (
+            ("pass", "here"),
+            ("passed", "here"),
+            ("pass", "by", "here"),
+            ("passed", "by", "here"),
+            ("come", "by", "here"),
+            ("came", "by", "here"),
+            ("walk", "by", "here"),
+            ("walked", "by", "here"),
+            ("pass", "by"),
+            ("passed", "by"),
+            ("been", "here"),
+        )
+        for phrase in passes:
+            if self.at(i, *phrase):
                 self.set("passed_here", True)
                 self.answer = self.answer or "time"
-                return len(words)
+                return len(phrase)
         if self.at(i, "here"):
             self.set("near", Near("me", self.cfg.near_radius_m))
             return 1
@@ -279,8 +410,14 @@ class _Parser:
     # -- the parse -------------------------------------------------------------------------
 
     def run(self, *, suggest: bool = True) -> ParsedQuery:
-        rules: list[Callable[[int], int]] = [self.questions, self.times, self.space, self.state,
-                                             self.confidence, self.noun]
+        rules: list[Callable[[int], int]] = [
+            self.questions,
+            self.times,
+            self.space,
+            self.state,
+            self.confidence,
+            self.noun,
+        ]
         i = 0
         while i < len(self.t):
             used = next((n for rule in rules if (n := rule(i)) > 0), 0)
@@ -290,10 +427,15 @@ class _Parser:
                 used = 1
             i += used
         if self.unknown:
-            raise QueryError(_unknown_message(self.text, self.unknown, self.now_s, self.cfg) if suggest
-                             else f"cannot read {self.unknown}")
+            raise QueryError(
+                _unknown_message(self.text, self.unknown, self.now_s, self.cfg)
+                if suggest
+                else f"cannot read {self.unknown}"
+            )
         if not self.t:
-            raise QueryError(f'empty query; ask e.g. "cups in FOV" or "how many chairs"; understood: {UNDERSTOOD}')
+            raise QueryError(
+                f'empty query; ask e.g. "cups in FOV" or "how many chairs"; understood: {UNDERSTOOD}'
+            )
         return self.build()
 
     def build(self) -> ParsedQuery:
@@ -345,7 +487,7 @@ def _unknown_message(text: str, unknown: list[str], now_s: float, cfg: QueryConf
     except QueryError:
         suggestion = "cups in FOV"
     quoted = ", ".join(f'"{w}"' for w in dict.fromkeys(unknown))
-    return (f'cannot read {quoted} in "{text}"; did you mean "{suggestion}"? hiper understands: {UNDERSTOOD}')
+    return f'cannot read {quoted} in "{text}"; did you mean "{suggestion}"? hiper understands: {UNDERSTOOD}'
 
 
 def with_limit(parsed: ParsedQuery, limit: int | None) -> ParsedQuery:

@@ -48,12 +48,19 @@ class InstanceIndex:
 
     def row(self, k: int) -> dict[str, Any]:
         speed = float(self.speeds[k])
-        return {"uuid": self.uuids[k], "class": str(self.classes[k]), "layer": str(self.layers[k]),
-                "state": str(self.states[k]), "first": float(self.first_s[k]), "last": float(self.last_s[k]),
-                "confidence": float(self.confidence[k]),
-                "center": tuple(float(v) for v in self.centers[k]),
-                "extent": tuple(float(v) for v in self.extents[k]), "count": int(self.counts[k]),
-                "speed": None if np.isnan(speed) else speed}
+        return {
+            "uuid": self.uuids[k],
+            "class": str(self.classes[k]),
+            "layer": str(self.layers[k]),
+            "state": str(self.states[k]),
+            "first": float(self.first_s[k]),
+            "last": float(self.last_s[k]),
+            "confidence": float(self.confidence[k]),
+            "center": tuple(float(v) for v in self.centers[k]),
+            "extent": tuple(float(v) for v in self.extents[k]),
+            "count": int(self.counts[k]),
+            "speed": None if np.isnan(speed) else speed,
+        }
 
     @classmethod
     def from_rows(cls, rows: list[dict[str, Any]]) -> InstanceIndex:
@@ -72,7 +79,9 @@ class InstanceIndex:
             centers=np.array([parse_vector(v) for v in col("center")], dtype=np.float64).reshape(n, 3),
             extents=np.array([parse_vector(v) for v in col("extent")], dtype=np.float64).reshape(n, 3),
             counts=np.array(col("count"), dtype=np.int64),
-            speeds=np.array([float(r["speed"].value) if "speed" in r else np.nan for r in rows], dtype=np.float64),
+            speeds=np.array(
+                [float(r["speed"].value) if "speed" in r else np.nan for r in rows], dtype=np.float64
+            ),
         )
 
 

@@ -15,9 +15,9 @@ from typing import Any, Literal
 
 __all__ = [
     "ANSWER_KINDS",
-    "AnswerKind",
     "SCHEMA_VERSION",
     "Answer",
+    "AnswerKind",
     "GoalPose",
     "Hit",
     "ReferencePose",
@@ -61,7 +61,11 @@ class TimeValue:
     now_s: float
 
     def to_dict(self) -> dict[str, Any]:
-        return {"stamp_s": self.stamp_s, "iso": iso_time(self.stamp_s), "ago": ago_text(self.stamp_s, self.now_s)}
+        return {
+            "stamp_s": self.stamp_s,
+            "iso": iso_time(self.stamp_s),
+            "ago": ago_text(self.stamp_s, self.now_s),
+        }
 
 
 @dataclass(frozen=True)
@@ -78,8 +82,14 @@ class ReferencePose:
     T_map_cam: tuple[tuple[float, ...], ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"x_m": self.x_m, "y_m": self.y_m, "z_m": self.z_m, "yaw_rad": self.yaw_rad,
-                "stamp_s": self.stamp_s, "source": self.source}
+        return {
+            "x_m": self.x_m,
+            "y_m": self.y_m,
+            "z_m": self.z_m,
+            "yaw_rad": self.yaw_rad,
+            "stamp_s": self.stamp_s,
+            "source": self.source,
+        }
 
 
 @dataclass(frozen=True)
@@ -95,11 +105,16 @@ class GoalPose:
     def to_dict(self) -> dict[str, Any]:
         half = self.yaw_rad / 2.0
         return {
-            "x_m": self.x_m, "y_m": self.y_m, "yaw_rad": self.yaw_rad, "target_uuid": self.target_uuid,
+            "x_m": self.x_m,
+            "y_m": self.y_m,
+            "yaw_rad": self.yaw_rad,
+            "target_uuid": self.target_uuid,
             "pose_stamped": {
                 "header": {"frame_id": self.frame_id},
-                "pose": {"position": {"x": self.x_m, "y": self.y_m, "z": 0.0},
-                         "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(half), "w": math.cos(half)}},
+                "pose": {
+                    "position": {"x": self.x_m, "y": self.y_m, "z": 0.0},
+                    "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(half), "w": math.cos(half)},
+                },
             },
         }
 
@@ -136,13 +151,18 @@ class Hit:
 
     def to_dict(self, now_s: float) -> dict[str, Any]:
         return {
-            "uuid": self.uuid, "class": self.class_name, "layer": self.layer,
+            "uuid": self.uuid,
+            "class": self.class_name,
+            "layer": self.layer,
             "position_m": list(self.center_map_m),
             "box": {"center_m": list(self.center_map_m), "extent_m": list(self.extent_m), "frame": "map"},
             "first_seen": TimeValue(self.first_seen_s, now_s).to_dict(),
             "last_seen": TimeValue(self.last_seen_s, now_s).to_dict(),
-            "observation_count": self.observation_count, "confidence": self.confidence,
-            "state": self.state, "speed_mps": self.speed_mps, "distance_m": self.distance_m,
+            "observation_count": self.observation_count,
+            "confidence": self.confidence,
+            "state": self.state,
+            "speed_mps": self.speed_mps,
+            "distance_m": self.distance_m,
             "support": None if self.support is None else self.support.to_dict(),
             "evidence_uuids": list(self.evidence_uuids),
         }
@@ -169,11 +189,16 @@ class Answer:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "format": "hiper-query-answer", "version": SCHEMA_VERSION, "kind": self.kind,
-            "query": self.query, "text": self.text, "parsed": self.parsed,
+            "format": "hiper-query-answer",
+            "version": SCHEMA_VERSION,
+            "kind": self.kind,
+            "query": self.query,
+            "text": self.text,
+            "parsed": self.parsed,
             "now": TimeValue(self.now_s, self.now_s).to_dict(),
             "reference": self.reference.to_dict(),
-            "count": self.count, "value": self.value,
+            "count": self.count,
+            "value": self.value,
             "time": None if self.time is None else self.time.to_dict(),
             "duration_s": self.duration_s,
             "goal": None if self.goal is None else self.goal.to_dict(),
@@ -195,10 +220,14 @@ class Sighting:
     now_s: float
 
     def to_dict(self) -> dict[str, Any]:
-        return {"uuid": self.uuid, "class": self.class_name,
-                "first_seen": TimeValue(self.first_seen_s, self.now_s).to_dict(),
-                "last_seen": TimeValue(self.last_seen_s, self.now_s).to_dict(),
-                "time_in_view_s": self.time_in_view_s, "observation_count": self.observation_count}
+        return {
+            "uuid": self.uuid,
+            "class": self.class_name,
+            "first_seen": TimeValue(self.first_seen_s, self.now_s).to_dict(),
+            "last_seen": TimeValue(self.last_seen_s, self.now_s).to_dict(),
+            "time_in_view_s": self.time_in_view_s,
+            "observation_count": self.observation_count,
+        }
 
 
 @dataclass(frozen=True)
@@ -222,7 +251,12 @@ class Trajectory:
         return self.length_m / self.duration_s if self.duration_s > 0 else None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"uuid": self.uuid, "class": self.class_name, "columns": ["stamp_s", "x_m", "y_m", "z_m",
-                                                                     "vx_mps", "vy_mps", "vz_mps"],
-                "rows": [list(r) for r in self.rows], "length_m": self.length_m,
-                "duration_s": self.duration_s, "mean_speed_mps": self.mean_speed_mps}
+        return {
+            "uuid": self.uuid,
+            "class": self.class_name,
+            "columns": ["stamp_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"],
+            "rows": [list(r) for r in self.rows],
+            "length_m": self.length_m,
+            "duration_s": self.duration_s,
+            "mean_speed_mps": self.mean_speed_mps,
+        }

@@ -31,16 +31,28 @@ def _classes(what: str | None) -> tuple[tuple[str, ...], str | None]:
         return (), None
     name = resolve_class(what)
     if name is None:
-        raise QueryError(f"unknown class {what!r}; expected a COCO or hiper class such as "
-                         f"{', '.join(CLASS_NAMES[:6])}, ... (plurals and synonyms like 'mugs' work)")
+        raise QueryError(
+            f"unknown class {what!r}; expected a COCO or hiper class such as "
+            f"{', '.join(CLASS_NAMES[:6])}, ... (plurals and synonyms like 'mugs' work)"
+        )
     return ((), "foreground") if name == ANY_FOREGROUND else ((name,), None)
 
 
 def spec_for(
-    what: str | None = None, *, near: str | None = None, radius_m: float | None = None,
-    in_fov: bool = False, on: str | None = None, on_closest: bool = False, since_s: float | None = None,
-    until_s: float | None = None, state: str | None = None, min_confidence: float = 0.0,
-    sort: str | None = None, limit: int | None = None, config: QueryConfig | None = None,
+    what: str | None = None,
+    *,
+    near: str | None = None,
+    radius_m: float | None = None,
+    in_fov: bool = False,
+    on: str | None = None,
+    on_closest: bool = False,
+    since_s: float | None = None,
+    until_s: float | None = None,
+    state: str | None = None,
+    min_confidence: float = 0.0,
+    sort: str | None = None,
+    limit: int | None = None,
+    config: QueryConfig | None = None,
 ) -> QuerySpec:
     """The ``QuerySpec`` of the verbs' keyword arguments (``near`` "me" or class words)."""
     cfg = config or QueryConfig()
@@ -50,8 +62,10 @@ def spec_for(
         target = "me" if near in (None, "me", "here") else _classes(near)[0]
         if not isinstance(target, str) and not target:
             raise QueryError(f"near {near!r}: name one class (e.g. 'table') or 'me'")
-        near_spec = Near(target if isinstance(target, str) else target[0],
-                         cfg.near_radius_m if radius_m is None else float(radius_m))
+        near_spec = Near(
+            target if isinstance(target, str) else target[0],
+            cfg.near_radius_m if radius_m is None else float(radius_m),
+        )
     on_spec = None
     if on is not None:
         on_classes = _classes(on)[0]
@@ -60,19 +74,37 @@ def spec_for(
         on_spec = On(on_classes[0], on_closest)
     if state == "moving":
         state = "dynamic"
-    return QuerySpec(classes=classes, layer=layer, state=state, since_s=since_s, until_s=until_s,
-                     min_confidence=min_confidence, in_fov=in_fov, near=near_spec, on=on_spec, sort=sort,
-                     limit=limit)
+    return QuerySpec(
+        classes=classes,
+        layer=layer,
+        state=state,
+        since_s=since_s,
+        until_s=until_s,
+        min_confidence=min_confidence,
+        in_fov=in_fov,
+        near=near_spec,
+        on=on_spec,
+        sort=sort,
+        limit=limit,
+    )
 
 
-def _context(kb: KnowledgeBase, pose: Pose | None, at_s: float | None, now_s: float | None,
-             config: QueryConfig | None) -> Context:
+def _context(
+    kb: KnowledgeBase, pose: Pose | None, at_s: float | None, now_s: float | None, config: QueryConfig | None
+) -> Context:
     return make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
 
 
 def find(
-    kb: KnowledgeBase, what: str | None = None, *, pose: Pose | None = None, at_s: float | None = None,
-    now_s: float | None = None, config: QueryConfig | None = None, evidence: bool = True, **filters: Any,
+    kb: KnowledgeBase,
+    what: str | None = None,
+    *,
+    pose: Pose | None = None,
+    at_s: float | None = None,
+    now_s: float | None = None,
+    config: QueryConfig | None = None,
+    evidence: bool = True,
+    **filters: Any,
 ) -> list[Hit]:
     """The instances matching ``what`` and the filters of ``spec_for`` (near, radius_m,
     in_fov, on, on_closest, since_s, until_s, state, min_confidence, sort, limit), nearest
@@ -83,8 +115,14 @@ def find(
 
 
 def count(
-    kb: KnowledgeBase, what: str | None = None, *, pose: Pose | None = None, at_s: float | None = None,
-    now_s: float | None = None, config: QueryConfig | None = None, **filters: Any,
+    kb: KnowledgeBase,
+    what: str | None = None,
+    *,
+    pose: Pose | None = None,
+    at_s: float | None = None,
+    now_s: float | None = None,
+    config: QueryConfig | None = None,
+    **filters: Any,
 ) -> int:
     """How many instances ``find`` would return (without fetching their details)."""
     ctx = _context(kb, pose, at_s, now_s, config)
@@ -92,12 +130,25 @@ def count(
 
 
 def last_seen(
-    kb: KnowledgeBase, what: str, *, pose: Pose | None = None, at_s: float | None = None,
-    now_s: float | None = None, config: QueryConfig | None = None, **filters: Any,
+    kb: KnowledgeBase,
+    what: str,
+    *,
+    pose: Pose | None = None,
+    at_s: float | None = None,
+    now_s: float | None = None,
+    config: QueryConfig | None = None,
+    **filters: Any,
 ) -> Hit | None:
     """The most recently seen instance of ``what`` (None when there is none)."""
-    found = find(kb, what, pose=pose, at_s=at_s, now_s=now_s, config=config,
-                 **{**filters, "sort": "last_seen", "limit": 1})
+    found = find(
+        kb,
+        what,
+        pose=pose,
+        at_s=at_s,
+        now_s=now_s,
+        config=config,
+        **{**filters, "sort": "last_seen", "limit": 1},
+    )
     return found[0] if found else None
 
 
@@ -108,16 +159,26 @@ def _in_view_s(stamps: list[float], gap_s: float) -> float:
     return float(dt[dt <= gap_s].sum())
 
 
-def when(kb: KnowledgeBase, uuid: str, *, now_s: float | None = None,
-         config: QueryConfig | None = None) -> Sighting:
+def when(
+    kb: KnowledgeBase, uuid: str, *, now_s: float | None = None, config: QueryConfig | None = None
+) -> Sighting:
     """First and last sighting and time in view of one instance."""
     ctx = _context(kb, None, None, now_s, config)
     d = engine.details(ctx, uuid)
     if d is None:
-        raise QueryError(f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'")
+        raise QueryError(
+            f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'"
+        )
     stamps = kb.observation_stamps_of(uuid)
-    return Sighting(uuid, d["class"], d["first"], d["last"], _in_view_s(stamps, ctx.config.view_gap_s),
-                    d["count"], ctx.now_s)
+    return Sighting(
+        uuid,
+        d["class"],
+        d["first"],
+        d["last"],
+        _in_view_s(stamps, ctx.config.view_gap_s),
+        d["count"],
+        ctx.now_s,
+    )
 
 
 def passed_here(ctx: Context, spec: QuerySpec) -> tuple[float, Hit] | None:
@@ -143,6 +204,8 @@ def trajectory(kb: KnowledgeBase, uuid: str) -> Trajectory:
     """The map-frame track of one instance (empty for background instances)."""
     inst = kb.instance(uuid)
     if inst is None:
-        raise QueryError(f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'")
+        raise QueryError(
+            f"no instance {uuid!r} in {kb.location}; list them with 'hiper query objects --json'"
+        )
     rows = inst.data.get("trajectory") or []
     return Trajectory(uuid, inst.class_name, tuple(tuple(float(v) for v in row) for row in rows))

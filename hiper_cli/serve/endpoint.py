@@ -20,12 +20,27 @@ from hiper_cli.graph.kb import KnowledgeBase
 
 __all__ = ["SparqlEndpoint", "choose_media_type"]
 
-_BY_NAME = {"json": "application/sparql-results+json", "xml": "application/sparql-results+xml",
-            "csv": "text/csv", "tsv": "text/tab-separated-values", "turtle": "text/turtle",
-            "ntriples": "application/n-triples", "rdfxml": "application/rdf+xml"}
-_ACCEPTED = ("application/sparql-results+json", "application/sparql-results+xml", "text/csv",
-             "text/tab-separated-values", "text/turtle", "application/n-triples", "application/rdf+xml",
-             "application/json", "application/xml", "text/xml")
+_BY_NAME = {
+    "json": "application/sparql-results+json",
+    "xml": "application/sparql-results+xml",
+    "csv": "text/csv",
+    "tsv": "text/tab-separated-values",
+    "turtle": "text/turtle",
+    "ntriples": "application/n-triples",
+    "rdfxml": "application/rdf+xml",
+}
+_ACCEPTED = (
+    "application/sparql-results+json",
+    "application/sparql-results+xml",
+    "text/csv",
+    "text/tab-separated-values",
+    "text/turtle",
+    "application/n-triples",
+    "application/rdf+xml",
+    "application/json",
+    "application/xml",
+    "text/xml",
+)
 
 
 def choose_media_type(accept: str | None, format_name: str | None) -> str:
@@ -35,9 +50,11 @@ def choose_media_type(accept: str | None, format_name: str | None) -> str:
     for part in (accept or "").split(","):
         media = part.split(";")[0].strip().lower()
         if media in _ACCEPTED:
-            return {"application/json": "application/sparql-results+json",
-                    "application/xml": "application/sparql-results+xml",
-                    "text/xml": "application/sparql-results+xml"}.get(media, media)
+            return {
+                "application/json": "application/sparql-results+json",
+                "application/xml": "application/sparql-results+xml",
+                "text/xml": "application/sparql-results+xml",
+            }.get(media, media)
     return "application/sparql-results+json"
 
 
@@ -53,7 +70,7 @@ class SparqlEndpoint:
     @property
     def url(self) -> str:
         host, port = self._server.server_address[:2]
-        return f"http://{host}:{port}/query"
+        return f"http://{host!s}:{port}/query"
 
     def answer(self, sparql: str, media_type: str) -> tuple[bytes, str]:
         with self._lock:
@@ -107,11 +124,15 @@ def _handler(endpoint: SparqlEndpoint) -> type[BaseHTTPRequestHandler]:
             if path not in ("/query", "/sparql", ""):
                 self._error(404, f"no such resource {path}; send queries to /query")
                 return
-            query = body_query if body_query is not None else (params.get("query") or [None])[0]
+            query = body_query if body_query is not None else next(iter(params.get("query") or []), None)
             if not query:
-                self._error(400, "missing query: GET /query?query=... or POST a application/sparql-query body")
+                self._error(
+                    400, "missing query: GET /query?query=... or POST a application/sparql-query body"
+                )
                 return
-            media = choose_media_type(self.headers.get("Accept"), (params.get("format") or [None])[0])
+            media = choose_media_type(
+                self.headers.get("Accept"), next(iter(params.get("format") or []), None)
+            )
             try:
                 body, media = endpoint.answer(query, media)
             except HiperError as err:
