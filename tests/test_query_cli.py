@@ -255,3 +255,39 @@ def test_query_help_imports_no_heavy_module():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "Example:" in done.stdout
     assert done.stderr.strip() == "[]"
+
+
+@pytest.mark.slow
+def test_the_wheel_ships_the_named_queries_and_the_schema(tmp_path):
+    import pathlib
+    import zipfile
+
+    root = pathlib.Path(__file__).resolve().parents[1]
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path), str(root)],
+                   check=True, capture_output=True)
+    (wheel,) = tmp_path.glob("hiper-*.whl")
+    names = set(zipfile.ZipFile(wheel).namelist())
+    shipped = {p.name for p in (root / "queries").glob("*.rq")}
+    assert shipped and {f"hiper_cli/queries/{n}" for n in shipped} <= names
+    assert "hiper_cli/query/answer.schema.json" in names
+
+
+def test_describe_and_workspace_read_learned_features(tmp_path):
+    import shutil
+
+    from hiper_cli.model import Analysis
+    from hiper_cli.query.describe import describe
+    from hiper_cli.query.workspace import workspace
+
+    h = house_truth_kb()
+    shutil.copytree(h.path, tmp_path / "kb.hiper")
+    ods = {"mean_mps": 0.8, "cl_mps": 0.7, "cu_mps": 0.9, "ratio": 0.4, "sigma_mps": 0.1}
+    with open_kb(tmp_path / "kb.hiper") as kb:
+        kb.put_analyses([Analysis("ods", "person", 0.0, 40.0, ods, 1.0)])
+        kb.sync_graph()
+        summary = describe(kb)
+        assert summary.features[0]["kind"] == "ods" and summary.features[0]["values"] == ods
+        assert "ods person:" in summary.text and "mean_mps 0.8" in summary.text
+        person = ask(kb, "where was the person last seen").hits[0]
+        ws = workspace(kb, person.center_map_m, 3.0, resolution_m=0.1)
+        assert ws.dynamics["person"]["source"] == "ods" and ws.dynamics["person"]["mean_mps"] == 0.8
