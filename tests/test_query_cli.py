@@ -291,3 +291,21 @@ def test_describe_and_workspace_read_learned_features(tmp_path):
         person = ask(kb, "where was the person last seen").hits[0]
         ws = workspace(kb, person.center_map_m, 3.0, resolution_m=0.1)
         assert ws.dynamics["person"]["source"] == "ods" and ws.dynamics["person"]["mean_mps"] == 0.8
+
+
+def test_every_example_answers_on_a_perceived_house_log(tmp_path):
+    """The fixture house log through the real pipeline (truth detector): every example query
+    answers without error and validates; counts agree with the instances the KB holds."""
+    import pathlib
+
+    from hiper_cli.pipeline import perceive
+
+    log = pathlib.Path(__file__).resolve().parents[1] / "fixtures" / "house_small"
+    with open_kb(tmp_path / "kb.hiper") as kb:
+        perceive(log, kb, ["background", "foreground"], {"foreground": {"detector": "truth"}})
+        for words in EXAMPLES:
+            jsonschema.validate(ask(kb, words).to_dict(), _schema())
+        people = len(kb.instances(class_name="person"))
+        assert ask(kb, "how many people").count == people
+        walls = ask(kb, "closest wall")
+        assert walls.hits and walls.hits[0].class_name == "wall" and walls.goal is not None
