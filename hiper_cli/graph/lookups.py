@@ -14,23 +14,10 @@ __all__ = ["Lookups"]
 
 
 class Lookups:
-    """Reads over ``docs_box``, ``obs_cells``, ``all_links`` and ``poses``."""
+    """Reads over ``obs_cells``, ``all_links``, ``docs`` columns and ``poses``."""
 
     _db: sqlite3.Connection
     _grid_cell_m: float
-
-    def instance_boxes_in(
-        self, lo: Sequence[float], hi: Sequence[float]
-    ) -> list[tuple[str, tuple[float, float, float, float, float, float]]]:
-        """(uuid, (min_x, max_x, min_y, max_y, min_z, max_z)) of the instances whose indexed
-        map box meets [lo, hi]. The index rows are the boxes grown by a slack: a prefilter."""
-        rows = self._db.execute(
-            "SELECT d.uuid, b.min_x, b.max_x, b.min_y, b.max_y, b.min_z, b.max_z "
-            "FROM docs_box b CROSS JOIN docs d ON d.id = b.id WHERE b.max_x >= ? AND b.min_x <= ? "
-            "AND b.max_y >= ? AND b.min_y <= ? AND b.max_z >= ? AND b.min_z <= ? AND d.type = 'instance'",
-            [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]],
-        )
-        return [(str(r[0]), (r[1], r[2], r[3], r[4], r[5], r[6])) for r in rows]
 
     def observation_points_in(
         self, lo: Sequence[float], hi: Sequence[float], class_name: str | None = None
@@ -105,14 +92,6 @@ class Lookups:
                 (float(stamp_s),),
             ).fetchone()
         return None if row is None else (int(row[0]), int(row[1]), float(row[2]), json.loads(row[3]))
-
-    def poses_between(self, t0_s: float, t1_s: float) -> list[tuple[float, list[list[float]]]]:
-        """(stamp_s, T_map_cam) of every recorded pose in [t0_s, t1_s], in time order."""
-        rows = self._db.execute(
-            "SELECT stamp_s, T_map_cam FROM poses WHERE stamp_s BETWEEN ? AND ? ORDER BY stamp_s",
-            (float(t0_s), float(t1_s)),
-        )
-        return [(float(t), json.loads(T)) for t, T in rows]
 
     def stamp_span(self) -> tuple[float, float] | None:
         """(first, last) stamp of the poses and documents, None for an empty store."""

@@ -67,9 +67,6 @@ class KbReads:
         session_id, pose_id, stamp_s, T = row
         return RobotPose(stamp_s, np.asarray(T, dtype=np.float64), session_id, pose_id)
 
-    def robot_poses(self, t0_s: float, t1_s: float) -> list[RobotPose]:
-        return [RobotPose(t, np.asarray(T, dtype=np.float64)) for t, T in self.docs.poses_between(t0_s, t1_s)]
-
     def stamp_span(self) -> tuple[float, float] | None:
         """(first, last) stamp known to the knowledge base (poses and observations)."""
         return self.docs.stamp_span()
@@ -93,10 +90,6 @@ class KbReads:
             ObservationPoint(u, i, t, (x, y, z))
             for u, i, t, x, y, z in self.docs.observation_points_in(lo, hi, class_name)
         ]
-
-    def instance_uuids_in(self, lo: Sequence[float], hi: Sequence[float]) -> list[str]:
-        """Instances whose map box may meet [lo, hi] (an index prefilter: boxes grown 0.25 m)."""
-        return [u for u, _ in self.docs.instance_boxes_in(lo, hi)]
 
     def analyses(self, kind: str | None = None, class_name: str | None = None) -> list[Analysis]:
         """Learned features (``hiper analyze``), newest window last."""
