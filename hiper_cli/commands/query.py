@@ -195,8 +195,10 @@ def workspace_command(
     kb_docs: KbDocsOption = None,
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """The background as primitive shapes and the foreground as a voxel grid with classes and
-    learned dynamics, inside a box: what a manipulation planner needs.
+    """What a box of the map holds, for a manipulation planner.
+
+    The static background as primitive shapes with their class, the foreground as a voxel
+    grid with classes and learned dynamics (ODS where hiper analyze has run).
 
     Example: hiper query workspace --center 1.7,1.9,0.8 --size 1.0 --kb house.hiper --json
     """

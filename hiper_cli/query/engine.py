@@ -7,7 +7,7 @@ then the typed hits with their support and evidence observations (the documents'
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -31,17 +31,10 @@ class Context:
     now_s: float
     reference: ReferencePose
     config: QueryConfig
-    index: InstanceIndex = field(default=None)  # type: ignore[assignment]
-    _rows: dict[str, int] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        if self.index is None:
-            self.index = instance_index(self.kb)
+    index: InstanceIndex
 
     def row_of(self, uuid: str) -> int | None:
-        if not self._rows and len(self.index):
-            self._rows.update({u: k for k, u in enumerate(self.index.uuids)})
-        return self._rows.get(uuid)
+        return self.index.row_numbers.get(uuid)
 
     @property
     def T_map_cam(self) -> np.ndarray:
@@ -92,7 +85,7 @@ def make_context(
                 "robot",
                 tuple(tuple(r) for r in robot.T_map_cam.tolist()),
             )
-    return Context(kb, float(now_s), ref, config or QueryConfig())
+    return Context(kb, float(now_s), ref, config or QueryConfig(), instance_index(kb))
 
 
 @dataclass

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -45,6 +46,11 @@ class InstanceIndex:
 
     def __len__(self) -> int:
         return len(self.uuids)
+
+    @cached_property
+    def row_numbers(self) -> dict[str, int]:
+        """uuid -> row."""
+        return {u: k for k, u in enumerate(self.uuids)}
 
     def row(self, k: int) -> dict[str, Any]:
         speed = float(self.speeds[k])
