@@ -16,9 +16,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from hiper_cli.graph import open_kb
-from hiper_cli.model import Box3D, Instance, Observation
-from hiper_cli.perceive.stage import FrameResult
-from hiper_cli.sim.truth import Truth, load_truth
+from hiper_cli.model import Box3D, FrameResult, Instance, Observation
+from hiper_cli.perceive.logs.truth import Truth, load_truth
 
 MIN_PIXELS = 6
 

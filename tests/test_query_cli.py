@@ -298,11 +298,12 @@ def test_every_example_answers_on_a_perceived_house_log(tmp_path):
     answers without error and validates; counts agree with the instances the KB holds."""
     import pathlib
 
-    from hiper_cli.pipeline import perceive
+    from hiper_cli.pipeline import PerceiveOptions, perceive_log
 
     log = pathlib.Path(__file__).resolve().parents[1] / "fixtures" / "house_small"
+    perceive_log(log, str(tmp_path / "kb.hiper"),
+                 options=PerceiveOptions(stage_options={"foreground": {"detector": "truth"}}))
     with open_kb(tmp_path / "kb.hiper") as kb:
-        perceive(log, kb, ["background", "foreground"], {"foreground": {"detector": "truth"}})
         for words in EXAMPLES:
             jsonschema.validate(ask(kb, words).to_dict(), _schema())
         people = len(kb.instances(class_name="person"))

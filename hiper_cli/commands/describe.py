@@ -2,20 +2,19 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
 from hiper_cli.commands._render import JSON_OPTION, console, print_json
-from hiper_cli.commands.perceive import KB_DOCS_HELP, KB_HELP
 
 __all__ = ["register"]
 
 
 def describe_command(
-    kb: Annotated[str, typer.Option("--kb", help=KB_HELP)] = "scene.hiper",
-    kb_docs: Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)] = None,
+    kb: KbOption = DEFAULT_KB,
+    kb_docs: KbDocsOption = None,
     recent_s: Annotated[
         float, typer.Option("--recent-s", help="Movers seen in this many seconds before the KB's last stamp.")
     ] = 300.0,

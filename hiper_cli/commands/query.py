@@ -10,8 +10,8 @@ from typing import Annotated, Any
 import typer
 from typer.core import TyperGroup
 
+from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
 from hiper_cli.commands._render import JSON_OPTION, HiperTyper, console, print_json
-from hiper_cli.commands.perceive import KB_DOCS_HELP, KB_HELP
 from hiper_cli.errors import QueryError
 
 __all__ = ["query_app", "register"]
@@ -41,8 +41,6 @@ query_app = HiperTyper(
     ),
 )
 
-KbOption = Annotated[str, typer.Option("--kb", help=KB_HELP)]
-KbDocsOption = Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)]
 
 
 def _floats(text: str | None, n: int, option: str, form: str) -> tuple[float, ...] | None:
@@ -76,7 +74,7 @@ def _stamp(text: str | None, option: str, now_s: float) -> float | None:
 @query_app.command("ask")
 def ask_command(
     words: Annotated[list[str] | None, typer.Argument(help="The query in plain words.")] = None,
-    kb: KbOption = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
     pose: Annotated[
         str | None,
@@ -191,7 +189,7 @@ def workspace_command(
     center: Annotated[str, typer.Option("--center", help="Centre x,y,z of the workspace box (m, map).")],
     size: Annotated[str, typer.Option("--size", help="Edge of the box (m), or sx,sy,sz.")] = "1.0",
     resolution: Annotated[float, typer.Option("--resolution", help="Voxel edge (m).")] = 0.05,
-    kb: KbOption = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
     as_json: bool = JSON_OPTION,
 ) -> None:

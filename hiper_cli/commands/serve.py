@@ -2,20 +2,19 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
 from hiper_cli.commands._render import console
-from hiper_cli.commands.perceive import KB_DOCS_HELP, KB_HELP
 
 __all__ = ["register"]
 
 
 def serve_command(
-    kb: Annotated[str, typer.Option("--kb", help=KB_HELP)] = "scene.hiper",
-    kb_docs: Annotated[Path | None, typer.Option("--kb-docs", help=KB_DOCS_HELP)] = None,
+    kb: KbOption = DEFAULT_KB,
+    kb_docs: KbDocsOption = None,
     host: Annotated[
         str, typer.Option("--host", help="Address to bind (0.0.0.0 exposes it to the network).")
     ] = "127.0.0.1",

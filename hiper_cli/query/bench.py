@@ -62,8 +62,7 @@ def build_bench_kb(
     import numpy as np
 
     from hiper_cli.graph.kb import open_kb
-    from hiper_cli.model import Box3D, Instance, Observation
-    from hiper_cli.perceive.stage import FrameResult
+    from hiper_cli.model import Box3D, FrameResult, Instance, Observation
 
     rng = random.Random(config.seed)
     n_tables = max(1, config.instances // 50)
