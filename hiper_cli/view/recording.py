@@ -152,11 +152,11 @@ def _log_robot(rr: Any, rec: Any, tl: Timeline, scene: ViewScene, camera: Camera
 
 
 def _log_floor(rr: Any, rec: Any, image: FloorImage, z_m: float) -> None:
-    """A grid as a textured quad on the floor (``/map/<name>``), red-hot where it is high."""
+    """A grid as a textured quad on the floor (``/map/<name>``), turbo colours, red where it is high."""
     import cv2
 
     values = (image.normalised() * 255).astype(np.uint8)
-    rgb = cv2.applyColorMap(values, cv2.COLORMAP_INFERNO)[:, :, ::-1]
+    rgb = cv2.applyColorMap(values, cv2.COLORMAP_TURBO)[:, :, ::-1]
     rgba = np.dstack([rgb, np.where(values > 0, 200, 40).astype(np.uint8)])
     x0, x1, y0, y1 = image.extent_m
     z = z_m + 0.01

@@ -1,11 +1,12 @@
 """A top-down picture of a ``ViewScene`` (OpenCV, no Rerun): for the README and for reports.
 
-Drawn in the map's x-y plane, +y up: the floor images (heatmaps, occupancy) underneath, floor
-polygons filled, walls and other background planes as their footprint in the class colour,
-the robot's path in grey with its start and end, each foreground track as a polyline coloured
-by speed (thin grey across times it was not seen) with its last box footprint and a label
-(class, short uuid, and mean speed when it moved), "unknown" clusters faint, a 1 m grid,
-a scale bar, a legend and the time window in the title.
+Drawn in the map's x-y plane, +y up: floor polygons filled, the floor images (heatmaps,
+occupancy) over them in the turbo colour map (cells of value 0 left out), walls and other
+background planes as their footprint in the class colour, the robot's path in grey with its
+start and end, each foreground track as a polyline coloured by speed (thin grey across times it
+was not seen) with its last box footprint and a label (class, short uuid, and mean speed when
+it moved), "unknown" clusters faint, a 1 m grid, a scale bar, a legend and the time window in
+the title.
 """
 
 from __future__ import annotations
@@ -86,7 +87,7 @@ def _floor_images(canvas: _Canvas, scene: ViewScene) -> None:
         (u0, v1), (u1, v0) = canvas.px(np.array([[x0, y0], [x1, y1]]))
         if u1 <= u0 or v1 <= v0:
             continue
-        color = _cv2.applyColorMap(np.flipud(values), _cv2.COLORMAP_INFERNO)
+        color = _cv2.applyColorMap(np.flipud(values), _cv2.COLORMAP_TURBO)
         color = _cv2.resize(color, (u1 - u0, v1 - v0), interpolation=_cv2.INTER_NEAREST)
         mask = _cv2.resize(np.flipud(values), (u1 - u0, v1 - v0), interpolation=_cv2.INTER_NEAREST) > 0
         ua, va = max(u0, 0), max(v0, 0)
@@ -94,7 +95,7 @@ def _floor_images(canvas: _Canvas, scene: ViewScene) -> None:
         region = canvas.image[va:vb, ua:ub]
         sub = color[va - v0 : vb - v0, ua - u0 : ub - u0]
         m = mask[va - v0 : vb - v0, ua - u0 : ub - u0]
-        region[m] = (0.45 * region[m] + 0.55 * sub[m]).astype(np.uint8)
+        region[m] = (0.3 * region[m] + 0.7 * sub[m]).astype(np.uint8)
 
 
 def _grid(canvas: _Canvas) -> None:
@@ -132,7 +133,6 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
     config = config or TopDownConfig()
     canvas = _Canvas(*_bounds(scene), config)
     img = canvas.image
-    _floor_images(canvas, scene)
     _grid(canvas)
     floors = [b for b in scene.background if b.class_name == "floor"]
     for item in floors:
@@ -140,6 +140,7 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
         layer = img.copy()
         cv2.fillPoly(layer, [canvas.px(poly)], _bgr(class_color("floor")))
         img[:] = cv2.addWeighted(layer, 0.5, img, 0.5, 0)
+    _floor_images(canvas, scene)
     for item in scene.background:
         if item.class_name == "floor":
             continue
