@@ -89,6 +89,9 @@ def test_recording_holds_the_layers_and_the_logs_time_range(kb_dir, tmp_path):
     assert "Boxes3D:labels" in entities[path]["columns"]
     assert f"{path}/trajectory" in entities and f"{path}/speed_mps" in entities
     assert summary.rrd_bytes == out.stat().st_size
+    import rerun.chunk
+
+    assert len(rerun.chunk.RrdReader(out).blueprints()) == 1  # the layout it opens with
 
 
 def test_time_window_cuts_the_recording(kb_dir, tmp_path):

@@ -74,7 +74,7 @@ def _record(request: ViewRequest, scene: ViewScene, kb: Any) -> tuple[dict[str, 
 
         reader = open_log(request.log)
         camera = reader.info().camera
-    rec = new_recording(request.rrd, request.spawn, scene)
+    rec = new_recording(request.rrd, request.spawn, with_images=reader is not None)
     counts = write_scene(rec, scene, camera)
     frames = 0
     if reader is not None:

@@ -57,16 +57,31 @@ def import_rerun() -> Any:
     return rerun
 
 
-def new_recording(out: Path | None, spawn: bool, scene: ViewScene) -> Any:
+def _blueprint(with_images: bool) -> Any:
+    """The layout the viewer opens with: the 3D scene, the camera's image (with ``--log``) and
+    the tracks' speeds, on the ``stamp`` timeline."""
+    import rerun.blueprint as rrb
+
+    side: list[Any] = [rrb.Spatial2DView(origin=IMAGE_PATH, name="camera")] if with_images else []
+    side.append(rrb.TimeSeriesView(origin="/foreground", name="speed (m/s)"))
+    return rrb.Blueprint(
+        rrb.Horizontal(rrb.Spatial3DView(origin="/", name="scene"), rrb.Vertical(*side),
+                       column_shares=[2, 1]),
+        rrb.TimePanel(timeline=TIMELINE),
+    )
+
+
+def new_recording(out: Path | None, spawn: bool, with_images: bool = False) -> Any:
     """A recording stream saving to ``out`` and/or streaming to a spawned viewer."""
     rr = import_rerun()
     rec = rr.RecordingStream("hiper_view")
     rr.set_log_time_enabled(False, recording=rec)
+    blueprint = _blueprint(with_images)
     if spawn:
-        rec.spawn()
+        rec.spawn(default_blueprint=blueprint)
     if out is not None:
         out.parent.mkdir(parents=True, exist_ok=True)
-        rec.save(out)
+        rec.save(out, default_blueprint=blueprint)
     return rec
 
 
