@@ -33,7 +33,9 @@ def view_command(
     """
     from hiper_cli.view import TimeWindow, ViewRequest, render_view
 
-    summary = render_view(ViewRequest(kb, out, spawn, png, log, TimeWindow(start_s, end_s), image_hz))
+    request = ViewRequest(kb=kb, rrd=out, spawn=spawn, png=png, log=log, window=TimeWindow(start_s, end_s),
+                          image_hz=image_hz)
+    summary = render_view(request)
     if as_json:
         print_json(summary.to_dict())
     else:
