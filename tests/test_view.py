@@ -21,7 +21,7 @@ from hiper_cli.pipeline import perceive
 from hiper_cli.view import TimeWindow, ViewRequest, load_scene, render_view
 from hiper_cli.view.camera import pick_frames
 from hiper_cli.view.floor import floor_images
-from hiper_cli.view.style import class_color
+from hiper_cli.view.style import class_color, entity_path
 
 ROOT = Path(__file__).resolve().parents[1]
 LOG = ROOT / "fixtures" / "house_small"
@@ -176,3 +176,23 @@ def test_pick_frames_subsamples_to_the_rate():
     assert pick_frames(stamps, TimeWindow(), 2.0) == list(range(0, 40, 2))
     assert pick_frames(stamps, TimeWindow(), 0.0) == list(range(40))
     assert pick_frames(stamps, TimeWindow(2.0, 3.0), 1.0) == [8, 12]
+
+
+def test_live_view_streams_perception_as_it_runs(tmp_path):
+    pytest.importorskip("rerun", reason="rerun-sdk (the hiper[view] extra) is not installed")
+    from hiper_cli.view.live import LiveView
+
+    out = tmp_path / "live.rrd"
+    live = LiveView.open(out=out, image_hz=1.0)
+    with open_kb(tmp_path / "live.hiper") as kb:
+        perceive(LOG, kb, ["background", "foreground"], {"foreground": {"detector": "truth"}}, on_frame=live)
+        instances = kb.instances()
+    live.close()
+    entities = _read_rrd(out)
+    assert len(entities["/robot/camera"]["stamps_s"]) == 60
+    assert len(entities["/robot/camera/image/rgb"]["stamps_s"]) == 15
+    assert {"background", "foreground"} == {i.layer for i in instances}
+    for inst in instances:
+        assert entity_path(inst.layer, inst.class_name, inst.uuid) in entities
+    people = [p for p in entities if p.startswith("/foreground/person/")]
+    assert people and any("Clear:is_recursive" in entities[p]["columns"] for p in people)

@@ -23,7 +23,7 @@ from hiper_cli.types import Frame
 from hiper_cli.view.scene import TimeWindow
 from hiper_cli.view.style import IMAGE_PATH, class_color
 
-__all__ = ["FrameOverlay", "log_frames", "pick_frames"]
+__all__ = ["FrameOverlay", "log_frame_images", "log_frames", "overlay_of", "pick_frames"]
 
 # Observations of a frame carry the frame's stamp exactly; this absorbs float printing.
 _STAMP_TOL_S = 1e-6
@@ -55,7 +55,8 @@ def pick_frames(stamps_s: NDArray[np.float64], window: TimeWindow, image_hz: flo
     return picked
 
 
-def _overlay(docs: list[dict[str, Any]]) -> FrameOverlay:
+def overlay_of(docs: list[dict[str, Any]]) -> FrameOverlay:
+    """The overlay of a frame from its observation documents."""
     boxes, labels, box_cls = [], [], []
     blobs: list[NDArray[np.float64]] = []
     blob_cls: list[str] = []
@@ -86,7 +87,8 @@ def _colors(classes: tuple[str, ...]) -> NDArray[np.uint8]:
     return np.array([class_color(c) for c in classes], dtype=np.uint8).reshape(-1, 3)
 
 
-def _log_frame(rr: Any, rec: Any, frame: Frame, overlay: FrameOverlay, jpeg_quality: int) -> None:
+def log_frame_images(rr: Any, rec: Any, frame: Frame, overlay: FrameOverlay, jpeg_quality: int = 85) -> None:
+    """Log one frame's images and overlay at the recording's current time."""
     import cv2
 
     ok, jpeg = cv2.imencode(".jpg", frame.rgb[:, :, ::-1], [cv2.IMWRITE_JPEG_QUALITY, jpeg_quality])
@@ -117,5 +119,5 @@ def log_frames(rec: Any, set_time: Any, reader: LogReader, kb: KnowledgeBase, wi
         docs = kb.docs.find(type="observation", t_start_s=frame.stamp_s - _STAMP_TOL_S,
                             t_end_s=frame.stamp_s + _STAMP_TOL_S)
         set_time(frame.stamp_s)
-        _log_frame(rr, rec, frame, _overlay(docs), jpeg_quality)
+        log_frame_images(rr, rec, frame, overlay_of(docs), jpeg_quality)
     return len(picked)

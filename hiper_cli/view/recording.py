@@ -25,13 +25,13 @@ from hiper_cli.view.floor import FloorImage
 from hiper_cli.view.scene import BackgroundItem, TrackItem, ViewScene
 from hiper_cli.view.style import CAMERA_PATH, IMAGE_PATH, ROBOT_PATH, class_color, entity_path, speed_colors
 
-__all__ = ["INSTALL_HINT", "TIMELINE", "RecordingConfig", "Timeline", "import_rerun", "new_recording",
-           "write_scene"]
+__all__ = ["INSTALL_HINT", "TIMELINE", "RecordingConfig", "Timeline", "import_rerun", "log_pinhole",
+           "new_recording", "quat_xyzw", "write_scene"]
 
 TIMELINE = "stamp"
 INSTALL_HINT = "pip install 'hiper[view]'"
 # Stamps above this are seconds since 1970 (wall-clock logs), below it seconds since the log began.
-_EPOCH_STAMP_S = 1e8
+EPOCH_STAMP_S = 1e8
 # A camera of 60° horizontal field of view, 4:3, when the recording has no log to take it from.
 DEFAULT_CAMERA = CameraIntrinsics(width=640, height=480, fx=554.3, fy=554.3, cx=319.5, cy=239.5)
 
@@ -90,7 +90,7 @@ class Timeline:
 
     def __init__(self, rr: Any, rec: Any, scene: ViewScene) -> None:
         self.rr, self.rec = rr, rec
-        self.kind = "timestamp" if scene.t_min_s > _EPOCH_STAMP_S else "duration"
+        self.kind = "timestamp" if scene.t_min_s > EPOCH_STAMP_S else "duration"
 
     def set(self, stamp_s: float) -> None:
         self.rec.set_time(TIMELINE, **{self.kind: float(stamp_s)})
@@ -99,7 +99,8 @@ class Timeline:
         return self.rr.TimeColumn(TIMELINE, **{self.kind: np.asarray(stamps_s, dtype=np.float64)})
 
 
-def _quat_xyzw(R: NDArray[np.float64]) -> NDArray[np.float64]:
+def quat_xyzw(R: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The rotation matrix as a quaternion (x, y, z, w), Rerun's order."""
     return np.asarray(Rotation.from_matrix(R).as_quat(), dtype=np.float64)
 
 
@@ -108,7 +109,7 @@ def _log_background(rr: Any, rec: Any, tl: Timeline, item: BackgroundItem, alpha
     color = (*class_color(item.class_name), alpha)
     tl.set(max(item.first_seen_s, t0))
     rec.log(path, rr.Boxes3D(centers=[item.box.center_m], half_sizes=[item.box.extent_m / 2.0],
-                             quaternions=[_quat_xyzw(item.box.R)], colors=[color], fill_mode="solid",
+                             quaternions=[quat_xyzw(item.box.R)], colors=[color], fill_mode="solid",
                              labels=[item.class_name], show_labels=False))
     if len(item.contour_map_m) >= 3:
         loop = np.vstack([item.contour_map_m, item.contour_map_m[:1]])
@@ -130,7 +131,7 @@ def _log_track(rr: Any, rec: Any, tl: Timeline, track: TrackItem, hold_s: float)
     boxes = rr.Boxes3D.columns(
         centers=track.centers_map_m,
         half_sizes=np.tile(track.box.extent_m / 2.0, (n, 1)),
-        quaternions=np.tile(_quat_xyzw(track.box.R), (n, 1)),
+        quaternions=np.tile(quat_xyzw(track.box.R), (n, 1)),
         colors=np.tile(np.array(color, dtype=np.uint8), (n, 1)),
         labels=[label] * n,
     )
@@ -152,14 +153,20 @@ def _log_track(rr: Any, rec: Any, tl: Timeline, track: TrackItem, hold_s: float)
             labels=[f"{label} {track.mean_speed_mps:.2f} m/s"] + [""] * (len(segments) - 1)))
 
 
+def log_pinhole(rr: Any, rec: Any, camera: CameraIntrinsics, frustum_m: float) -> None:
+    """The camera's intrinsics (static), drawn as a frustum ``frustum_m`` deep; and z up."""
+    rec.log("/", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    rec.log(IMAGE_PATH, rr.Pinhole(image_from_camera=camera.K, resolution=[camera.width, camera.height],
+                                   camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=frustum_m),
+            static=True)
+
+
 def _log_robot(rr: Any, rec: Any, tl: Timeline, scene: ViewScene, camera: CameraIntrinsics,
                frustum_m: float) -> None:
     strips = [r.T_map_cam[:, :3, 3] for r in scene.robot if len(r.stamps_s) >= 2]
     if strips:
         rec.log(ROBOT_PATH, rr.LineStrips3D(strips, colors=[(60, 60, 60)], radii=0.01), static=True)
-    rec.log(IMAGE_PATH, rr.Pinhole(image_from_camera=camera.K, resolution=[camera.width, camera.height],
-                                   camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=frustum_m),
-            static=True)
+    log_pinhole(rr, rec, camera, frustum_m)
     for robot in scene.robot:
         rec.send_columns(CAMERA_PATH, indexes=[tl.column(robot.stamps_s)],
                          columns=rr.Transform3D.columns(translation=robot.T_map_cam[:, :3, 3],
@@ -188,7 +195,6 @@ def write_scene(rec: Any, scene: ViewScene, camera: CameraIntrinsics | None = No
     rr = import_rerun()
     config = config or RecordingConfig()
     tl = Timeline(rr, rec, scene)
-    rec.log("/", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     t0 = scene.t_min_s
     for item in scene.background:
         _log_background(rr, rec, tl, item, config.background_alpha, t0)
