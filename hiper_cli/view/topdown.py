@@ -122,7 +122,10 @@ def _text(img: NDArray[np.uint8], text: str, at: tuple[int, int], color: tuple[i
           scale: float = 0.45) -> None:
     import cv2
 
-    cv2.putText(img, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, _WHITE, 3, cv2.LINE_AA)
+    # A white halo from shifted copies: a thicker stroke would widen the glyphs (OpenCV 5 fonts).
+    for du, dv in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        cv2.putText(img, text, (at[0] + du, at[1] + dv), cv2.FONT_HERSHEY_SIMPLEX, scale, _WHITE, 1,
+                    cv2.LINE_AA)
     cv2.putText(img, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, color, 1, cv2.LINE_AA)
 
 
