@@ -196,3 +196,33 @@ def test_live_view_streams_perception_as_it_runs(tmp_path):
         assert entity_path(inst.layer, inst.class_name, inst.uuid) in entities
     people = [p for p in entities if p.startswith("/foreground/person/")]
     assert people and any("Clear:is_recursive" in entities[p]["columns"] for p in people)
+
+
+def test_floor_images_read_the_forms_hiper_analyze_stores(tmp_path):
+    import base64
+    import zlib
+
+    occ = np.full((4, 6), -1, dtype=np.int8)
+    occ[1:3, 1:5] = 0
+    occ[0, :] = 100  # bottom row (y0) occupied
+    env = [{"map": {"resolution_m": 0.5, "origin_m": [-1.0, -2.0, 0.0], "width": 6, "height": 4,
+                    "encoding": "int8 rows bottom-up, zlib, base64",
+                    "cells": base64.b64encode(zlib.compress(occ.tobytes())).decode()}}]
+    heat = np.zeros((4, 6), dtype=np.uint8)
+    heat[3, 5] = 80  # top-right cell hot, 255 unknown
+    heat[0, 0] = 255
+    pgm = tmp_path / "heatmap_person_keepout.pgm"
+    cv2.imwrite(str(pgm), np.flipud(heat))  # map_server: row 0 at the top
+    docs = [{"kind": "heatmap", "class": "person", "t_start_s": 0, "t_end_s": 9, "created_s": 1,
+             "values": {"resolution_m": 0.5, "origin_m": [-1.0, -2.0, 0.0], "shape": [4, 6],
+                        "files": {"png": str(tmp_path / "x.png"), "keepout_pgm": str(pgm)}}},
+            {"kind": "heatmap", "class": "cup", "t_start_s": 0, "t_end_s": 9,
+             "values": {"resolution_m": 0.5, "origin_m": [0, 0], "files": {"keepout_pgm": "/gone.pgm"}}}]
+    heatmap, occupancy = floor_images(docs, env, TimeWindow())
+    assert (heatmap.name, occupancy.name) == ("heatmap/person", "occupancy")
+    assert heatmap.grid[3, 5] == 80 and np.isnan(heatmap.grid[0, 0]) and heatmap.grid.shape == (4, 6)
+    np.testing.assert_array_equal(occupancy.grid, occ)
+    assert occupancy.extent_m == (-1.0, 2.0, -2.0, 0.0)
+    rgba = occupancy.rgba()
+    assert rgba[0, 0, 3] > 100 > rgba[1, 1, 3] > 0 == rgba[3, 0, 3]  # occupied, free, unknown
+    assert heatmap.rgba()[3, 5, 3] == 220 and heatmap.rgba()[0, 0, 3] == 0 == heatmap.rgba()[1, 1, 3]

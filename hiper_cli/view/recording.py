@@ -174,14 +174,10 @@ def _log_robot(rr: Any, rec: Any, tl: Timeline, scene: ViewScene, camera: Camera
 
 
 def _log_floor(rr: Any, rec: Any, image: FloorImage, z_m: float) -> None:
-    """A grid as a textured quad on the floor (``/map/<name>``), turbo colours, red where it is high."""
-    import cv2
-
-    values = (image.normalised() * 255).astype(np.uint8)
-    rgb = cv2.applyColorMap(values, cv2.COLORMAP_TURBO)[:, :, ::-1]
-    rgba = np.dstack([rgb, np.where(values > 0, 200, 40).astype(np.uint8)])
+    """A grid as a textured quad on the floor (``/map/<name>``), in ``FloorImage.rgba`` colours."""
+    rgba = image.rgba()
     x0, x1, y0, y1 = image.extent_m
-    z = z_m + 0.01
+    z = z_m + (0.005 if image.kind == "occupancy" else 0.01)  # heatmaps over the map
     corners = [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]]
     # Texture row 0 is cell row 0, at y0: texcoord v runs with y.
     rec.log(f"/map/{image.name}", rr.Mesh3D(vertex_positions=corners, triangle_indices=[[0, 1, 2], [0, 2, 3]],

@@ -1,7 +1,7 @@
 """A top-down picture of a ``ViewScene`` (OpenCV, no Rerun): for the README and for reports.
 
-Drawn in the map's x-y plane, +y up: floor polygons filled, the floor images (heatmaps,
-occupancy) over them in the turbo colour map (cells of value 0 left out), walls and other
+Drawn in the map's x-y plane, +y up: the occupancy map in greys, floor polygons filled,
+heatmaps over them in the turbo colour map (faint cells left out), walls and other
 background planes as their footprint in the class colour, the robot's path in grey with its
 start and end, each foreground track as a polyline coloured by speed (thin grey across times it
 was not seen) with its last box footprint and a label (class, short uuid, and mean speed when
@@ -78,24 +78,22 @@ def _bounds(scene: ViewScene) -> tuple[NDArray[np.float64], NDArray[np.float64]]
     return allpts.min(axis=0), allpts.max(axis=0)
 
 
-def _floor_images(canvas: _Canvas, scene: ViewScene) -> None:
+def _floor_images(canvas: _Canvas, scene: ViewScene, occupancy: bool) -> None:
     import cv2 as _cv2
 
-    for image in scene.floor:
-        values = (image.normalised() * 255).astype(np.uint8)
+    for image in (f for f in scene.floor if (f.kind == "occupancy") == occupancy):
         x0, x1, y0, y1 = image.extent_m
         (u0, v1), (u1, v0) = canvas.px(np.array([[x0, y0], [x1, y1]]))
         if u1 <= u0 or v1 <= v0:
             continue
-        color = _cv2.applyColorMap(np.flipud(values), _cv2.COLORMAP_TURBO)
-        color = _cv2.resize(color, (u1 - u0, v1 - v0), interpolation=_cv2.INTER_NEAREST)
-        mask = _cv2.resize(np.flipud(values), (u1 - u0, v1 - v0), interpolation=_cv2.INTER_NEAREST) > 0
+        # Image rows run down, grid rows up (+y): flip, then BGR and alpha blending.
+        rgba = _cv2.resize(np.flipud(image.rgba()), (u1 - u0, v1 - v0), interpolation=_cv2.INTER_NEAREST)
         ua, va = max(u0, 0), max(v0, 0)
         ub, vb = min(u1, canvas.image.shape[1]), min(v1, canvas.image.shape[0])
         region = canvas.image[va:vb, ua:ub]
-        sub = color[va - v0 : vb - v0, ua - u0 : ub - u0]
-        m = mask[va - v0 : vb - v0, ua - u0 : ub - u0]
-        region[m] = (0.3 * region[m] + 0.7 * sub[m]).astype(np.uint8)
+        sub = rgba[va - v0 : vb - v0, ua - u0 : ub - u0]
+        a = sub[:, :, 3:4].astype(np.float64) / 255.0
+        region[:] = (region * (1 - a) + sub[:, :, 2::-1] * a).astype(np.uint8)
 
 
 def _grid(canvas: _Canvas) -> None:
@@ -136,6 +134,7 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
     config = config or TopDownConfig()
     canvas = _Canvas(*_bounds(scene), config)
     img = canvas.image
+    _floor_images(canvas, scene, occupancy=True)
     _grid(canvas)
     floors = [b for b in scene.background if b.class_name == "floor"]
     for item in floors:
@@ -143,7 +142,7 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
         layer = img.copy()
         cv2.fillPoly(layer, [canvas.px(poly)], _bgr(class_color("floor")))
         img[:] = cv2.addWeighted(layer, 0.5, img, 0.5, 0)
-    _floor_images(canvas, scene)
+    _floor_images(canvas, scene, occupancy=False)
     for item in scene.background:
         if item.class_name == "floor":
             continue
