@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from hiper_cli.cli import app
 from hiper_cli.graph import open_kb, open_kb_for_reading
 from hiper_cli.model import Analysis
-from hiper_cli.pipeline import perceive
+from hiper_cli.pipeline import PerceiveOptions, perceive_log
 from hiper_cli.view import TimeWindow, ViewRequest, load_scene, render_view
 from hiper_cli.view.camera import pick_frames
 from hiper_cli.view.floor import floor_images
@@ -27,14 +27,15 @@ ROOT = Path(__file__).resolve().parents[1]
 LOG = ROOT / "fixtures" / "house_small"
 # Pictures the tests draw, kept for a person to look at (out/ is not committed).
 OUTPUT = ROOT / "out" / "test-output" / "view"
+TRUTH = PerceiveOptions(stages=("background", "foreground"),
+                        stage_options={"foreground": {"detector": "truth"}})
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
 def kb_dir(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("view") / "house.hiper"
-    with open_kb(path) as kb:
-        perceive(LOG, kb, ["background", "foreground"], {"foreground": {"detector": "truth"}})
+    perceive_log(LOG, str(path), options=TRUTH)
     return path
 
 
@@ -184,10 +185,10 @@ def test_live_view_streams_perception_as_it_runs(tmp_path):
 
     out = tmp_path / "live.rrd"
     live = LiveView.open(out=out, image_hz=1.0)
-    with open_kb(tmp_path / "live.hiper") as kb:
-        perceive(LOG, kb, ["background", "foreground"], {"foreground": {"detector": "truth"}}, on_frame=live)
-        instances = kb.instances()
+    perceive_log(LOG, str(tmp_path / "live.hiper"), options=TRUTH, on_frame=live)
     live.close()
+    with open_kb_for_reading(tmp_path / "live.hiper") as kb:
+        instances = kb.instances()
     entities = _read_rrd(out)
     assert len(entities["/robot/camera"]["stamps_s"]) == 60
     assert len(entities["/robot/camera/image/rgb"]["stamps_s"]) == 15

@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._render import JSON_OPTION, console, print_json
-from hiper_cli.commands.perceive import KB_HELP
+from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbOption
+from hiper_cli.commands._render import console, print_json
 
 __all__ = ["register"]
 
@@ -17,7 +17,7 @@ LOG_HELP = "The sensor log: the RGB, depth and overlays of its frames."
 
 
 def view_command(
-    kb: Annotated[str, Opt("--kb", help=KB_HELP)] = "scene.hiper",
+    kb: KbOption = DEFAULT_KB,
     log: Annotated[Path | None, Opt("--log", help=LOG_HELP)] = None,
     start_s: Annotated[float | None, Opt("--from", help="First log stamp to show, seconds.")] = None,
     end_s: Annotated[float | None, Opt("--to", help="Last log stamp to show, seconds.")] = None,

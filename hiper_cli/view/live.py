@@ -14,8 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from hiper_cli.model import Instance
-from hiper_cli.perceive.stage import FrameResult
+from hiper_cli.model import FrameResult, Instance
 from hiper_cli.types import Frame
 from hiper_cli.view.camera import log_frame_images, overlay_of
 from hiper_cli.view.recording import EPOCH_STAMP_S, import_rerun, log_pinhole, new_recording, quat_xyzw
