@@ -227,3 +227,25 @@ def test_floor_images_read_the_forms_hiper_analyze_stores(tmp_path):
     rgba = occupancy.rgba()
     assert rgba[0, 0, 3] > 100 > rgba[1, 1, 3] > 0 == rgba[3, 0, 3]  # occupied, free, unknown
     assert heatmap.rgba()[3, 5, 3] == 220 and heatmap.rgba()[0, 0, 3] == 0 == heatmap.rgba()[1, 1, 3]
+
+
+def test_perceive_view_streams_to_rerun_and_says_how_to_install(tmp_path, monkeypatch):
+    pytest.importorskip("rerun", reason="rerun-sdk (the hiper[view] extra) is not installed")
+    from hiper_cli.view import live as live_module
+
+    out = tmp_path / "watched.rrd"
+    opened = []
+
+    def open_to_file(**kwargs):  # no display here: the viewer's stream goes to a file instead
+        opened.append(kwargs)
+        return live_module.LiveView(live_module.new_recording(out, False, with_images=True))
+
+    monkeypatch.setattr(live_module.LiveView, "open", staticmethod(open_to_file))
+    args = ["perceive", str(LOG), "--kb", str(tmp_path / "w.hiper"), "--detector", "truth", "--json"]
+    result = runner.invoke(app, [*args, "--view"])
+    assert result.exit_code == 0, result.output
+    assert opened == [{"spawn": True}]
+    assert len(_read_rrd(out)["/robot/camera"]["stamps_s"]) == 60
+    monkeypatch.setitem(sys.modules, "rerun", None)
+    result = runner.invoke(app, [*args[:3], str(tmp_path / "x.hiper"), *args[4:], "--view"])
+    assert result.exit_code == 2 and "pip install 'hiper[view]'" in result.output
