@@ -143,12 +143,14 @@ def perceive_log(
     kb_docs: Path | None = None,
     progress: Progress | None = None,
     on_start: Callable[[int], None] | None = None,
+    on_frame: Callable[[Frame | None, FrameResult], None] | None = None,
 ) -> PerceiveSummary:
     """``hiper perceive`` in one call: open ``log``, build the stages, ``perceive`` into ``kb``.
 
     ``kb`` is a knowledge base location (see ``open_kb``; ``kb_docs`` its documents directory
     for an http:// endpoint). The log is opened and the stages built first, so bad options
-    leave no knowledge base behind. ``on_start(total_frames)`` is called before the first frame.
+    leave no knowledge base behind. ``on_start(total_frames)`` is called before the first frame,
+    ``on_frame`` as in ``perceive``.
     """
     from hiper_cli.graph import open_kb
 
@@ -160,7 +162,7 @@ def perceive_log(
     with open_kb(kb, docs_dir=kb_docs) as knowledge:
         if on_start is not None:
             on_start(len(reader))
-        return perceive(reader, knowledge, stages, options, progress=progress)
+        return perceive(reader, knowledge, stages, options, progress=progress, on_frame=on_frame)
 
 
 @dataclass
@@ -280,13 +282,16 @@ def perceive(
     options: PerceiveOptions | None = None,
     *,
     progress: Progress | None = None,
+    on_frame: Callable[[Frame | None, FrameResult], None] | None = None,
 ) -> PerceiveSummary:
     """Run ``stages`` over the frames of ``reader`` and store everything in ``kb``.
 
     ``stages``: built stages, or a ``StageSet`` from ``select_stages`` (whose unavailable
     stages the summary reports). ``options.log_path`` names the log in the session (default:
     the reader's path); ``options.env_name`` the environment (default: the log folder's name).
-    ``progress(done, total)`` is called after every frame.
+    ``progress(done, total)`` is called after every frame. ``on_frame(frame, result)`` after
+    each frame is written (and with ``frame=None`` for what the stages flush at the end), e.g.
+    ``hiper_cli.view.live.LiveView`` to watch the run in Rerun.
     """
     options = options or PerceiveOptions()
     if isinstance(stages, StageSet):
@@ -331,7 +336,9 @@ def perceive(
                 continue
             yield frame
 
-    def on_frame(frame: Frame | None, result: FrameResult) -> None:
+    hook = on_frame
+
+    def write(frame: Frame | None, result: FrameResult) -> None:
         nonlocal last_sync
         if frame is None:
             kb.write_frame(current, result)
@@ -350,11 +357,13 @@ def perceive(
             last_sync = time.perf_counter()
         if progress is not None and frame is not None:
             progress(summary.frames_already_done + summary.frames_read, total)
+        if hook is not None:
+            hook(frame, result)
 
     start = time.perf_counter()
     # Frames are read and decoded one thread ahead (decoding releases the interpreter lock):
     # with the `truth` or `log` detector the second core decodes while this one perceives.
-    world, stats = run_stages(prefetch(frames()), stage_list, world, on_frame)
+    world, stats = run_stages(prefetch(frames()), stage_list, world, write)
     kb.end_session(current)
     t0 = time.perf_counter()
     kb.sync_graph()

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's demo: the main job end to end on the built-in example log, into an embedded
-# knowledge base (out/demo.hiper), then what it knows.
+# knowledge base (out/demo.hiper), then what it knows, as tables, JSON, a picture and a Rerun
+# recording (out/demo.png, out/demo.rrd).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${1:-.venv}"
@@ -26,3 +27,11 @@ set -x
 "$HIPER" kb info --kb "$KB"
 "$HIPER" kb check --kb "$KB"
 "$HIPER" export out/demo.json --kb "$KB"
+"$HIPER" view --kb "$KB" --png out/demo.png                 # top-down picture (docs/view.md)
+set +x
+if "$VENV/bin/python" -c "import rerun" 2>/dev/null; then
+  set -x
+  "$HIPER" view --kb "$KB" --log "$LOG" -o out/demo.rrd     # open with: rerun out/demo.rrd
+else
+  echo "demo: no Rerun recording (pip install 'hiper[view]' for out/demo.rrd)"
+fi

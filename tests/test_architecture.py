@@ -13,7 +13,7 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "hiper_cli"
 
 _UI = ("hiper_cli.commands", "hiper_cli.cli", "typer", "rich")
 _ABOVE_PERCEIVE = ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
-                   "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate")
+                   "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", "hiper_cli.view")
 _CORE_FORBIDDEN = ("hiper_cli.perceive", *_ABOVE_PERCEIVE, *_UI)
 
 # package (folder) or module (file stem) -> prefixes its modules may not import
@@ -23,18 +23,22 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     "model": _CORE_FORBIDDEN,
     "errors": _CORE_FORBIDDEN,
     # recognition: log readers (the simulator's truth format included), stages, detectors
-    "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib"),
+    "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib", "rerun"),
     # the knowledge base stores what perceive produced
     "graph": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.serve", "hiper_cli.pipeline",
-              "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+              "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", "hiper_cli.view", *_UI, "rerun"),
     # interpretation of a knowledge base
-    "analyze": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim", *_UI),
+    "analyze": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+                "hiper_cli.view", *_UI, "rerun"),
+    # hiper view: draws what a KB holds (perceive types, graph), after graph; never the CLI
+    "view": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+             "hiper_cli.evaluate", *_UI),
     # questions over perceive types, the graph and the analyses
     "query": ("hiper_cli.serve", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
-              "hiper_cli.evaluate", *_UI),
+              "hiper_cli.evaluate", "hiper_cli.view", *_UI),
     # the SPARQL endpoint over a knowledge base's graph
     "serve": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
-              "hiper_cli.evaluate", *_UI),
+              "hiper_cli.evaluate", "hiper_cli.view", *_UI),
     # the simulator writes logs (perceive.logs writers), never reads a knowledge base
     "sim": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
             "hiper_cli.reanchor", "hiper_cli.evaluate", *_UI),
@@ -95,3 +99,11 @@ def test_query_rule_allows_what_it_builds_on():
         assert not allowed.startswith(FORBIDDEN["query"])
     for denied in ("hiper_cli.commands._common", "hiper_cli.cli", "typer", "rich.table"):
         assert denied.startswith(FORBIDDEN["query"])
+
+
+def test_view_rule_allows_what_it_draws_from():
+    """hiper view reads perceive types and the graph, and is itself imported by no stage below it."""
+    for allowed in ("hiper_cli.perceive.logs", "hiper_cli.graph", "hiper_cli.model", "rerun"):
+        assert not allowed.startswith(FORBIDDEN["view"])
+    for below in ("perceive", "graph", "analyze", "query"):
+        assert "hiper_cli.view".startswith(FORBIDDEN[below])

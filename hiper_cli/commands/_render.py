@@ -18,8 +18,10 @@ __all__ = ["JSON_OPTION", "HiperTyper", "console", "frame_progress", "group", "p
 def print_error(message: str) -> None:
     """One red line on stderr."""
     from rich.console import Console
+    from rich.markup import escape
 
-    Console(stderr=True, highlight=False, soft_wrap=True).print(f"[bold red]error:[/] {message}")
+    # Escaped: a message such as "pip install 'hiper[view]'" keeps its brackets.
+    Console(stderr=True, highlight=False, soft_wrap=True).print(f"[bold red]error:[/] {escape(message)}")
 
 
 def print_json(data: Any) -> None:

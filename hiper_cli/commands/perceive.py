@@ -32,6 +32,8 @@ Options = Annotated[list[str] | None, typer.Option(
     "-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable).")]
 Resume = Annotated[bool, typer.Option("--resume", help="Continue the unfinished session of this log.")]
 Env = Annotated[Text, typer.Option("--env", help="Environment name (default: the log folder's name).")]
+View = Annotated[bool, typer.Option(
+    "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Log = Annotated[Path, typer.Argument(help="Sensor log: TUM folder, .bag, rosbag2 folder or .mcap.")]
 
 
@@ -39,7 +41,8 @@ def perceive_command(
     log: Log, kb: KbOption = DEFAULT_KB, kb_docs: KbDocsOption = None, stages: Stages = None,
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
-    resume: Resume = False, env: Env = None, as_json: bool = JSON_OPTION, *, log_options: LogOptions,
+    resume: Resume = False, env: Env = None, view: View = False, as_json: bool = JSON_OPTION, *,
+    log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
@@ -57,9 +60,16 @@ def perceive_command(
         stages=stages, options=option or [], env_name=env, resume=resume,
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     out = console()
+    live = None
+    if view:  # without --view nothing of hiper_cli.view is imported or run
+        from hiper_cli.view.live import LiveView
+
+        live = LiveView.open(spawn=True)
     with frame_progress("perceive", out, enabled=not as_json) as bar:
-        summary = perceive_log(log, kb, log_options, options, kb_docs=kb_docs,
+        summary = perceive_log(log, kb, log_options, options, kb_docs=kb_docs, on_frame=live,
                                on_start=bar.start if bar else None, progress=bar.update if bar else None)
+    if live is not None:
+        live.close()
     if as_json:
         print_json(summary.to_dict())
     else:
