@@ -60,11 +60,11 @@ COUNT = Range(0, 1 << 31, integer=True)
 
 OPTION_RANGES: dict[str, Range] = {
     # camera and log flags (hiper info / perceive / convert)
-    "fx": Range(0.0, 1e6, lo_open=True), "fy": Range(0.0, 1e6, lo_open=True),
-    "cx": Range(0.0, 1e5), "cy": Range(0.0, 1e5),
-    "width": PIXELS, "height": PIXELS,
+    "fx_px": Range(0.0, 1e6, lo_open=True), "fy_px": Range(0.0, 1e6, lo_open=True),
+    "cx_px": Range(0.0, 1e5), "cy_px": Range(0.0, 1e5),
+    "width": PIXELS, "height": PIXELS, "width_px": PIXELS, "height_px": PIXELS,
     "depth_scale": Range(1e-3, 1e7),
-    "max_dt": Range(0.0, 60.0, lo_open=True), "max_dt_s": Range(0.0, 60.0),
+    "max_dt_s": Range(0.0, 60.0),
     "mapping_hz": Range(0.0, 1000.0, lo_open=True), "keyframe_hz": Range(0.0, 1000.0, lo_open=True),
     # hiper sim
     "seconds": Range(0.0, 24 * 3600.0, lo_open=True), "rate_hz": Range(0.0, 1000.0, lo_open=True),
@@ -88,17 +88,19 @@ def _flag(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def check_options(values: Mapping[str, Any]) -> None:
+def check_options(values: Mapping[str, Any], flags: Mapping[str, str] | None = None) -> None:
     """Check every number among a command's keyword arguments: finite, and in its range when
-    ``OPTION_RANGES`` knows the option."""
+    ``OPTION_RANGES`` knows the option. ``flags`` maps parameter names to the flags the user
+    types (default ``--name-with-dashes``)."""
     for name, value in values.items():
         if isinstance(value, bool) or not isinstance(value, int | float):
             continue
+        flag = (flags or {}).get(name) or _flag(name)
         allowed = OPTION_RANGES.get(name)
         if allowed is not None:
-            check_number(_flag(name), value, allowed)
+            check_number(flag, value, allowed)
         elif not (math.isfinite(float(value)) and abs(float(value)) <= MAX_MAGNITUDE):
-            raise ConfigError(f"{_flag(name)} {value!r}: expected a finite number of at most "
+            raise ConfigError(f"{flag} {value!r}: expected a finite number of at most "
                               f"{MAX_MAGNITUDE:g}")
 
 
@@ -120,6 +122,8 @@ def _coerce(where: str, value: Any, kind: Any) -> Any:
     if kind is bool:
         if isinstance(value, bool):
             return value
+        if isinstance(value, int) and value in (0, 1):
+            return bool(value)
         if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
             return value.lower() in ("true", "1", "yes")
         raise ConfigError(f"{where}={value!r}: expected true or false")

@@ -35,7 +35,7 @@ def _numeric_options() -> list[tuple[str, str]]:
 
 def test_every_numeric_option_has_a_range():
     options = _numeric_options()
-    assert ("sim", "seconds") in options and ("perceive", "fx") in options
+    assert ("sim", "seconds") in options and ("perceive", "fx_px") in options
     missing = sorted({name for _, name in options if name not in OPTION_RANGES})
     assert not missing, f"numeric options without a range in hiper_cli.validate.OPTION_RANGES: {missing}"
 
@@ -44,8 +44,8 @@ def test_every_numeric_option_has_a_range():
     ("seconds", math.inf, r"--seconds inf: expected a finite number in \(0, 86400\]"),
     ("rate_hz", math.nan, "--rate-hz nan"),
     ("seed", -1, r"--seed -1: expected an integer in \[0, 4.29497e\+09\]"),
-    ("fx", 1e308, "--fx 1e"),
-    ("cx", -1e9, "--cx -1"),
+    ("fx_px", 1e308, "--fx-px 1e"),
+    ("cx_px", -1e9, "--cx-px -1"),
     ("depth_scale", 1e-300, "--depth-scale 1e-300"),
     ("false_positives", 1e9, "--false-positives"),
     ("obs_per_frame", 0, "--obs-per-frame 0"),

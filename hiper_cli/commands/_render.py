@@ -34,6 +34,23 @@ def console() -> Any:
     return Console(highlight=False)
 
 
+def _flag_names(func: Any) -> dict[str, str]:
+    """Parameter name -> the long flag the user types (``fx_px`` -> ``--fx``)."""
+    import inspect
+
+    try:
+        parameters = inspect.signature(func, eval_str=True).parameters
+    except (NameError, TypeError):
+        parameters = inspect.signature(func).parameters
+    out: dict[str, str] = {}
+    for name, p in parameters.items():
+        for info in (p.default, *getattr(p.annotation, "__metadata__", ())):
+            decls = [d for d in getattr(info, "param_decls", None) or () if isinstance(d, str)]
+            if decls:
+                out[name] = next((d for d in decls if d.startswith("--")), decls[0])
+    return out
+
+
 class HiperTyper(typer.Typer):
     """A Typer whose commands check their numeric options (``hiper_cli.validate``) and turn
     ``HiperError`` into one red line and its exit code.
@@ -51,10 +68,12 @@ class HiperTyper(typer.Typer):
             from hiper_cli.errors import HiperError
             from hiper_cli.validate import check_options
 
+            flags = _flag_names(func)
+
             @functools.wraps(func)
             def guarded(*f_args: Any, **f_kwargs: Any) -> Any:
                 try:
-                    check_options(f_kwargs)  # every number, where the command line is parsed
+                    check_options(f_kwargs, flags)  # every number, where the command line is parsed
                     return func(*f_args, **f_kwargs)
                 except HiperError as err:
                     print_error(str(err))

@@ -30,7 +30,8 @@ Exclude = Annotated[Text, typer.Option("--exclude-classes", help=(
 MappingHz = Annotated[float | None, typer.Option("--mapping-hz", help="Background keyframe rate in Hz.")]
 Options = Annotated[list[str] | None, typer.Option(
     "-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable).")]
-Resume = Annotated[bool, typer.Option("--resume", help="Redo the interrupted session of this log in its place.")]
+Resume = Annotated[bool, typer.Option(
+    "--resume", help="Redo the interrupted session of this log in its place.")]
 Replace = Annotated[bool, typer.Option(
     "--replace", help="Drop this log's earlier session (one transaction), then perceive it again.")]
 Again = Annotated[bool, typer.Option(

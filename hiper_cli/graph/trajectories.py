@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from hiper_cli.graph.codec import dumps, loads
-from hiper_cli.model import ROW_POSITION, ROW_STAMP
 from hiper_cli.graph.sqlite_guard import GuardedConnection
+from hiper_cli.model import ROW_POSITION, ROW_STAMP
 
 __all__ = ["CHUNK_ROWS", "INLINE_ROWS", "SCHEMA", "TrajectoryStore"]
 
