@@ -260,26 +260,40 @@ def _verify(case: Any, ws: Workspace, result: Result, totals: dict[str, Any],
     return problems
 
 
+def _kill_command(kind: str, ws: Workspace) -> list[str]:
+    """The command of a kill case, its inputs set up in ``ws``."""
+    values = ws.values()
+    if kind == "perceive":
+        return ["perceive", values["log"], "--kb", values["kb"], "--detector", "truth", "--json"]
+    if kind == "export":
+        shutil.copytree(ws.cache / "template.hiper", ws.kb)
+        shutil.copy(ws.cache / "export.json", ws.root / "out.json")
+        return ["export", str(ws.root / "out.json"), "--kb", values["kb"], "--format", "json",
+                "--observations"]
+    return ["import", values["export"], "--kb", values["kb"]]
+
+
+def _duration(kind: str, repo: Path, cache: Path) -> float:
+    """Seconds an uninterrupted run of the kill case's command takes here (measured once)."""
+    timing = cache / f"duration-{kind}.txt"
+    if not timing.is_file():
+        with tempfile.TemporaryDirectory(prefix="hiper-time-") as tmp:
+            ws = Workspace(Path(tmp), cache, repo)
+            result = run_hiper(repo, _kill_command(kind, ws), ws.root, 300.0)
+        timing.write_text(str(result.seconds))
+    return float(timing.read_text())
+
+
 def kill_case(kind: str, index: int, repo: Path, cache: Path, totals: dict[str, Any]) -> Outcome:
     """Start a perceive, export or import, kill -9 it at a random instant, and check that the
     knowledge base reopens consistent with nothing committed lost, and that an export target
     holds either the earlier export or a complete new one."""
     rng = random.Random(f"{kind}-{index}")
+    # a random instant of the run's second half or so (the first ~0.4 s is Python starting)
+    delay = rng.uniform(0.3, 0.95) * _duration(kind, repo, cache)
     with tempfile.TemporaryDirectory(prefix="hiper-kill-") as tmp:
         ws = Workspace(Path(tmp), cache, repo)
-        values = ws.values()
-        if kind == "perceive":
-            args = ["perceive", values["log"], "--kb", values["kb"], "--detector", "truth", "--json"]
-            delay = rng.uniform(0.3, 5.0)
-        elif kind == "export":
-            shutil.copytree(cache / "template.hiper", ws.kb)
-            shutil.copy(cache / "export.json", ws.root / "out.json")
-            args = ["export", str(ws.root / "out.json"), "--kb", values["kb"], "--format", "json",
-                    "--observations"]
-            delay = rng.uniform(0.2, 2.0)
-        else:
-            args = ["import", values["export"], "--kb", values["kb"]]
-            delay = rng.uniform(0.2, 2.0)
+        args = _kill_command(kind, ws)
         proc = subprocess.Popen(hiper_argv(repo, args), cwd=ws.root, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.PIPE, text=True, start_new_session=True)
         start = time.monotonic()
