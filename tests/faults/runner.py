@@ -333,7 +333,7 @@ def summarise(outcomes: Sequence[Outcome]) -> dict[str, int]:
     return {
         "cases": len(outcomes),
         "passed": verdicts.count("pass"),
-        "clean_errors": sum(o.clean_error for o in outcomes),
+        "clean_errors": sum(o.clean_error for o in outcomes if o.group != "kill"),
         "tracebacks": verdicts.count("traceback"),
         "hangs": verdicts.count("hang"),
         "data_loss": verdicts.count("data loss"),
