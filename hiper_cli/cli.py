@@ -55,26 +55,24 @@ _register_commands()
 
 
 def main() -> None:
-    """Entry point of the ``hiper`` script: one red line and a non-zero exit on HiperError."""
+    """Entry point of the ``hiper`` script: one red line and a non-zero exit on ``HiperError``;
+    a usage error prints the command's usage line and one red line with a hint, exit code 2."""
+    from hiper_cli.commands._render import is_usage_error, print_error, print_usage_error
+
     try:
         # In non-standalone mode click returns the code of a typer.Exit instead of raising it.
         code = app(standalone_mode=False)
         if isinstance(code, int) and code != 0:
             sys.exit(code)
     except HiperError as err:
-        from hiper_cli.commands._render import print_error
-
         print_error(str(err))
         sys.exit(err.exit_code)
     except typer.Exit as exc:
         sys.exit(exc.exit_code)
-    except typer.Abort:
+    except (typer.Abort, KeyboardInterrupt):
         print("Aborted.", file=sys.stderr)
         sys.exit(130)
-    except Exception as exc:  # click usage errors arrive here in non-standalone mode
-        import click
-
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            sys.exit(exc.exit_code)
-        raise
+    except Exception as exc:  # click's usage errors arrive here in non-standalone mode
+        if not is_usage_error(exc):
+            raise
+        sys.exit(print_usage_error(exc))

@@ -10,6 +10,7 @@ from __future__ import annotations
 __all__ = [
     "ConfigError",
     "DataError",
+    "GraphDamagedError",
     "HiperError",
     "KnowledgeBaseError",
     "LogError",
@@ -40,6 +41,10 @@ class LogError(HiperError):
 
 class KnowledgeBaseError(HiperError):
     """The knowledge base cannot be opened, written or is inconsistent."""
+
+
+class GraphDamagedError(KnowledgeBaseError):
+    """The scene graph cannot be opened or read; it is derived data, rebuilt by ``hiper kb check``."""
 
 
 class PerceptionError(HiperError):

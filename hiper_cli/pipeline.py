@@ -2,8 +2,9 @@
 
 The pipeline owns the ``World``. Every frame's merged ``FrameResult`` (observations, upserted
 and deleted instances) is written in one transaction together with the frame's pose row and
-the session's progress, so a crash loses at most the frame in flight and ``resume``
-continues after the last committed frame of the unfinished session of the same log. The scene
+the session's progress, so a crash loses at most the frame in flight; ``resume`` redoes the
+unfinished session of the same log in its place. Perceiving a log the environment already
+holds with the same stages is refused unless asked for (``on_existing``). The scene
 graph follows the documents every ``graph_sync_s`` seconds and at the end (see ``graph.kb``).
 
 Each run is a session of an environment (default: the log folder's name); the environment's
@@ -76,14 +77,20 @@ class PerceiveOptions:
     that are not available are then dropped, not errors). ``stage_options``: per stage, the
     keyword options of its factory, e.g. ``{"foreground": {"detector": "truth"}}``
     (``parse_stage_options`` reads them from ``-o STAGE.KEY=VALUE``). ``env_name``: the
-    environment (default: the log folder's name). ``resume``: continue the unfinished session
-    of this log. ``log_path`` names the log in the session (default: the reader's path).
+    environment (default: the log folder's name). ``resume``: redo the interrupted session of
+    this log in its place (from its first frame: the trackers' state is not stored, so
+    continuing mid-log would split tracks; this gives the instances of an uninterrupted run).
+    ``on_existing``: what to do with a log the environment holds already with the same stages:
+    ``refuse``, ``replace`` (drop that session's data first, one transaction) or ``again`` (a
+    new session on purpose). ``log_path`` names the log in the session (default: the reader's
+    path).
     """
 
     stages: tuple[str, ...] | None = None
     stage_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     env_name: str | None = None
     resume: bool = False
+    on_existing: str = "refuse"
     log_path: Path | None = None
     graph_sync_s: float = DEFAULT_GRAPH_SYNC_S
 
@@ -96,6 +103,7 @@ class PerceiveOptions:
         overrides: Mapping[str, Mapping[str, Any]] | None = None,
         env_name: str | None = None,
         resume: bool = False,
+        on_existing: str = "refuse",
     ) -> PerceiveOptions:
         """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
 
@@ -108,7 +116,8 @@ class PerceiveOptions:
                 if value is not None:
                     merged.setdefault(stage, {})[key] = value
         names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
-        return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume)
+        return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume,
+                   on_existing=on_existing)
 
 
 @dataclass(frozen=True)
@@ -123,6 +132,10 @@ def select_stages(log_path: Path, options: PerceiveOptions) -> StageSet:
     """Build the stages ``options`` asks for; ``ConfigError`` when none can run."""
     stage_options = options.stage_options
     if options.stages is None:
+        unknown = sorted(set(stage_options) - set(STAGES))
+        if unknown:
+            raise ConfigError(f"-o {unknown[0]}.…: no stage {unknown[0]!r}; expected one of "
+                              f"{', '.join(STAGES)}")
         ok, _ = available_stages()
         stage_options = {k: v for k, v in stage_options.items() if k in ok}
     built, unavailable = build_stages(options.stages, log_path, stage_options)
@@ -302,26 +315,14 @@ def perceive(
     path = Path(options.log_path if options.log_path is not None else reader.info().path).resolve()
     env = kb.environment(env_name or path.stem or path.name)
     names = [s.name for s in stage_list]
-    session: Session | None = None
-    after_pose: int | None = None
-    if resume:
-        session = kb.resumable_session(env, str(path))
-        if session is None:
-            past = [s for s in kb.sessions(env.uuid) if s.log_path == str(path)]
-            if past:
-                raise KnowledgeBaseError(
-                    f"{path}: nothing to resume, its last session ({past[-1].id}) in environment "
-                    f"{env.name!r} of {kb.location} finished; run without --resume to perceive it again"
-                )
-        else:
-            after_pose = session.last_pose_id
-    if session is None:
-        session = kb.start_session(env, str(path), names)
+    _check_log_fits(reader, stage_list, path)
+    session = _session_for(kb, env, str(path), names,
+                           on_existing="resume" if resume else options.on_existing)
     world = kb.load_world(env)
     total = len(reader)
     summary = PerceiveSummary(
         log=str(path), kb=kb.location, environment=env.name, session_id=session.id, stages=names,
-        resumed_after_pose_id=after_pose if resume else None, frames_total=total,
+        resumed_after_pose_id=None, frames_total=total,
         unavailable_stages=unavailable_stages,
     )
     obs_counts: Counter[tuple[str, str]] = Counter()
@@ -329,12 +330,7 @@ def perceive(
     current = session
 
     def frames() -> Iterator[Frame]:
-        # Runs in the reading thread (``prefetch``): the only writer of frames_already_done.
-        for frame in reader:
-            if after_pose is not None and frame.pose_id <= after_pose:
-                summary.frames_already_done += 1
-                continue
-            yield frame
+        yield from reader
 
     hook = on_frame
 
@@ -378,3 +374,43 @@ def perceive(
     summary.instances = _layer_class_counts(inst_counts)
     summary.stage_mean_s = {k: sum(v) / len(v) for k, v in stats.stage_times_s.items() if v}
     return summary
+
+
+ON_EXISTING = ("refuse", "replace", "again", "resume")
+
+
+def _check_log_fits(log: Any, stages: Sequence[Stage], path: Path) -> None:
+    """Refuse, before a session is started, stages the log cannot feed."""
+    if any(getattr(s, "needs_log_detections", False) for s in stages) and not log.info().has_detections:
+        raise ConfigError(f"{path}: the log holds no detections, so --detector log has nothing to read; "
+                          "pick another detector (yolox, truth, onnx:PATH)")
+
+
+def _session_for(kb: KnowledgeBase, env: Any, log_path: str, names: list[str], *,
+                 on_existing: str) -> Session:
+    """The session to perceive ``log_path`` into, by ``on_existing`` (see ``perceive``)."""
+    if on_existing not in ON_EXISTING:
+        raise ConfigError(f"on_existing {on_existing!r}; expected one of {', '.join(ON_EXISTING)}")
+    same = kb.sessions_of(env, log_path, names)
+    if on_existing == "resume":
+        unfinished = [s for s in kb.sessions_of(env, log_path) if not s.finished]
+        if unfinished:
+            return kb.restart_session(unfinished[-1])
+        if same:
+            raise KnowledgeBaseError(
+                f"{log_path}: nothing to resume, its last session ({same[-1].id}) in environment "
+                f"{env.name!r} of {kb.location} finished; run without --resume to perceive it again"
+            )
+        return kb.start_session(env, log_path, names)
+    if same and on_existing == "replace":
+        return kb.restart_session(same[-1])
+    if same and on_existing == "refuse":
+        last = same[-1]
+        state = (f"finished with {last.frames} frames" if last.finished
+                 else f"interrupted after {last.frames} frames")
+        raise KnowledgeBaseError(
+            f"{log_path}: already in {kb.location} (environment {env.name!r}, session {last.id}, {state}); "
+            "pass --resume to finish an interrupted run, --replace to drop that session and perceive "
+            "again, or --again for another session on purpose"
+        )
+    return kb.start_session(env, log_path, names)

@@ -61,7 +61,7 @@ def reanchor_with_poses(kb: str, poses: Path, *, kb_docs: Path | None = None, ma
     from hiper_cli.perceive.logs import read_tum_trajectory
 
     trajectory = read_tum_trajectory(poses)
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         summary = reanchor_kb(knowledge, trajectory, max_dt_s=max_dt_s, write=write)
     return replace(summary, kb=str(kb), poses=str(poses))
 

@@ -22,6 +22,9 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     "types": _CORE_FORBIDDEN,
     "model": _CORE_FORBIDDEN,
     "errors": _CORE_FORBIDDEN,
+    # shared checks and safe file writes every layer may use
+    "validate": _CORE_FORBIDDEN,
+    "files": _CORE_FORBIDDEN,
     # recognition: log readers (the simulator's truth format included), stages, detectors
     "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib", "rerun"),
     # the knowledge base stores what perceive produced

@@ -74,7 +74,14 @@ def test_perceive_writes_every_frame_and_summarises(tmp_path):
     assert done[-1] == (12, 12)
 
 
-def test_resume_continues_after_the_last_committed_frame(tmp_path):
+def _instances(kb):
+    return sorted((i.layer, i.class_name, len(i.observation_uuids)) for i in kb.instances())
+
+
+def test_resume_gives_the_instances_of_an_uninterrupted_run(tmp_path):
+    with open_kb(tmp_path / "whole") as kb:
+        perceive(_log(), kb, [ProbeStage()])
+        whole = _instances(kb)
     with open_kb(tmp_path / "kb") as kb:
         with pytest.raises(Crash):
             perceive(_log(), kb, [CrashingStage(crash_at=7)])
@@ -82,16 +89,29 @@ def test_resume_continues_after_the_last_committed_frame(tmp_path):
         assert not session.finished and session.last_pose_id == 6 and session.frames == 7
     with open_kb(tmp_path / "kb") as kb:
         summary = perceive(_log(), kb, [ProbeStage()], PerceiveOptions(resume=True))
-        assert summary.resumed_after_pose_id == 6
-        assert summary.frames_already_done == 7 and summary.frames_read == 5
+        assert summary.frames_read == 12  # the interrupted session is redone in its place
         (session,) = kb.docs.sessions()
         assert session.finished and session.frames == 12
         assert kb.docs.count(type="observation") == 24
-        # the floor instance from before the crash was reloaded into the world and kept growing
-        (floor,) = kb.instances(layer="background")
-        assert len(floor.observation_uuids) == 12
+        assert _instances(kb) == whole
+        assert kb.check(repair=False).ok
         with pytest.raises(KnowledgeBaseError, match="nothing to resume"):
             perceive(_log(), kb, [ProbeStage()], PerceiveOptions(resume=True))
+
+
+def test_perceiving_a_log_again_is_refused_unless_asked_for(tmp_path):
+    with open_kb(tmp_path / "kb") as kb:
+        perceive(_log(), kb, [ProbeStage()])
+        once = (kb.docs.count(type="observation"), _instances(kb))
+        with pytest.raises(KnowledgeBaseError, match=r"already in .* --resume .* --replace .* --again"):
+            perceive(_log(), kb, [ProbeStage()])
+        assert (kb.docs.count(type="observation"), _instances(kb)) == once
+        perceive(_log(), kb, [ProbeStage()], PerceiveOptions(on_existing="replace"))
+        assert (kb.docs.count(type="observation"), _instances(kb)) == once
+        assert len(kb.docs.sessions()) == 1 and kb.check(repair=False).ok
+        perceive(_log(), kb, [ProbeStage()], PerceiveOptions(on_existing="again"))
+        assert len(kb.docs.sessions()) == 2
+        assert kb.docs.count(type="observation") == 2 * once[0]
 
 
 class UnreadableAt(FrameList):

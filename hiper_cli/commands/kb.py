@@ -54,8 +54,10 @@ def check_command(
     """
     from hiper_cli.graph import open_kb
 
-    # open without the automatic catch-up so the check sees what a crash left behind
-    with open_kb(kb, docs_dir=kb_docs, sync=False) as knowledge:
+    # open without the automatic catch-up so the check sees what a crash left behind; a graph
+    # that cannot be opened is rebuilt from the documents (unless --no-repair)
+    with open_kb(kb, docs_dir=kb_docs, sync=False, create=False, read_only=no_repair,
+                 rebuild_damaged_graph=not no_repair) as knowledge:
         report = knowledge.check(repair=not no_repair)
     if as_json:
         print_json(report.to_dict())

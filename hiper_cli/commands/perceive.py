@@ -30,7 +30,12 @@ Exclude = Annotated[Text, typer.Option("--exclude-classes", help=(
 MappingHz = Annotated[float | None, typer.Option("--mapping-hz", help="Background keyframe rate in Hz.")]
 Options = Annotated[list[str] | None, typer.Option(
     "-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable).")]
-Resume = Annotated[bool, typer.Option("--resume", help="Continue the unfinished session of this log.")]
+Resume = Annotated[bool, typer.Option(
+    "--resume", help="Redo the interrupted session of this log in its place.")]
+Replace = Annotated[bool, typer.Option(
+    "--replace", help="Drop this log's earlier session (one transaction), then perceive it again.")]
+Again = Annotated[bool, typer.Option(
+    "--again", help="Perceive a log the knowledge base holds already, as a new session.")]
 Env = Annotated[Text, typer.Option("--env", help="Environment name (default: the log folder's name).")]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
@@ -41,8 +46,8 @@ def perceive_command(
     log: Log, kb: KbOption = DEFAULT_KB, kb_docs: KbDocsOption = None, stages: Stages = None,
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
-    resume: Resume = False, env: Env = None, view: View = False, as_json: bool = JSON_OPTION, *,
-    log_options: LogOptions,
+    resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
+    view: View = False, as_json: bool = JSON_OPTION, *, log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
@@ -56,8 +61,13 @@ def perceive_command(
 
     foreground = {"detector": detector, "background_filter": False if no_background_filter else None,
                   "classes": classes, "exclude_classes": exclude_classes}
+    if sum((resume, replace, again)) > 1:
+        from hiper_cli.errors import ConfigError
+
+        raise ConfigError("choose one of --resume, --replace and --again")
     options = PerceiveOptions.from_text(
         stages=stages, options=option or [], env_name=env, resume=resume,
+        on_existing="replace" if replace else "again" if again else "refuse",
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     out = console()
     live = None

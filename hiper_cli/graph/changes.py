@@ -4,11 +4,11 @@ counts ``kb check`` compares with the graph. A mixin of ``DocumentStore``."""
 
 from __future__ import annotations
 
-import sqlite3
 from collections.abc import Iterator, Sequence
 from typing import Any
 
 from hiper_cli.graph.codec import loads
+from hiper_cli.graph.sqlite_guard import GuardedConnection
 
 __all__ = ["ChangeFeed"]
 
@@ -16,7 +16,7 @@ __all__ = ["ChangeFeed"]
 class ChangeFeed:
     """Reads over the ``docs``, ``all_links`` and ``tombstones`` tables by change sequence."""
 
-    _db: sqlite3.Connection
+    _db: GuardedConnection
 
     def _scalar(self, sql: str, params: Sequence[Any] = ()) -> Any:
         row = self._db.execute(sql, params).fetchone()

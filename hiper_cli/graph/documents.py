@@ -32,6 +32,13 @@ from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.lookups import Lookups
+from hiper_cli.graph.sqlite_guard import (
+    GuardedConnection,
+    connect_read_only,
+    damaged_error,
+    inspect_existing,
+    translate,
+)
 from hiper_cli.graph.trajectories import SCHEMA as TRAJECTORIES_SCHEMA
 from hiper_cli.graph.trajectories import TrajectoryStore
 
@@ -204,11 +211,14 @@ class DocumentStore(ChangeFeed, Lookups):
 
     def __init__(self, path: Path, *, read_only: bool = False) -> None:
         self.path = Path(path)
+        if self.path.is_file() and self.path.stat().st_size > 0:
+            inspect_existing(self.path)  # read-only: refuse another program's file before any write
         try:
             if read_only:
-                self._db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, isolation_level=None)
+                self._db = GuardedConnection(connect_read_only(self.path), self.path)
             else:
-                self._db = sqlite3.connect(str(self.path), isolation_level=None, timeout=30.0)
+                self._db = GuardedConnection(sqlite3.connect(str(self.path), isolation_level=None,
+                                                             timeout=30.0), self.path)
                 # 2 KiB pages (only takes effect on a new file): a frame dirties a few dozen
                 # index pages spread over the file and COMMIT copies each into the WAL, so
                 # smaller pages mean fewer bytes per commit (measured: 4 KiB -> 2 KiB +20 %
@@ -232,10 +242,12 @@ class DocumentStore(ChangeFeed, Lookups):
                     "INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
                 )
                 self._db.execute("INSERT OR IGNORE INTO meta VALUES ('seq', '0')")
-        except sqlite3.DatabaseError as err:
-            raise KnowledgeBaseError(
-                f"{self.path}: not a hiper document store ({err}); pass another --kb directory"
-            ) from err
+        except (sqlite3.Error, KnowledgeBaseError) as err:
+            if hasattr(self, "_db"):
+                self._db.close()
+            if isinstance(err, KnowledgeBaseError):
+                raise
+            raise translate(self.path, err) from err
         version = self.meta("schema_version")
         if version is not None and int(version) != SCHEMA_VERSION:
             raise KnowledgeBaseError(
@@ -570,6 +582,28 @@ class DocumentStore(ChangeFeed, Lookups):
             (pose_id, stamp_s, seq, session_id),
         )
 
+    def clear_session(self, session_id: int) -> int:
+        """Delete the documents a session created (observations, instances: tombstones for the
+        graph), its pose rows and every link to its observations, and restart the session row
+        (no frames, unfinished). Instances of other sessions it updated keep their update.
+        Returns the number of documents deleted."""
+        seq = self._current_seq()
+        db = self._db
+        uuids = [str(u) for (u,) in db.execute("SELECT uuid FROM docs WHERE session_id = ?", (session_id,))]
+        db.execute("DELETE FROM links WHERE observation_uuid IN "
+                   "(SELECT uuid FROM docs WHERE session_id = ? AND type = 'observation')", (session_id,))
+        db.execute("DELETE FROM links_new WHERE observation_uuid IN "
+                   "(SELECT uuid FROM docs WHERE session_id = ? AND type = 'observation')", (session_id,))
+        for uuid in uuids:
+            self.delete(uuid)
+        self._link_counts.clear()
+        self._pending_link_counts.clear()
+        db.execute("DELETE FROM poses WHERE session_id = ?", (session_id,))
+        db.execute("UPDATE sessions SET frames = 0, last_pose_id = NULL, last_stamp_s = NULL, "
+                   "ended_s = NULL, "
+                   "started_s = ?, seq = ? WHERE id = ?", (time.time(), seq, session_id))
+        return len(uuids)
+
     def end_session(self, session_id: int) -> None:
         seq = self._current_seq()
         self._db.execute(
@@ -736,7 +770,10 @@ class DocumentStore(ChangeFeed, Lookups):
 
     def integrity_problems(self) -> list[str]:
         """SQLite's own integrity check plus the store's invariants; empty when all is well."""
-        problems = [str(r[0]) for r in self._db.execute("PRAGMA quick_check") if r[0] != "ok"]
+        damage = [str(r[0]) for r in self._db.execute("PRAGMA quick_check") if r[0] != "ok"]
+        if damage:
+            raise damaged_error(self.path, f"{len(damage)} problems, first: {damage[0]}")
+        problems: list[str] = []
         orphans = int(
             self._scalar("SELECT COUNT(*) FROM docs_box b LEFT JOIN docs d ON d.id = b.id WHERE d.id IS NULL")
         )

@@ -18,6 +18,7 @@ data, and their boxes are zero unless the graph held them (``observation_detail=
 from __future__ import annotations
 
 import json
+import re
 import time
 import warnings
 from collections import defaultdict
@@ -27,6 +28,8 @@ from typing import Any
 import pyoxigraph as ox
 
 from hiper_cli.errors import DataError, KnowledgeBaseError
+from hiper_cli.files import atomic_output, os_error, refuse_inside
+from hiper_cli.graph.import_check import check_documents, check_json_shape
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, doc_quads, h, layer_graph, link_quad, speed_mps
 from hiper_cli.model import LAYERS
@@ -113,14 +116,25 @@ def _local(iri: str) -> str:
 
 
 def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = False) -> dict[str, Any]:
-    """Write ``kb`` to ``out`` in ``fmt``; returns a summary (format, path, counts)."""
+    """Write ``kb`` to ``out`` in ``fmt``; returns a summary (format, path, counts).
+
+    The file is written beside ``out`` and renamed into place when complete, so a failure
+    leaves an earlier file of that name whole; ``out`` may not lie inside a knowledge base."""
     if fmt not in EXPORT_FORMATS:
         raise DataError(f"export format {fmt!r}; expected one of {', '.join(EXPORT_FORMATS)}")
-    out.parent.mkdir(parents=True, exist_ok=True)
+    refuse_inside(out, "export")
+    if out.is_dir():
+        raise DataError(f"{out}: is a folder; pass a file name for the export")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise os_error(out.parent, err, "create") from err
     summary: dict[str, Any] = {"format": fmt, "path": str(out)}
     if fmt == "json":
         data = json_export(kb, observations=observations)
-        out.write_text(json.dumps(data, indent=1) + "\n")
+        with atomic_output(out) as target, target.open("w") as f:
+            json.dump(data, f, indent=1)
+            f.write("\n")
         keys = ("environments", "instances", "analyses", "observations")
         summary["counts"] = {k: len(data[k]) for k in keys}
         return summary
@@ -129,6 +143,12 @@ def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = Fa
         quads = _with_observations(kb, quads)
     quads = _with_layers(kb, quads)
     summary["quads"] = len(quads)
+    with atomic_output(out) as target:
+        _write_rdf(quads, target, fmt)
+    return summary
+
+
+def _write_rdf(quads: list[ox.Quad], out: Path, fmt: str) -> None:
     prefixes = {"hiper": HIPER, "prov": PROV, "sosa": "http://www.w3.org/ns/sosa/"}
     if fmt == "nquads":
         ox.serialize(quads, str(out), ox.RdfFormat.N_QUADS)
@@ -157,7 +177,7 @@ def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = Fa
             g.add_node(s, iri=s)
             key = _local(q.predicate.value)
             if isinstance(q.object, ox.Literal):
-                g.nodes[s][key] = q.object.value
+                g.nodes[s][key] = _xml_text(q.object.value)
                 continue
             o = str(getattr(q.object, "value", q.object))
             if key in ("type", "layer"):
@@ -166,7 +186,14 @@ def export_kb(kb: KnowledgeBase, out: Path, fmt: str, *, observations: bool = Fa
                 g.add_node(o, iri=o)
                 g.add_edge(s, o, predicate=key)
         nx.write_graphml(g, str(out))
-    return summary
+
+
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
+
+
+def _xml_text(text: str) -> str:
+    """``text`` without the characters XML 1.0 cannot hold (written as ``\\xNN``)."""
+    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
 
 
 def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, Any]:
@@ -200,32 +227,36 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
     }
 
 
-def _docs_from_json(data: dict[str, Any], source: Path) -> list[dict[str, Any]]:
+def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]:
+    """(where in the file, document) for every document of a JSON export."""
+    check_json_shape(data, source)
     if data.get("format") != JSON_FORMAT_NAME:
         raise DataError(f"{source}: not a hiper JSON export (format {data.get('format')!r}); "
                         f"expected {JSON_FORMAT_NAME!r} written by 'hiper export --format json'")
-    out: list[dict[str, Any]] = []
-    for e in data.get("environments", []):
-        out.append({"uuid": e["uuid"], "type": "environment", "name": e["name"], "data": {},
-                    "env_uuid": e["uuid"]})
-    for i in data.get("instances", []):
-        box = dict(i["box"])
-        if box.get("R") is None:
+    out: list[tuple[str, dict[str, Any]]] = []
+    for k, e in enumerate(data.get("environments", [])):
+        out.append((f"environments[{k}]", {"uuid": e.get("uuid"), "type": "environment",
+                                           "name": e.get("name"),
+                                           "data": {}, "env_uuid": e.get("uuid")}))
+    for k, i in enumerate(data.get("instances", [])):
+        box = dict(i["box"]) if isinstance(i.get("box"), dict) else i.get("box")
+        if isinstance(box, dict) and box.get("R") is None:
             box.pop("R", None)
-        out.append({
-            "uuid": i["uuid"], "type": "instance", "layer": i["layer"], "class": i["class"], "box": box,
-            "first_seen_s": i["first_seen_s"], "last_seen_s": i["last_seen_s"],
-            "state": i.get("state") or "static", "confidence": i.get("confidence") or 1.0,
+        out.append((f"instances[{k}]", {
+            "uuid": i.get("uuid"), "type": "instance", "layer": i.get("layer"), "class": i.get("class"),
+            "box": box, "first_seen_s": i.get("first_seen_s"), "last_seen_s": i.get("last_seen_s"),
+            "state": i.get("state") or "static",
+            "confidence": 1.0 if i.get("confidence") is None else i["confidence"],
             "observation_uuids": i.get("observation_uuids", []), "frame_id": i.get("frame", "map"),
             "data": i.get("data") or {},
-        })
-    for a in data.get("analyses", []):
-        out.append({**a, "type": "analysis"})
-    live = {d["uuid"] for d in out if d["type"] == "instance"}
-    for o in data.get("observations", []):
+        }))
+    for k, a in enumerate(data.get("analyses", [])):
+        out.append((f"analyses[{k}]", {**a, "type": "analysis"}))
+    live = {d["uuid"] for _, d in out if d["type"] == "instance"}
+    for k, o in enumerate(data.get("observations", [])):
         if o.get("instance_uuid") not in live:  # its instance was merged away before the export
             o = {**o, "instance_uuid": None}
-        out.append(o)
+        out.append((f"observations[{k}]", o))
     return out
 
 
@@ -233,8 +264,8 @@ def _vec(text: str | None) -> list[float]:
     return [float(v) for v in text.split()] if text else [0.0, 0.0, 0.0]
 
 
-def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[dict[str, Any]]:
-    """Documents from node properties keyed by local predicate name (RDF or GraphML)."""
+def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, dict[str, Any]]]:
+    """(node, document) from node properties keyed by local predicate name (RDF or GraphML)."""
     out: list[dict[str, Any]] = []
     links: dict[str, list[str]] = defaultdict(list)
     for iri, p in props.items():
@@ -282,7 +313,7 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[dict[str, A
             out.append({"uuid": uuid, "type": "environment", "name": one(p, "name", uuid), "data": {},
                         "env_uuid": uuid})
     order = {"environment": 0, "observation": 1, "instance": 2, "analysis": 3}
-    return sorted(out, key=lambda d: order[d["type"]])
+    return [(f"node <urn:uuid:{d['uuid']}>", d) for d in sorted(out, key=lambda d: order[d["type"]])]
 
 
 def _props_from_rdf(path: Path, fmt: str) -> dict[str, dict[str, list[str]]]:
@@ -320,22 +351,29 @@ def _props_from_graphml(path: Path) -> dict[str, dict[str, list[str]]]:
 
 
 def import_kb(kb: KnowledgeBase, path: Path, fmt: str | None = None) -> dict[str, Any]:
-    """Read an export into ``kb`` (documents first, then the graph follows)."""
+    """Read an export into ``kb`` (documents first, then the graph follows). Every document is
+    validated before the first is written; the write is one transaction."""
     fmt = fmt or guess_format(path)
     if not path.is_file():
         raise DataError(f"{path}: no such file; pass a file written by 'hiper export'")
     if fmt == "json":
         try:
-            data = json.loads(path.read_text())
-        except ValueError as err:
-            raise DataError(f"{path}: not valid JSON ({err})") from err
-        docs = _docs_from_json(data, path)
-    elif fmt == "graphml":
-        docs = _docs_from_props(_props_from_graphml(path))
-    elif fmt in ("turtle", "nquads", "jsonld"):
-        docs = _docs_from_props(_props_from_rdf(path, fmt))
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (ValueError, RecursionError) as err:  # RecursionError: nesting deeper than any export
+            detail = "nested too deeply" if isinstance(err, RecursionError) else str(err)[:200]
+            raise DataError(f"{path}: not valid JSON ({detail}); pass a file written by "
+                            "'hiper export --format json'") from err
+        labelled = _docs_from_json(data, path)
+    elif fmt in ("graphml", "turtle", "nquads", "jsonld"):
+        props = _props_from_graphml(path) if fmt == "graphml" else _props_from_rdf(path, fmt)
+        try:
+            labelled = _docs_from_props(props)
+        except (ValueError, TypeError, KeyError) as err:
+            raise DataError(f"{path}: a node property does not parse ({err}); nothing was imported") from err
     else:
         raise DataError(f"import format {fmt!r}; expected one of {', '.join(EXPORT_FORMATS)}")
+    check_documents(labelled, path)
+    docs = [d for _, d in labelled]
     if kb.read_only:
         raise KnowledgeBaseError(f"{kb.location}: opened read-only; cannot import")
     envs = [d["uuid"] for d in docs if d["type"] == "environment"]

@@ -14,6 +14,9 @@ a crash at any instant leaves a knowledge base that reopens with both stores in 
 
 from __future__ import annotations
 
+import contextlib
+import os
+import shutil
 import uuid as _uuid
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -23,8 +26,9 @@ from typing import Any
 import numpy as np
 
 from hiper_cli import DEFAULT_KB
-from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.errors import GraphDamagedError, KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
+from hiper_cli.graph.location import kb_location
 from hiper_cli.graph.ontology import (
     OBSERVATION_BATCH_S,
     OBSERVATION_DETAIL,
@@ -137,7 +141,11 @@ class KnowledgeBase(KbReads):
         self.docs = docs
         self.config = config
         self.read_only = read_only
+        self.graph_rebuilt = False  # set by open_kb when it replaced a damaged graph
         kb_id = docs.meta("kb_id")
+        if kb_id is None and read_only:
+            raise KnowledgeBaseError(f"{root}: the knowledge base was never written (no id); "
+                                     "open it writable once, e.g. 'hiper kb check'")
         if kb_id is None:
             kb_id = str(_uuid.uuid4())
             docs.set_meta("kb_id", kb_id)
@@ -156,11 +164,17 @@ class KnowledgeBase(KbReads):
         """The knowledge base as the user names it: its directory, or the endpoint URL."""
         return self.graph.location if isinstance(self.graph, SparqlGraph) else str(self.root)
 
-    def close(self) -> None:
-        if not self.read_only and not self.graph_detached:
-            self.sync_graph()
-        self.graph.close()
-        self.docs.close()
+    def close(self, *, sync: bool = True) -> None:
+        """Bring the graph up to date (``sync``) and close both stores (always, even when the
+        sync fails)."""
+        try:
+            if sync and not self.read_only and not self.graph_detached:
+                self.sync_graph()
+        finally:
+            try:
+                self.graph.close()
+            finally:
+                self.docs.close()
 
     @property
     def graph_detached(self) -> bool:
@@ -181,8 +195,12 @@ class KnowledgeBase(KbReads):
     def __enter__(self) -> KnowledgeBase:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, kind: object, *exc: object) -> None:
+        if kind is None:
+            self.close()
+            return
+        with contextlib.suppress(KnowledgeBaseError):  # leaving on an error: let a second one not hide it
+            self.close()
 
     def graphs(self) -> list[Any]:
         """The named graphs of this knowledge base: four layers and the meta graph."""
@@ -211,6 +229,22 @@ class KnowledgeBase(KbReads):
         """The newest unfinished session of ``log_path`` in ``env``, if any."""
         found = [s for s in self.docs.sessions() if s.env_uuid == env.uuid and s.log_path == log_path]
         return found[-1] if found and not found[-1].finished else None
+
+    def sessions_of(self, env: Environment, log_path: str,
+                    stages: Sequence[str] | None = None) -> list[Session]:
+        """The sessions of ``log_path`` in ``env`` (with exactly these ``stages`` when given)."""
+        return [s for s in self.docs.sessions() if s.env_uuid == env.uuid and s.log_path == log_path
+                and (stages is None or sorted(s.stages) == sorted(stages))]
+
+    def restart_session(self, session: Session) -> Session:
+        """Drop what ``session`` wrote, in one transaction, and hand it back empty and unfinished
+        (for perceiving its log again in its place); the graph is rebuilt from the documents."""
+        with self.docs.transaction():
+            self.docs.clear_session(session.id)
+        self.sync_graph(rebuild=True)
+        restarted = self.docs.session(session.id)
+        assert restarted is not None
+        return restarted
 
     def end_session(self, session: Session) -> None:
         with self.docs.transaction():
@@ -359,20 +393,33 @@ class KnowledgeBase(KbReads):
 
     def check(self, *, repair: bool = True) -> CheckReport:
         """Verify the documents and that the graph agrees with them; rebuild the graph from the
-        documents when it does not (``repair``)."""
+        documents when it does not, or when it cannot be read at all (``repair``). Damaged
+        documents raise: they are the source of truth and cannot be rebuilt from anything."""
         problems = self.docs.integrity_problems()
-        synced = self.graph.synced_seq(self.kb_id)
-        if synced != self.docs.seq:
-            problems.append(f"graph high-water mark {synced} != document sequence {self.docs.seq}")
-        graph_counts, doc_counts = self.graph_counts(), self.document_counts()
-        if graph_counts != doc_counts:
-            keys = sorted(set(graph_counts) | set(doc_counts))
-            diff = [f"{k}: graph {graph_counts.get(k, 0)} vs documents {doc_counts.get(k, 0)}"
-                    for k in keys if graph_counts.get(k, 0) != doc_counts.get(k, 0)]
-            problems.append("graph and documents disagree: " + "; ".join(diff))
-        problems += self._compare_nodes(self.config.check_sample)
+        if self.graph_rebuilt:
+            problems.append("the scene graph could not be opened; it was rebuilt from the documents")
+        doc_counts = self.document_counts()
+        graph_counts: dict[str, int] = {}
+        try:
+            synced = self.graph.synced_seq(self.kb_id)
+            if synced != self.docs.seq:
+                problems.append(f"graph high-water mark {synced} != document sequence {self.docs.seq}")
+            graph_counts = self.graph_counts()
+            if graph_counts != doc_counts:
+                keys = sorted(set(graph_counts) | set(doc_counts))
+                diff = [f"{k}: graph {graph_counts.get(k, 0)} vs documents {doc_counts.get(k, 0)}"
+                        for k in keys if graph_counts.get(k, 0) != doc_counts.get(k, 0)]
+                problems.append("graph and documents disagree: " + "; ".join(diff))
+            problems += self._compare_nodes(self.config.check_sample)
+        except GraphDamagedError as err:
+            problems.append(str(err))
+            if repair and not self.read_only and isinstance(self.graph, LocalGraph):
+                path = Path(self.graph.location)
+                with contextlib.suppress(KnowledgeBaseError):
+                    self.graph.close()
+                self.graph = _fresh_graph(path)
         report = CheckReport(ok=not problems, problems=problems, graph_counts=graph_counts,
-                             document_counts=doc_counts)
+                             document_counts=doc_counts, repaired=self.graph_rebuilt)
         if problems and repair and not self.read_only:
             self.sync_graph(rebuild=True)
             report.repaired = True
@@ -434,20 +481,33 @@ class KnowledgeBase(KbReads):
 def open_kb_for_reading(
     location: str | Path = DEFAULT_KB, *, docs_dir: str | Path | None = None
 ) -> KnowledgeBase:
-    """Open an existing knowledge base to read it, even while a ``perceive`` run writes it
-    (then read-only: the graph may lag the documents by the writer's sync interval)."""
+    """Open an existing knowledge base to read it: read-only where it cannot be written
+    (read-only media, a ``perceive`` run writing it: the graph may then lag the documents by
+    the writer's sync interval), else as ``open_kb`` does, which catches the graph up."""
+    remote, _ = kb_location(location)
+    root = Path(docs_dir) if docs_dir is not None else Path(str(location))
+    if not remote and not _writable(root):
+        return open_kb(location, docs_dir=docs_dir, read_only=True)
     try:
-        root = Path(docs_dir) if docs_dir is not None else Path(str(location))
-        if not str(location).startswith(("http://", "https://")) and not (root / DOCUMENTS_FILE).exists():
-            raise KnowledgeBaseError(
-                f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); "
-                f"run 'hiper perceive LOG --kb {root}'"
-            )
-        return open_kb(location, docs_dir=docs_dir)
+        return open_kb(location, docs_dir=docs_dir, create=False)
+    except GraphDamagedError:
+        raise
     except KnowledgeBaseError as err:
-        if "another hiper process" not in str(err):
+        if not any(why in str(err) for why in ("another hiper process", "disk is full", "read-only")):
             raise
         return open_kb(location, docs_dir=docs_dir, read_only=True)
+
+
+def _writable(root: Path) -> bool:
+    docs = root / DOCUMENTS_FILE
+    return not docs.exists() or (os.access(root, os.W_OK) and os.access(docs, os.W_OK))
+
+
+def _no_kb(root: Path) -> KnowledgeBaseError:
+    return KnowledgeBaseError(
+        f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); check the --kb path, or "
+        f"create one with 'hiper perceive LOG --kb {root}'"
+    )
 
 
 def open_kb(
@@ -457,34 +517,63 @@ def open_kb(
     read_only: bool = False,
     config: KbConfig | None = None,
     sync: bool = True,
+    create: bool = True,
+    rebuild_damaged_graph: bool = False,
 ) -> KnowledgeBase:
-    """Open (creating on first use) the knowledge base at ``location``.
+    """Open (creating on first use, unless ``create`` is False) the knowledge base at ``location``.
 
     ``location`` is a directory, or the URL of a SPARQL 1.1 endpoint holding the scene graph; in
     that case the documents live in ``docs_dir`` (default ``./scene.hiper``). On open the graph is
-    brought up to date with the documents (``sync``), which repairs an interrupted write.
+    brought up to date with the documents (``sync``), which repairs an interrupted write. A local
+    graph that cannot be opened raises ``GraphDamagedError`` unless ``rebuild_damaged_graph``:
+    then it is replaced by one rebuilt from the documents.
     """
-    text = str(location)
-    remote = text.startswith(("http://", "https://"))
+    remote, text = kb_location(location)
     root = Path(docs_dir) if docs_dir is not None else (Path(DEFAULT_KB) if remote else Path(text))
     if root.exists() and not root.is_dir():
         raise KnowledgeBaseError(
             f"{root}: is a file, not a knowledge-base directory; pass a directory to --kb"
         )
     docs_path = root / DOCUMENTS_FILE
-    if read_only and not docs_path.exists():
-        raise KnowledgeBaseError(
-            f"{root}: no knowledge base there ({DOCUMENTS_FILE} missing); "
-            f"run 'hiper perceive LOG --kb {root}'"
-        )
-    root.mkdir(parents=True, exist_ok=True)
+    if (read_only or not create) and not docs_path.exists():
+        raise _no_kb(root)
+    if not read_only:
+        try:
+            root.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise KnowledgeBaseError(f"{root}: cannot create the knowledge-base folder ({err.strerror}); "
+                                     "pass a writable --kb path") from err
     docs = DocumentStore(docs_path, read_only=read_only)
+    rebuilt = False
     try:
-        graph = open_graph(text if remote else root / GRAPH_DIR, read_only=read_only)
+        try:
+            graph = open_graph(text if remote else root / GRAPH_DIR, read_only=read_only)
+        except GraphDamagedError:
+            if remote or read_only or not rebuild_damaged_graph:
+                raise
+            graph = _fresh_graph(root / GRAPH_DIR)
+            rebuilt = True
     except BaseException:
         docs.close()
         raise
     kb = KnowledgeBase(root, graph, docs, config or KbConfig(), read_only=read_only)
-    if sync and not read_only:
-        kb.sync_graph()
+    if rebuilt:
+        kb.sync_graph(rebuild=True)
+        kb.graph_rebuilt = True
+    elif sync and not read_only:
+        try:
+            kb.sync_graph()
+        except BaseException:
+            kb.close(sync=False)
+            raise
     return kb
+
+
+def _fresh_graph(path: Path) -> LocalGraph:
+    """An empty graph store in place of the damaged one at ``path`` (derived data: the caller
+    rebuilds it from the documents)."""
+    if path.is_dir():
+        shutil.rmtree(path)
+    elif path.exists():
+        path.unlink()
+    return LocalGraph(path)

@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import json
 import math
-import sqlite3
 from collections.abc import Sequence
 from typing import Any
+
+from hiper_cli.graph.sqlite_guard import GuardedConnection
 
 __all__ = ["Lookups"]
 
@@ -16,7 +17,7 @@ __all__ = ["Lookups"]
 class Lookups:
     """Reads over ``obs_cells``, ``all_links``, ``docs`` columns and ``poses``."""
 
-    _db: sqlite3.Connection
+    _db: GuardedConnection
     _grid_cell_m: float
 
     def observation_points_in(

@@ -8,17 +8,18 @@ bring the graph up to date from its documents with a high-water mark.
 
 from __future__ import annotations
 
+import functools
 import time
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
 import pyoxigraph as ox
 
-from hiper_cli.errors import KnowledgeBaseError, QueryError
+from hiper_cli.errors import GraphDamagedError, KnowledgeBaseError, QueryError
 from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
 
 __all__ = ["DetachedGraph", "GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
@@ -103,6 +104,12 @@ def _solutions(result: Any) -> list[dict[str, Any]]:
     return [{n: sol[n] for n in names if sol[n] is not None} for sol in result]
 
 
+def _is_lock_error(err: BaseException) -> bool:
+    """Whether RocksDB refused the store because another process holds its LOCK file."""
+    text = str(err).lower()
+    return "lock file" in text or "/lock:" in text or "temporarily unavailable" in text
+
+
 def _open_store(path: Path, wait_s: float = 3.0) -> ox.Store:
     """The on-disk store, waiting up to ``wait_s`` for a lock that a dying process (a graph
     follower killed with its writer) still holds."""
@@ -111,9 +118,44 @@ def _open_store(path: Path, wait_s: float = 3.0) -> ox.Store:
         try:
             return ox.Store(str(path))
         except OSError as err:
-            if "lock" not in str(err).lower() or time.monotonic() > deadline:
+            if not _is_lock_error(err) or time.monotonic() > deadline:
                 raise
             time.sleep(0.05)
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def store_error(path: str, err: BaseException) -> KnowledgeBaseError:
+    """The one-line error for a failure of the on-disk graph store at ``path``."""
+    text = " ".join(str(err).split())
+    if "no space" in text.lower() or "file too large" in text.lower():
+        return KnowledgeBaseError(f"{path}: the disk is full ({text}); free some space; the documents "
+                                  "are kept and 'hiper kb check' brings the scene graph up to date")
+    if "read-only" in text.lower() or "permission denied" in text.lower():
+        return KnowledgeBaseError(f"{path}: the scene graph cannot be written ({text}); the knowledge "
+                                  "base is read-only: copy it to a writable folder to change it")
+    return GraphDamagedError(f"{path}: the scene graph is damaged ({text[:200]}); it is derived from the "
+                             f"documents: run 'hiper kb check --kb {Path(path).parent}' to rebuild it")
+
+
+def _guarded(method: F) -> F:
+    """Store errors of a ``LocalGraph`` method as one-line ``KnowledgeBaseError``s."""
+    @functools.wraps(method)
+    def wrapper(self: LocalGraph, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return method(self, *args, **kwargs)
+        except (OSError, RuntimeError) as err:
+            raise store_error(self.location, err) from err
+
+    return wrapper  # type: ignore[return-value]
+
+
+def _drop_old_logs(path: Path) -> None:
+    """RocksDB keeps the info log of every earlier open (``LOG.old.*``, ~140 KB each); they are
+    diagnostics only, so each open removes them and the folder does not grow by reading."""
+    for old in path.glob("LOG.old.*"):
+        old.unlink(missing_ok=True)
 
 
 class LocalGraph:
@@ -124,13 +166,18 @@ class LocalGraph:
         self.read_only = read_only
         try:
             self._store = ox.Store.read_only(str(path)) if read_only else _open_store(path)
-        except OSError as err:
-            raise KnowledgeBaseError(
-                f"{path}: cannot open the scene graph ({err}); is another hiper process writing "
-                "this knowledge base? wait for it or use another --kb"
-            ) from err
+        except (OSError, RuntimeError) as err:
+            if _is_lock_error(err):
+                raise KnowledgeBaseError(
+                    f"{path}: cannot open the scene graph ({err}); is another hiper process writing "
+                    "this knowledge base? wait for it or use another --kb"
+                ) from err
+            raise store_error(str(path), err) from err
+        if not read_only:
+            _drop_old_logs(path)
         self._link = ox.NamedNode(PROV + "wasDerivedFrom")
 
+    @_guarded
     def write(
         self, kb_id: str, refresh: Sequence[str], drop: Sequence[str], quads: Sequence[ox.Quad]
     ) -> None:
@@ -145,6 +192,7 @@ class LocalGraph:
             store.remove(q)
         store.extend(quads)
 
+    @_guarded
     def append_nquads(self, text: str) -> None:
         if not text:
             return
@@ -158,6 +206,7 @@ class LocalGraph:
             raise KnowledgeBaseError(f"{self.location}: a generated graph node does not parse ({err}); "
                                      "a document uuid is not a plain uuid? run 'hiper kb check'") from err
 
+    @_guarded
     def objects(self, subject: str, predicate: str) -> list[str]:
         found = self._store.quads_for_pattern(ox.NamedNode(subject), ox.NamedNode(predicate), None)
         return [q.object.value for q in found if isinstance(q.object, ox.NamedNode)]
@@ -165,6 +214,7 @@ class LocalGraph:
     def synced_seq(self, kb_id: str) -> int:
         return self.sync_state(kb_id)[0]
 
+    @_guarded
     def sync_state(self, kb_id: str) -> tuple[int, bool]:
         s, g = _kb_node(kb_id), meta_graph(kb_id)
         seq = 0
@@ -173,10 +223,12 @@ class LocalGraph:
         dirty = any(True for _ in self._store.quads_for_pattern(s, _DIRTY, None, g))
         return seq, dirty
 
+    @_guarded
     def begin_sync(self, kb_id: str) -> None:
         self._store.add(ox.Quad(_kb_node(kb_id), _DIRTY, _TRUE, meta_graph(kb_id)))
         self._store.flush()  # on disk before any bulk-loaded file
 
+    @_guarded
     def set_synced_seq(self, kb_id: str, seq: int) -> None:
         s, g = _kb_node(kb_id), meta_graph(kb_id)
         old = list(self._store.quads_for_pattern(s, _SYNCED, None, g))
@@ -187,10 +239,12 @@ class LocalGraph:
             + f"INSERT DATA {{ GRAPH {g} {{ {s} {_SYNCED} {ox.Literal(str(seq), datatype=_INTEGER)} }} }}"
         )
 
+    @_guarded
     def clear(self, graphs: Sequence[ox.NamedNode]) -> None:
         for g in graphs:
             self._store.clear_graph(g)
 
+    @_guarded
     def query(self, sparql: str, bindings: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
         try:
             if bindings:
@@ -200,6 +254,7 @@ class LocalGraph:
         except SyntaxError as err:
             raise KnowledgeBaseError(f"SPARQL query does not parse: {err}") from err
 
+    @_guarded
     def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
         readonly_check(sparql)
         try:
@@ -208,12 +263,14 @@ class LocalGraph:
             raise QueryError(f"SPARQL query does not parse: {err}") from err
         return serialize_results(result, media_type)
 
+    @_guarded
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
         out: list[ox.Quad] = []
         for g in graphs:
             out.extend(self._store.quads_for_pattern(None, None, None, g))
         return out
 
+    @_guarded
     def flush(self) -> None:
         if not self.read_only:
             self._store.flush()

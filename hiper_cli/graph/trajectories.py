@@ -14,12 +14,12 @@ the same document either way.
 from __future__ import annotations
 
 import hashlib
-import sqlite3
 from typing import Any
 
 import numpy as np
 
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.graph.sqlite_guard import GuardedConnection
 from hiper_cli.model import ROW_POSITION, ROW_STAMP
 
 __all__ = ["CHUNK_ROWS", "INLINE_ROWS", "SCHEMA", "TrajectoryStore"]
@@ -50,7 +50,7 @@ def _speed_mps(rows: list[Any]) -> float | None:
 class TrajectoryStore:
     """The ``trajectories`` table of one document store connection."""
 
-    def __init__(self, db: sqlite3.Connection) -> None:
+    def __init__(self, db: GuardedConnection) -> None:
         self._db = db
         self._chunks: dict[str, list[bytes]] = {}  # uuid -> digests of the committed chunks
         self._pending: dict[str, list[bytes]] = {}

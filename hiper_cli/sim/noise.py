@@ -36,6 +36,9 @@ CONFUSIONS: dict[str, tuple[str, ...]] = {
 FP_CLASSES = ("person", "chair", "bottle", "cup", "tv", "potted plant", "book")
 
 
+MAX_FALSE_POSITIVES_PER_IMAGE = 100.0  # a mean; far beyond it drawing the boxes never ends
+
+
 @dataclass(frozen=True)
 class NoiseModel:
     """Detection noise; ``NoiseModel.perfect()`` gives exact boxes with no misses or extras."""
@@ -55,6 +58,9 @@ class NoiseModel:
             value = getattr(self, name)
             if not 0.0 <= value <= 1.0:
                 raise ConfigError(f"noise model: {name}={value}; expected a probability in [0, 1]")
+        if not 0 <= self.false_positives_per_image <= MAX_FALSE_POSITIVES_PER_IMAGE:
+            raise ConfigError(f"noise model: false_positives_per_image={self.false_positives_per_image}; "
+                              f"expected 0 to {MAX_FALSE_POSITIVES_PER_IMAGE} random boxes per image")
         if self.jitter_frac < 0 or self.false_positives_per_image < 0 or self.min_pixels < 1:
             raise ConfigError(
                 "noise model: jitter_frac and false_positives_per_image must be >= 0, min_pixels >= 1"

@@ -8,7 +8,7 @@ box overlap, contour overlap). Lengths in metres, angles in degrees.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 from hiper_cli.errors import ConfigError
@@ -93,26 +93,8 @@ class BackgroundConfig:
 
     @classmethod
     def from_options(cls, **options: Any) -> BackgroundConfig:
-        """Build from keyword options; an unknown name raises ``ConfigError``."""
-        names = [f.name for f in fields(cls)]
-        unknown = sorted(set(options) - set(names))
-        if unknown:
-            raise ConfigError(
-                f"unknown background option(s) {unknown}; expected one of {', '.join(names)}"
-            )
-        typed: dict[str, Any] = {}
-        for f in fields(cls):
-            if f.name in options:
-                typed[f.name] = _typed(f.name, options[f.name], type(getattr(cls, f.name)))
-        return cls(**typed)
+        """Build from keyword options, checked by ``hiper_cli.validate.typed_options`` (known
+        name, type, finite); an unknown name raises ``ConfigError``."""
+        from hiper_cli.validate import typed_options
 
-
-def _typed(name: str, value: Any, kind: type) -> Any:
-    """``value`` as the field's type (numbers from ints or floats, text as text)."""
-    if kind in (int, float):
-        ok = isinstance(value, int | float) and not isinstance(value, bool)
-    else:
-        ok = isinstance(value, kind)
-    if not ok or (kind is int and float(value) != int(value)):
-        raise ConfigError(f"background option {name}={value!r}: expected {kind.__name__}")
-    return kind(value)
+        return cls(**typed_options(cls, options, "-o background"))

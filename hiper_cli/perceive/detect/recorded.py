@@ -46,6 +46,8 @@ class TruthDetector:
             raise ConfigError(f"detector 'truth': {err}") from err
         self._stamps = sorted(records)
         self._by_stamp = {s: Detections.from_records(r) for s, r in records.items()}
+        # the classes the truth can report: those in its records
+        self.class_names = tuple(sorted({n for d in self._by_stamp.values() for n in d.class_names}))
         self.min_score = float(min_score)
         self.stamp_tolerance_s = float(stamp_tolerance_s)
 

@@ -128,6 +128,7 @@ class YoloxDetector:
         self.size_hw = (int(shape[2]), int(shape[3])) if isinstance(shape[2], int) else (416, 416)
         self.score_threshold = float(score_threshold)
         self.nms_iou = float(nms_iou)
+        self.class_names = COCO_NAMES
 
     def detect(self, frame: Frame) -> Detections:
         canvas, r, _ = letterbox(frame.rgb, self.size_hw, centre=False)

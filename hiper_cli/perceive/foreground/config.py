@@ -420,6 +420,10 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
                 raise ConfigError(f"foreground option {name!r} given twice")
             flat[name] = value
         unknown = sorted(set(flat) - known)
+        if not unknown:  # names, types and finiteness by the shared validator
+            from hiper_cli.validate import typed_options
+
+            flat = typed_options(cls, flat, "-o foreground")
         if unknown:
             raise ConfigError(
                 f"unknown foreground option(s) {unknown}; expected one of {', '.join(sorted(known))}"

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import PerceptionError
+from hiper_cli.errors import ConfigError, PerceptionError
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
@@ -96,6 +96,9 @@ class ForegroundStage:
         import scipy.sparse.csgraph  # noqa: F401
 
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
+        _check_classes(cfg.classes, getattr(self.detector, "class_names", None), cfg.detector)
+        # the ``log`` detector reads the log's own detections: perceive checks the log has them
+        self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
         self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
         self._priors: dict[tuple[str, str], dict[str, Any]] = {}
@@ -336,3 +339,17 @@ class ForegroundStage:
             return np.asarray(ok & ~occluded)
 
         return visible
+
+
+def _check_classes(wanted: tuple[str, ...], known: Any, detector: str) -> None:
+    """Refuse ``--classes`` the detector can never report (a typo would silently keep nothing)."""
+    if not wanted or not known:
+        return
+    unknown = [c for c in wanted if c not in known]
+    if unknown:
+        import difflib
+
+        near = difflib.get_close_matches(unknown[0], list(known), n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise ConfigError(f"--classes {', '.join(unknown)}: detector {detector!r} has no such class; {hint}"
+                          f"its classes: {', '.join(known)}")

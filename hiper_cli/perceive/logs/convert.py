@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import os
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from hiper_cli.errors import ConfigError
+from hiper_cli.errors import ConfigError, LogError
+from hiper_cli.files import os_error, refuse_inside
 from hiper_cli.perceive.logs import LogReader
 from hiper_cli.perceive.logs.bag_writer import BAG_KINDS, BagLayout, BagWriter
 from hiper_cli.perceive.logs.tum_writer import TumWriter
@@ -60,17 +63,57 @@ def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayou
     """
     if to not in CONVERT_TARGETS:
         raise ConfigError(f"--to {to}: unknown format; expected one of {', '.join(CONVERT_TARGETS)}")
+    out = Path(out)
+    refuse_inside(out, "converted log")
+    if out.exists() and (to != "tum" or not overwrite):
+        if to != "tum":
+            raise LogError(f"{out}: exists already; choose a new output path")
+        if out.is_file() or any(out.iterdir()):
+            raise LogError(f"{out}: folder exists and is not empty; choose another output or pass "
+                           "--overwrite")
     camera = reader.info().camera
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise os_error(out.parent, err, "create") from err
+    # written beside the target and renamed into place when complete: a failure half-way
+    # leaves nothing (or the earlier folder) behind
+    partial = out.parent / f".{out.name}.{os.getpid()}.partial"
+    _remove(partial)
     writer: TumWriter | BagWriter
-    if to == "tum":
-        writer = TumWriter(out, replace(camera, depth_scale=TUM_DEPTH_SCALE), overwrite=overwrite)
-    else:
-        writer = BagWriter(out, to, camera, layout or BagLayout())
     written = 0
-    with writer:
-        for frame in reader:
-            writer.write(frame)
-            written += 1
-            if on_frame is not None:
-                on_frame(frame)
+    try:
+        if to == "tum":
+            writer = TumWriter(partial, replace(camera, depth_scale=TUM_DEPTH_SCALE))
+        else:
+            writer = BagWriter(partial, to, camera, layout or BagLayout())
+        with writer:
+            for frame in reader:
+                writer.write(frame)
+                written += 1
+                if on_frame is not None:
+                    on_frame(frame)
+        _move_into_place(partial, out)
+    except OSError as err:
+        raise os_error(out, err) from err
+    finally:
+        _remove(partial)
     return ConvertResult(str(out), to, written, list(reader.skipped), input=str(reader.info().path))
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir():
+        shutil.rmtree(path, ignore_errors=True)
+    elif path.exists():
+        path.unlink()
+
+
+def _move_into_place(partial: Path, out: Path) -> None:
+    """Rename ``partial`` to ``out``; an existing (``--overwrite``) folder is swapped out first."""
+    if not out.exists():
+        os.replace(partial, out)
+        return
+    old = out.parent / f".{out.name}.{os.getpid()}.old"
+    os.replace(out, old)
+    os.replace(partial, out)
+    _remove(old)

@@ -8,6 +8,7 @@ Depth encodings: ``16UC1``/``mono16`` are millimetres (ROS convention) unless a
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,11 @@ __all__ = [
 ]
 
 RGB_ENCODINGS = ("rgb8", "bgr8", "rgba8", "bgra8", "mono8")
+# Larger images are refused from their header, before decoding: a few hundred KB of PNG can
+# decode to gigabytes; no RGB-D camera comes near 40 megapixels.
+MAX_IMAGE_PIXELS = 40_000_000
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+_JPEG_SOF = {0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE, 0xCF}
 DEPTH_ENCODINGS = ("16UC1", "mono16", "32FC1")
 ROS_DEPTH_MM_PER_M = 1000.0
 
@@ -38,10 +44,53 @@ def _cv2() -> Any:
     return cv2
 
 
+def encoded_size(head: bytes) -> tuple[int, int] | None:
+    """(width, height) read from the header of PNG or JPEG bytes; None when not found."""
+    if head[:8] == _PNG_MAGIC and head[12:16] == b"IHDR" and len(head) >= 24:
+        width, height = struct.unpack(">II", head[16:24])
+        return int(width), int(height)
+    if head[:2] != b"\xff\xd8":
+        return None
+    i = 2
+    while i + 9 <= len(head):
+        if head[i] != 0xFF:
+            i += 1
+            continue
+        marker = head[i + 1]
+        if marker in _JPEG_SOF:
+            height, width = struct.unpack(">HH", head[i + 5 : i + 9])
+            return int(width), int(height)
+        if marker in (0xD8, 0x01) or 0xD0 <= marker <= 0xD7 or marker == 0xFF:
+            i += 2 if marker != 0xFF else 1
+            continue
+        i += 2 + struct.unpack(">H", head[i + 2 : i + 4])[0]
+    return None
+
+
+def check_pixels(head: bytes, source: str) -> None:
+    """Refuse an encoded image whose header announces more than ``MAX_IMAGE_PIXELS``."""
+    size = encoded_size(head)
+    if size is not None and size[0] * size[1] > MAX_IMAGE_PIXELS:
+        raise LogError(f"{source}: the image is {size[0]}×{size[1]} pixels, over the limit of "
+                       f"{MAX_IMAGE_PIXELS / 1e6:.0f} megapixels; not decoded (a damaged or wrong file?)")
+
+
+def _check_file_pixels(path: Path) -> None:
+    try:
+        with path.open("rb") as f:
+            head = f.read(32)
+            if head[:2] == b"\xff\xd8":
+                head += f.read(1 << 16)
+    except OSError as err:
+        raise LogError(f"{path}: cannot read ({err.strerror or err})") from err
+    check_pixels(head, str(path))
+
+
 def read_rgb_file(path: Path) -> NDArray[np.uint8]:
     """An 8-bit colour (or grey) image file as (H, W, 3) uint8 RGB."""
     if not path.is_file():
         raise LogError(f"{path}: image file missing")
+    _check_file_pixels(path)
     cv2 = _cv2()
     image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if image is None:
@@ -53,6 +102,7 @@ def read_depth_png(path: Path, depth_scale: float) -> NDArray[np.float32]:
     """A 16-bit depth PNG (``depth_scale`` units per metre) as (H, W) float32 metres."""
     if not path.is_file():
         raise LogError(f"{path}: depth file missing")
+    _check_file_pixels(path)
     cv2 = _cv2()
     image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if image is None:
@@ -132,6 +182,7 @@ def decode_depth(encoding: str, height: int, width: int, step: int, data: NDArra
 
 def decode_compressed_rgb(fmt: str, data: NDArray[np.uint8], source: str) -> NDArray[np.uint8]:
     """A ``sensor_msgs/CompressedImage`` (png/jpeg) colour payload to RGB."""
+    check_pixels(bytes(np.asarray(data, dtype=np.uint8).reshape(-1)[: 1 << 16]), source)
     cv2 = _cv2()
     image = cv2.imdecode(np.asarray(data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
     if image is None:
@@ -148,6 +199,7 @@ def decode_compressed_depth(fmt: str, data: NDArray[np.uint8], source: str,
     start = bytes(buf[:64]).find(png_magic)
     if start > 0:  # compressed_depth_image_transport prepends a 12-byte config header
         buf = buf[start:]
+    check_pixels(bytes(buf[:32]), source)
     image = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
     if image is None:
         raise LogError(f"{source}: cannot decode the compressed depth image (format '{fmt}'); expected "

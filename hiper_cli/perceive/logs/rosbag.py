@@ -14,6 +14,7 @@ Indexing reads only the headers of image messages; iterating streams the bag onc
 from __future__ import annotations
 
 import struct
+import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -58,8 +59,9 @@ def _bag_errors() -> tuple[type[BaseException], ...]:
     from rosbags.rosbag2 import ReaderError as ReaderError2
     from rosbags.serde import SerdeError
 
+    # damaged bytes surface from the parsers as any of these
     return (AnyReaderError, ReaderError1, ReaderError2, SerdeError, OSError, struct.error, ValueError,
-            EOFError)
+            EOFError, OverflowError, IndexError, KeyError, zlib.error)
 
 
 def _open_reader(path: Path, ros1: bool) -> Any:
@@ -419,6 +421,13 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
                     detections = det_rows[int(det_order[pos])][1]
         locator = ((rgb_topic, ri, *places[rgb_topic][ri]), (depth_topic, di, *places[depth_topic][di]))
         entries.append(FrameEntry(stamp, T[k], source, locator, detections))
+    # a damaged chunk drops its messages without an error: count them against the bag's index
+    lost = {t: found[t].count - len(stamps[t]) for t in (rgb_topic, depth_topic)}
+    for _ in range(max(lost.values())):
+        index_skipped.append((f"{path} {rgb_topic}/{depth_topic}",
+                              f"image messages unreadable ({lost[rgb_topic]} colour, "
+                              f"{lost[depth_topic]} depth "
+                              f"of {found[rgb_topic].count} in the bag's index): the bag is damaged"))
     if not entries:
         raise LogError(f"{path}: no colour image stamp has a pose ({pose_source}); check --pose-topic, "
                        "--map-frame/--camera-frame or pass --poses traj.txt")

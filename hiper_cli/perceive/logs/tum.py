@@ -87,9 +87,20 @@ def _read_list(path: Path) -> list[tuple[float, str]]:
     return rows
 
 
+def _text(path: Path, what: str) -> str:
+    """The text of a log's list file; a binary or unreadable file is a ``LogError``."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as err:
+        raise LogError(f"{path}: not a text file (byte {err.start} is not UTF-8); expected {what}") from err
+    except OSError as err:
+        raise LogError(f"{path}: cannot read ({err.strerror or err})") from err
+
+
 def _read_associations(path: Path) -> list[tuple[float, str, float, str]]:
     rows = []
-    for number, line in enumerate(path.read_text().splitlines(), start=1):
+    text = _text(path, "lines 't_rgb rgb_path t_depth depth_path'")
+    for number, line in enumerate(text.splitlines(), start=1):
         line = line.strip()
         if not line or line.startswith("#"):
             continue
@@ -149,7 +160,8 @@ def tum_camera(root: Path, camera: CameraIntrinsics | None = None) -> tuple[Came
 def _read_detections(path: Path) -> tuple[NDArray[np.float64], list[Detections]]:
     stamps: list[float] = []
     dets: list[Detections] = []
-    for number, line in enumerate(path.read_text().splitlines(), start=1):
+    text = _text(path, 'one JSON object per line, {"stamp_s": s, "detections": [...]}')
+    for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip():
             continue
         try:

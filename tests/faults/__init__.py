@@ -1,0 +1,1 @@
+"""The fault suite: a corpus of bad inputs, damaged stores and crashes, generated in code."""
