@@ -72,6 +72,18 @@ class BackgroundConfig:
     wall_min_width_m: float = 1.0
     wall_min_area_m2: float = 1.0
     wall_top_min_m: float = 1.5  # the observed part reaches this high (furniture rarely does)
+    # wall bounds (``bounds.py``): a wall reaches the ceiling and the floor or the image's edge;
+    # probes this far beyond its top and bottom edge, in every column, must see the surface go
+    # on (within the tolerances of the plane's depth), not farther
+    wall_bounds: bool = True
+    wall_probe_gap_px: float = 8.0
+    wall_probe_reach_px: float = 48.0  # probes walk out to this, over occluders in front
+    wall_probe_tolerance_m: float = 0.05
+    wall_probe_tolerance_frac: float = 0.05
+    wall_probe_max_depth_m: float = 4.5  # no return where the plane would be nearer: nothing there
+    wall_probe_min_columns: int = 3
+    wall_open_share: float = 0.5  # of the columns with evidence, this share open: not a wall
+    wall_tall_m: float = 2.2  # seen reaching this high: a wall, though its views saw both ends open
     # merging (Algorithm 2)
     merge_angle_deg: float = 10.0
     merge_offset_m: float = 0.1

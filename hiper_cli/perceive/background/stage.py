@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, Instance, Observation
+from hiper_cli.perceive.background.bounds import edge_evidence, is_open
 from hiper_cli.perceive.background.classify import classify_plane
 from hiper_cli.perceive.background.config import BackgroundConfig
 from hiper_cli.perceive.background.contour import (
@@ -26,11 +27,12 @@ from hiper_cli.perceive.background.merge import (
     new_instance,
     to_map,
 )
+from hiper_cli.perceive.background.not_walls import NotWalls
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extract_planes
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Frame
 
-__all__ = ["BackgroundStage", "observe"]
+__all__ = ["BackgroundStage", "observe", "observe_all"]
 
 FloatArray = NDArray[np.float64]
 MIN_PLANE_THICKNESS_M = 0.02  # a plane observation's box is at least this thick (2 σ of its fit)
@@ -56,6 +58,7 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
     lo, hi = uv.min(axis=0), uv.max(axis=0)
     thickness = max(2.0 * seg.rms_m, MIN_PLANE_THICKNESS_M)
     box = Box3D(pf.to_3d((lo + hi) / 2.0)[0], np.array([*(hi - lo), thickness]), pf.R)
+    edges = edge_evidence(grid, frame.camera, seg, cfg) if class_name == "wall" and cfg.wall_bounds else None
     rows, cols = np.nonzero(seg.mask)
     pick = np.linspace(0, len(rows) - 1, min(cfg.pixel_sample, len(rows))).astype(int)
     pixels_uv = np.stack([cols[pick], rows[pick]], axis=1) * grid.stride
@@ -78,19 +81,32 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
             "rms_m": seg.rms_m,
             "num_points": seg.n_points,
             "method": cfg.method,
+            **({"edges": edges} if edges is not None else {}),
         },
     )
 
 
-def observe(frame: Frame, cfg: BackgroundConfig) -> list[Observation]:
-    """Algorithm 1 (``ExtractOb``): the classified plane observations of one frame."""
+def _open(obs: Observation) -> bool:
+    """A wall candidate that does not reach the ceiling or the floor (``bounds.py``)."""
+    return is_open(obs.data.get("edges", {}))
+
+
+def observe_all(frame: Frame, cfg: BackgroundConfig) -> tuple[list[Observation], list[Observation]]:
+    """(observations, open walls): the classified plane observations of one frame, and the
+    vertical planes that would be walls but end in the room (furniture fronts)."""
     grid, segments = extract_planes(frame.depth_m, frame.camera, cfg)
-    out = []
+    out: list[Observation] = []
+    open_walls: list[Observation] = []
     for seg in segments:
         obs = _observation(seg, grid, frame, cfg)
         if obs is not None:
-            out.append(obs)
-    return out
+            (open_walls if _open(obs) else out).append(obs)
+    return out, open_walls
+
+
+def observe(frame: Frame, cfg: BackgroundConfig) -> list[Observation]:
+    """Algorithm 1 (``ExtractOb``): the classified plane observations of one frame."""
+    return observe_all(frame, cfg)[0]
 
 
 def _copy(inst: Instance) -> Instance:
@@ -141,6 +157,7 @@ class BackgroundStage:
         del log_path  # the background needs nothing from the log besides the frames
         self.config = BackgroundConfig.from_options(**options)
         self._last_keyframe_s: float | None = None
+        self._not_walls = NotWalls(self.config)
         _warm_up(self.config.method)
 
     def is_keyframe(self, stamp_s: float) -> bool:
@@ -153,11 +170,22 @@ class BackgroundStage:
             return FrameResult(skipped="not a keyframe")
         self._last_keyframe_s = frame.stamp_s
         start, start_cpu = time.perf_counter(), time.process_time()
-        observations = observe(frame, self.config)
+        observations, open_walls = observe_all(frame, self.config)
         live = dict(world.background)
-        touched, deleted = merge_observations(
-            [to_map(o, frame.T_map_cam) for o in observations], live, self.config
-        )
+        vetoed = self._not_walls.veto([to_map(o, frame.T_map_cam) for o in open_walls], live)
+        kept = []
+        for obs in observations:
+            mo = to_map(obs, frame.T_map_cam)
+            if obs.class_name == "wall" and self._not_walls.covers(mo):
+                continue  # a plane seen ending in the room before: not a wall
+            kept.append(mo)
+        observations = [mo.obs for mo in kept]
+        touched, deleted = merge_observations(kept, live, self.config)
+        for obs in observations:
+            if obs.class_name == "wall":
+                self._not_walls.note(obs.instance_uuid, obs.data.get("edges", {}))
+        deleted = vetoed + deleted + self._not_walls.settle(live)
+        touched = {uuid: inst for uuid, inst in touched.items() if uuid in live}
         timings = {
             "background_s": time.perf_counter() - start,
             # CPU time of the process (all its threads): what the keyframe costs, whatever else runs

@@ -1,0 +1,110 @@
+"""Whether a vertical plane seen in one depth image bounds the free space like a wall.
+
+A wall reaches from the floor to the ceiling: in the image, right above its top edge the
+camera sees the ceiling (or the wall going on), right below its bottom edge the floor at
+the wall's foot, both at about the plane's own depth, unless the edge is the image's edge.
+A furniture front (a shelf, a wardrobe, a stack of boxes) ends in the room: above or below
+it the camera sees farther, or nothing within range. ``edge_evidence`` probes a few samples
+beyond the plane's top and bottom edge in every image column it covers and says, for each
+edge, whether the plane is ``open`` there (most probes see farther than the plane),
+``closed`` (the surface goes on, or the edge is the image's edge) or ``unknown`` (an
+occluder in front, too few probes).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.perceive.background.config import BackgroundConfig
+from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid
+from hiper_cli.types import CameraIntrinsics
+
+__all__ = ["SIDES", "EdgeEvidence", "edge_evidence", "is_open"]
+
+EdgeEvidence = Literal["open", "closed", "unknown"]
+_OPEN, _CLOSED, _UNKNOWN = 1, 0, -1
+
+
+def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.float64],
+           rows: NDArray[np.int64], cols: NDArray[np.int64], cfg: BackgroundConfig) -> NDArray[np.int64]:
+    """Per probe sample (``rows``, ``cols`` on the grid): open, closed or unknown."""
+    stride = grid.stride
+    ray = np.stack([
+        (cols * stride - camera.cx) / camera.fx,
+        (rows * stride - camera.cy) / camera.fy,
+        np.ones(len(rows)),
+    ], axis=1)
+    facing = ray @ plane_cam[:3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z_plane = np.where(facing < -1e-6, -plane_cam[3] / facing, np.inf)
+    z = grid.points_cam[rows, cols, 2]
+    valid = grid.valid[rows, cols]
+    tol = cfg.wall_probe_tolerance_m + cfg.wall_probe_tolerance_frac * z_plane
+    out = np.full(len(rows), _UNKNOWN, dtype=np.int64)
+    seen = valid & np.isfinite(z_plane)
+    out[seen & (z > z_plane + tol)] = _OPEN
+    out[seen & (np.abs(z - z_plane) <= tol)] = _CLOSED
+    # no return where the plane would still be well within range: nothing is there
+    out[~valid & (z_plane < cfg.wall_probe_max_depth_m)] = _OPEN
+    return out
+
+
+def _edge(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: BackgroundConfig,
+          side: str) -> EdgeEvidence:
+    """The evidence beyond one edge of the plane's mask: ``side`` top, bottom, left or right.
+
+    In each image line across the edge the probes lie from ``wall_probe_gap_px`` to
+    ``wall_probe_reach_px`` past it: the line is open when one of them sees beyond the plane
+    (past a furniture front's convex corner the side bends away; past a room's concave corner
+    the next wall is nearer, an occluder), else closed when one lies on the plane or outside
+    the image."""
+    mask = seg.mask if side in ("top", "bottom") else seg.mask.T
+    n_along, _ = mask.shape  # probes move along axis 0 of ``mask``
+    lines = np.flatnonzero(mask.any(axis=0))
+    if len(lines) == 0:
+        return "unknown"
+    gap = max(round(cfg.wall_probe_gap_px / grid.stride), 1)
+    reach = max(round(cfg.wall_probe_reach_px / grid.stride), gap)
+    steps = np.arange(gap, reach + 1)
+    if side in ("top", "left"):
+        edge = np.argmax(mask[:, lines], axis=0)
+        at = edge[:, None] - steps[None, :]
+    else:
+        edge = n_along - 1 - np.argmax(mask[::-1, lines], axis=0)
+        at = edge[:, None] + steps[None, :]
+    line_idx = np.broadcast_to(lines[:, None], at.shape)
+    outside = (at < 0) | (at >= n_along)
+    cat = np.full(at.shape, _CLOSED, dtype=np.int64)  # the image's edge
+    inside = ~outside
+    rows, cols = at[inside], line_idx[inside]
+    if side in ("left", "right"):
+        rows, cols = cols, rows
+    cat[inside] = _probe(grid, camera, seg.plane_cam, rows, cols, cfg)
+    verdict = np.where((cat == _OPEN).any(axis=1), _OPEN,
+                       np.where((cat == _CLOSED).any(axis=1), _CLOSED, _UNKNOWN))
+    n_open = int(np.sum(verdict == _OPEN))
+    n_closed = int(np.sum(verdict == _CLOSED))
+    if n_open + n_closed < cfg.wall_probe_min_columns:
+        return "unknown"
+    return "open" if n_open >= cfg.wall_open_share * (n_open + n_closed) else "closed"
+
+
+SIDES: tuple[str, ...] = ("top", "bottom", "left", "right")
+
+
+def edge_evidence(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,
+                  cfg: BackgroundConfig) -> dict[str, EdgeEvidence]:
+    """The evidence beyond each edge (``SIDES``) of the plane ``seg`` (camera frame) on ``grid``."""
+    return {side: _edge(grid, camera, seg, cfg, side) for side in SIDES}
+
+
+def is_open(edges: dict[str, EdgeEvidence]) -> bool:
+    """Whether a wall candidate ends in the room: open above or below (it does not reach the
+    ceiling or the floor), or at both sides (a free-standing panel; a wall ends at a corner,
+    or at one doorway)."""
+    return edges.get("top") == "open" or edges.get("bottom") == "open" or (
+        edges.get("left") == "open" and edges.get("right") == "open"
+    )
