@@ -25,6 +25,8 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # shared checks and safe file writes every layer may use
     "validate": _CORE_FORBIDDEN,
     "files": _CORE_FORBIDDEN,
+    # the typed learned features: analyze writes them, perceive reads them
+    "learned": _CORE_FORBIDDEN,
     # recognition: log readers (the simulator's truth format included), stages, detectors
     "perceive": (*_ABOVE_PERCEIVE, *_UI, "matplotlib", "rerun"),
     # the knowledge base stores what perceive produced

@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from hiper_cli.cli import app
 from hiper_cli.errors import ConfigError
-from hiper_cli.model import Analysis
+from hiper_cli.learned import AltitudeFeature, SizeFeature
 from hiper_cli.perceive.foreground import ForegroundConfig, ForegroundStage
 from hiper_cli.perceive.foreground.segment import segment
 from hiper_cli.perceive.runner import run_stages
@@ -97,10 +97,25 @@ def test_observations_carry_the_low_level_data():
 
 def test_learned_size_prior_turns_implausible_blobs_unknown():
     world = World(background=background_instances(room()))
-    world.analyses.append(Analysis("size", "person", 0, 1, {"lo_m3": 5.0, "hi_m3": 9.0}, created_s=1.0))
+    world.analyses.append(SizeFeature(7.0, 6.0, 8.0, 5.0, 9.0, 10).to_analysis("person", 0, 1, created_s=1.0))
     stage = ForegroundStage(detector="log", pixel_step=2)
     r = stage.process(walker_frames(1)[0], world)
     assert [o.class_name for o in r.observations] == ["unknown"]
+    switched_off = ForegroundStage(detector="log", pixel_step=2, learned_size=False)
+    r = switched_off.process(walker_frames(1)[0], world)
+    assert [o.class_name for o in r.observations] == ["person"]
+
+
+def test_learned_altitude_prior_rejects_a_floating_person():
+    world = World(background=background_instances(room()))
+    floating = AltitudeFeature(1.5, 1.4, 1.6, 1.2, 1.8, 10).to_analysis("person", 0, 1, created_s=1.0)
+    world.analyses.append(floating)
+    r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
+    assert [o.class_name for o in r.observations] == ["unknown"]
+    r = ForegroundStage(detector="log", pixel_step=2, use_learned_priors=False).process(
+        walker_frames(1)[0], world
+    )
+    assert [o.class_name for o in r.observations] == ["person"]
 
 
 def test_eval_foreground_command_on_a_small_sim_log(tmp_path):
@@ -194,3 +209,22 @@ def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker():
     assert len(a.data["trajectory"]) == 4
     assert np.allclose(a.data["trajectory"], b.data["trajectory"])
     assert len(a.observation_uuids) == len(b.observation_uuids) == 4
+
+
+def test_each_learned_dynamics_prior_switches_alone():
+    from hiper_cli.learned import ObjectDynamics
+
+    world = World(background=background_instances(room()))
+    ods = ObjectDynamics(0.6, 0.58, 0.62, 0.4, 0.8, 0.9, 0.03, 0.06, 100, 90, 5)
+    world.analyses.append(ods.to_analysis("person", 0, 1, created_s=1.0))
+    priors = {}
+    settings = {"all": {}, "no gates": {"learned_gates": False}, "no noise": {"learned_motion_noise": False},
+                "C2": {"use_learned_priors": False}}
+    for name, opts in settings.items():
+        stage = ForegroundStage(detector="log", pixel_step=2, **opts)
+        stage.process(walker_frames(1)[0], world)
+        priors[name] = stage._class_prior("person")
+    assert (priors["all"].cu_mps, priors["all"].sigma_mps) == (0.8, 0.03)
+    assert (priors["no gates"].cu_mps, priors["no gates"].sigma_mps) == (None, 0.03)
+    assert (priors["no noise"].cu_mps, priors["no noise"].sigma_mps) == (0.8, None)
+    assert (priors["C2"].cu_mps, priors["C2"].sigma_mps) == (None, None)

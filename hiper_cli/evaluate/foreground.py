@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.model import Instance, Observation, TrackTrajectory
+from hiper_cli.model import Analysis, Instance, Observation, TrackTrajectory
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.logs.truth import Truth, load_truth
 from hiper_cli.perceive.runner import prefetch, run_stages
@@ -169,11 +169,13 @@ def _frame_truth(
 
 
 def _run(
-    log_path: Path, truth: Truth, options: dict[str, Any], max_frames: int | None, background: str
+    log_path: Path, truth: Truth, options: dict[str, Any], max_frames: int | None, background: str,
+    priors: Sequence[Analysis] = (),
 ) -> ForegroundRun:
     from hiper_cli.perceive.logs import open_log
 
     stages, world, source = _background(truth, background)
+    world.analyses = list(priors)  # learned features the foreground stage reads
     foreground = make_stage("foreground", log_path=log_path, **options)
     stages.append(foreground)
     reader = open_log(log_path)

@@ -211,6 +211,7 @@ class DocumentStore(ChangeFeed, Lookups):
 
     def __init__(self, path: Path, *, read_only: bool = False) -> None:
         self.path = Path(path)
+        self.read_only = read_only
         if self.path.is_file() and self.path.stat().st_size > 0:
             inspect_existing(self.path)  # read-only: refuse another program's file before any write
         try:
@@ -287,6 +288,11 @@ class DocumentStore(ChangeFeed, Lookups):
             self._db.execute("ROLLBACK")
             raise
         self._db.execute("COMMIT")
+
+    @property
+    def connection(self) -> GuardedConnection:
+        """The SQLite connection, for column reads (``columns.py``); write through ``put``."""
+        return self._db
 
     def close(self) -> None:
         self._db.close()

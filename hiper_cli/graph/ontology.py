@@ -9,7 +9,6 @@ instance -> observation provenance).
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from collections.abc import Sequence
@@ -18,7 +17,7 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from hiper_cli.model import ROW_POSITION, ROW_STAMP
+from hiper_cli.learned import path_speed_mps
 
 __all__ = [
     "HIPER",
@@ -115,15 +114,7 @@ def speed_mps(doc: dict[str, Any]) -> float | None:
     if "trajectory_speed_mps" in data and "trajectory" not in data:
         speed = data["trajectory_speed_mps"]
         return None if speed is None else float(speed)
-    rows = data.get("trajectory") or []
-    if len(rows) < 2:
-        return None
-    try:
-        dist = sum(math.dist(a[ROW_POSITION], b[ROW_POSITION]) for a, b in itertools.pairwise(rows))
-        dt = float(rows[-1][ROW_STAMP]) - float(rows[0][ROW_STAMP])
-    except (TypeError, ValueError, IndexError):  # not [t, x, y, z, ...] rows: no speed
-        return None
-    return dist / dt if dt > 0 else None
+    return path_speed_mps(data.get("trajectory") or [])
 
 
 def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[ox.Quad]:

@@ -16,11 +16,9 @@ from __future__ import annotations
 import hashlib
 from typing import Any
 
-import numpy as np
-
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.sqlite_guard import GuardedConnection
-from hiper_cli.model import ROW_POSITION, ROW_STAMP
+from hiper_cli.learned import path_speed_mps
 
 __all__ = ["CHUNK_ROWS", "INLINE_ROWS", "SCHEMA", "TrajectoryStore"]
 
@@ -32,19 +30,6 @@ CREATE TABLE IF NOT EXISTS trajectories (
     PRIMARY KEY (instance_uuid, chunk)
 ) WITHOUT ROWID;
 """
-
-
-def _speed_mps(rows: list[Any]) -> float | None:
-    """Mean speed along the rows (path length over duration), as ``ontology.speed_mps``; None
-    for rows that are not [t, x, y, z, ...] numbers."""
-    try:
-        xyz = np.asarray([r[ROW_POSITION] for r in rows], dtype=np.float64)
-        dt = float(rows[-1][ROW_STAMP]) - float(rows[0][ROW_STAMP])
-    except (TypeError, ValueError, IndexError):
-        return None
-    if len(rows) < 2 or dt <= 0 or xyz.shape != (len(rows), 3):
-        return None
-    return float(np.linalg.norm(np.diff(xyz, axis=0), axis=1).sum() / dt)
 
 
 class TrajectoryStore:
@@ -64,7 +49,7 @@ class TrajectoryStore:
         assert isinstance(data, dict)
         kept = {k: v for k, v in data.items() if k != "trajectory"}
         kept["trajectory_rows"] = len(rows)
-        kept["trajectory_speed_mps"] = _speed_mps(rows)
+        kept["trajectory_speed_mps"] = path_speed_mps(rows)
         return {**doc, "data": kept}, rows
 
     def write(self, uuid: str, rows: list[Any] | None) -> None:

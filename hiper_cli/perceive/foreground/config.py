@@ -351,7 +351,17 @@ class TrackerConfig(_Part):
     dynamic_speed_mps: float = 0.15
     """A track moving faster than this is ``dynamic``; slower is ``static``."""
     use_learned_priors: bool = True
-    """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist."""
+    """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist
+    (``hiper analyze features``); off: the paper's C2 ablation. Each part can be switched alone:"""
+    learned_gates: bool = True
+    """The ODS's ``cu_mps · dt`` gates the tracker's association (dt < 1 s)."""
+    learned_motion_noise: bool = True
+    """The ODS's stationary-noise ``sigma_mps`` sets the class's acceleration noise."""
+    learned_size: bool = True
+    """A detection whose blob volume is outside the class's learned range becomes ``unknown``."""
+    learned_altitude: bool = True
+    """A detection whose blob bottom is outside the class's learned altitude range becomes
+    ``unknown`` (a person on a poster or a TV screen floats above the floor)."""
     prior_tolerance: float = 0.5
     """Size / altitude priors reject a class when a blob is outside [lo·(1-t), hi·(1+t)]."""
 

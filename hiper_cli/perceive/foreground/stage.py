@@ -12,7 +12,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import ConfigError, PerceptionError
+from hiper_cli.errors import ConfigError, DataError, PerceptionError
+from hiper_cli.learned import (
+    FEATURE_KINDS,
+    KIND_ALTITUDE,
+    KIND_ODS,
+    KIND_SIZE,
+    AltitudeFeature,
+    ObjectDynamics,
+    SizeFeature,
+    feature_from_analysis,
+)
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
@@ -101,7 +111,7 @@ class ForegroundStage:
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
         self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
-        self._priors: dict[tuple[str, str], dict[str, Any]] = {}
+        self._priors: dict[tuple[str, str], ObjectDynamics | SizeFeature | AltitudeFeature] = {}
         self._analyses_seen = -1
         self.tracker = Tracker(cfg, self._class_prior)
         self._instances: dict[str, Instance] = {}
@@ -113,34 +123,38 @@ class ForegroundStage:
         self._analyses_seen = len(world.analyses)
         self._priors = {}
         for a in sorted(world.analyses, key=lambda a: a.created_s):
-            if a.kind in ("ods", "size", "altitude"):
-                self._priors[(a.kind, a.class_name)] = dict(a.values)
+            if a.kind in FEATURE_KINDS:
+                try:
+                    self._priors[(a.kind, a.class_name)] = feature_from_analysis(a)
+                except DataError:  # written by an older hiper: no prior rather than no run
+                    continue
 
     def _class_prior(self, class_name: str) -> ClassPrior:
-        ods = self._priors.get(("ods", class_name))
-        if not ods:
+        cfg = self.config
+        ods = self._priors.get((KIND_ODS, class_name))
+        if not isinstance(ods, ObjectDynamics) or not cfg.use_learned_priors:
             return ClassPrior()
-        cu, sigma = ods.get("cu_mps"), ods.get("sigma_mps")
         return ClassPrior(
-            cu_mps=float(cu) if cu is not None else None,
-            sigma_mps=float(sigma) if sigma is not None else None,
+            cu_mps=ods.cu_mps if cfg.learned_gates else None,
+            sigma_mps=ods.sigma_mps if cfg.learned_motion_noise else None,
         )
 
     def _fits_priors(self, class_name: str, blob: Blob) -> bool:
         """False when the learned size / altitude of ``class_name`` rule the blob out."""
-        if not self.config.use_learned_priors:
+        cfg = self.config
+        if not cfg.use_learned_priors:
             return True
-        tol = self.config.prior_tolerance
-        size = self._priors.get(("size", class_name))
-        if size and "lo_m3" in size and "hi_m3" in size:
+        tol = cfg.prior_tolerance
+        size = self._priors.get((KIND_SIZE, class_name))
+        if cfg.learned_size and isinstance(size, SizeFeature):
             volume = float(np.prod(blob.extent_map_m))
-            if not float(size["lo_m3"]) * (1 - tol) <= volume <= float(size["hi_m3"]) * (1 + tol):
+            if not size.lo_m3 * (1 - tol) <= volume <= size.hi_m3 * (1 + tol):
                 return False
-        alt = self._priors.get(("altitude", class_name))
-        if alt and "lo_m" in alt and "hi_m" in alt:
-            lo, hi = float(alt["lo_m"]), float(alt["hi_m"])
-            slack = tol * max(hi - lo, MIN_ALTITUDE_SPAN_M)
-            if not lo - slack <= float(blob.center_map_m[2]) <= hi + slack:
+        alt = self._priors.get((KIND_ALTITUDE, class_name))
+        if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
+            slack = tol * max(alt.hi_m - alt.lo_m, MIN_ALTITUDE_SPAN_M)
+            bottom = float(blob.center_map_m[2] - blob.extent_map_m[2] / 2.0)
+            if not alt.lo_m - slack <= bottom <= alt.hi_m + slack:
                 return False
         return True
 

@@ -1,0 +1,81 @@
+"""``hiper analyze heatmap`` as one library call: query the class's rows and μ_v, draw them on
+the environment's map, write the files and record the heatmap as an analysis."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.analyze.costmap import MaskConfig, write_outputs
+from hiper_cli.analyze.features import FeatureConfig, check_classes, object_dynamics
+from hiper_cli.analyze.heatmap import Heatmap, HeatmapConfig, heatmap_from_rows
+from hiper_cli.analyze.maplayer import MapConfig, environment_of, map_for
+from hiper_cli.analyze.window import TimeWindow
+from hiper_cli.graph.columns import trajectory_columns
+from hiper_cli.graph.kb import KnowledgeBase
+from hiper_cli.learned import KIND_HEATMAP, KIND_ODS, ObjectDynamics
+from hiper_cli.model import Analysis
+
+__all__ = ["HeatmapResult", "generate_heatmap", "learned_speed_mps"]
+
+
+@dataclass(frozen=True)
+class HeatmapResult:
+    heatmap: Heatmap
+    files: dict[str, str]
+    speed_source: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return self.heatmap.summary() | {"speed_source": self.speed_source, "files": self.files}
+
+
+def learned_speed_mps(kb: KnowledgeBase, class_name: str) -> float | None:
+    """μ_v of the newest ``ods`` analysis of ``class_name``, if there is one with motion."""
+    found = [d for d in kb.docs.find(type="analysis", class_name=class_name) if d.get("kind") == KIND_ODS]
+    if not found:
+        return None
+    newest = max(found, key=lambda d: float(d.get("created_s", 0.0)))
+    return ObjectDynamics.from_values(Analysis.from_dict(newest).values).mean_mps
+
+
+def generate_heatmap(
+    kb: KnowledgeBase,
+    class_name: str,
+    window: TimeWindow | None = None,
+    out_dir: str | Path = ".",
+    *,
+    env_name: str | None = None,
+    map_yaml: str | None = None,
+    inverse: bool = False,
+    config: HeatmapConfig | None = None,
+    map_config: MapConfig | None = None,
+    mask_config: MaskConfig | None = None,
+    store: bool = True,
+) -> HeatmapResult:
+    """The heatmap of ``class_name`` in ``window`` on the environment's map, its files in
+    ``out_dir`` and (``store``) a ``heatmap`` analysis listing them."""
+    window = window or TimeWindow()
+    check_classes(kb, [class_name])
+    env = environment_of(kb, env_name)
+    grid = map_for(kb, env, map_yaml, map_config)
+    tracks = trajectory_columns(kb.docs, class_name, window.t_start_s, window.t_end_s)
+    speed = learned_speed_mps(kb, class_name)
+    source = "ods analysis"
+    if speed is None:
+        keep = window.mask(tracks.rows[:, 0])
+        rows = tracks.rows[keep]
+        speeds = np.hypot(rows[:, 4], rows[:, 5])
+        ods = object_dynamics(speeds, tracks.track[keep], FeatureConfig(bootstrap_samples=10))
+        speed, source = ods.mean_mps, "these rows"
+    hm = heatmap_from_rows(class_name, tracks.rows, tracks.track, grid, window, speed, config)
+    files = write_outputs(hm, out_dir, mask_config, inverse=inverse)
+    if store:
+        lo = window.t_start_s if window.t_start_s is not None else float(tracks.rows[:, 0].min(initial=0.0))
+        hi = window.t_end_s if window.t_end_s is not None else float(tracks.rows[:, 0].max(initial=0.0))
+        values = hm.summary() | {"files": files, "speed_source": source}
+        kb.put_analyses([Analysis(KIND_HEATMAP, class_name, lo, hi, values, time.time())], env_uuid=env.uuid)
+    return HeatmapResult(hm, files, source)
