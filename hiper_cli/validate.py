@@ -66,6 +66,8 @@ OPTION_RANGES: dict[str, Range] = {
     "depth_scale": Range(1e-3, 1e7),
     "max_dt_s": Range(0.0, 60.0),
     "mapping_hz": Range(0.0, 1000.0, lo_open=True), "keyframe_hz": Range(0.0, 1000.0, lo_open=True),
+    # hiper analyze
+    "hours": Range(0.0, 1000.0, lo_open=True), "resolution_m": Range(0.001, 10.0),
     # hiper sim
     "seconds": Range(0.0, 24 * 3600.0, lo_open=True), "rate_hz": Range(0.0, 1000.0, lo_open=True),
     "seed": Range(0, (1 << 32) - 1, integer=True), "max_range_m": Range(0.0, 1000.0, lo_open=True),

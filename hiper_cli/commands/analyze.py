@@ -54,7 +54,7 @@ def features_command(
         Path | None, typer.Option("--plot", help="Write histograms (paper Fig. 8) to this PNG.")
     ] = None,
     no_store: Annotated[
-        bool, typer.Option("--no-store", help="Do not write the analyses into the KB.")
+        bool, typer.Option("--no-store", help="Show the features only; leave the KB as it is.")
     ] = False,
     kb: KbOption = "scene.hiper",
     kb_docs: KbDocsOption = None,
