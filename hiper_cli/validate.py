@@ -77,6 +77,11 @@ OPTION_RANGES: dict[str, Range] = {
     # hiper eval, hiper kb bench
     "max_frames": COUNT, "queries": Range(1, 1_000_000, integer=True),
     "obs_per_frame": Range(1, 10_000, integer=True), "graph_sync_s": Range(0.0, 3600.0),
+    # hiper query, describe, serve, view (stamps in seconds: log time, possibly Unix epoch)
+    "start_s": Range(-1e11, 1e11), "end_s": Range(-1e11, 1e11), "recent_s": Range(0.0, 1e9),
+    "limit": Range(1, 1 << 31, integer=True), "resolution": Range(0.001, 10.0),
+    "instances": Range(1, 10_000_000, integer=True), "observations": Range(1, 100_000_000, integer=True),
+    "port": Range(0, 65535, integer=True), "image_hz": Range(0.0, 1000.0, lo_open=True),
 }
 
 
