@@ -16,18 +16,13 @@ from hiper_cli.cli import app
 from hiper_cli.errors import QueryError
 from hiper_cli.graph import open_kb
 from hiper_cli.query import ask
+from hiper_cli.query.bench import QUERY_FORMS
 from hiper_cli.query.templates import template
 from tests.query_truth_kb import house_truth_kb
 
 runner = CliRunner()
 EXAMPLES = (
-    "cups in FOV",
-    "closest table",
-    "people moving in the last 10 minutes",
-    "where was the bottle last seen",
-    "how many chairs",
-    "objects on the closest table",
-    "when did a person last pass here",
+    *QUERY_FORMS,  # the examples, the benchmark's query forms
     "is there a cup on the table",
     "go to the couch",
     "how long was the person in view",

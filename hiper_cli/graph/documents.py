@@ -19,7 +19,6 @@ write (~1,300 docs/s at 2 k documents, ~600/s at 5 k), SQLite with JSON document
 from __future__ import annotations
 
 import json
-import math
 import sqlite3
 import time
 from collections.abc import Iterator, Sequence
@@ -31,6 +30,7 @@ from typing import Any
 from hiper_cli.errors import KnowledgeBaseError
 from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.graph.grid import GRID_CELL_M, cell_index, cell_key, grid_rows
 from hiper_cli.graph.lookups import Lookups
 from hiper_cli.graph.sqlite_guard import (
     GuardedConnection,
@@ -174,23 +174,9 @@ def _session(row: Sequence[Any]) -> Session:
 
 Box = tuple[Sequence[float], Sequence[float]]
 
-# Observations are indexed spatially by the 2 m map cell (x, y, z) of their box centre in a
-# B-tree (cheaper to insert into than the R*Tree as it grows, measured); a query widens its box
-# by the largest half extent stored (meta ``grid_margin_m``) and scans one key range per (x, y)
-# column of cells. Other documents (instances, few and moving) stay in the R*Tree ``docs_box``.
-GRID_CELL_M = 2.0  # new stores; one written before this value was chosen keeps 1 m (meta)
-_GRID_OFFSET = 1 << 19
-_GRID_SPAN = 1 << 20
-
-
-def _cell_index(v: float, cell_m: float) -> int:
-    return math.floor(v / cell_m)
-
-
-def _cell_key(ix: int, iy: int, iz: int) -> int:
-    return ((ix + _GRID_OFFSET) * _GRID_SPAN + (iy + _GRID_OFFSET)) * _GRID_SPAN + (iz + _GRID_OFFSET)
-
-
+# Observations are indexed by the map cell of their box centre (graph/grid.py); a query widens
+# its box by the largest half extent stored (meta ``grid_margin_m``). Other documents
+# (instances, few and moving) stay in the R*Tree ``docs_box``.
 def _box_meets(doc: dict[str, Any], lo: Sequence[float], hi: Sequence[float]) -> bool:
     """Whether the map-frame box of a document (``box``: centre, extent, rotation) meets the
     axis-aligned box [lo, hi]; a document without a box passes."""
@@ -424,7 +410,7 @@ class DocumentStore(ChangeFeed, Lookups):
                 if doc["type"] == "observation":
                     c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
                     margin = max(margin, *(hi[k] - c[k] for k in range(3)))
-                    grid.append((_cell_key(*(_cell_index(v, cell_m) for v in c)),
+                    grid.append((cell_key(*(cell_index(v, cell_m) for v in c)),
                                  lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
                 else:
                     boxes.append((lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
@@ -715,30 +701,13 @@ class DocumentStore(ChangeFeed, Lookups):
     def _observations_in_box(
         self, lo: Sequence[float], hi: Sequence[float], limit: int | None
     ) -> list[dict[str, Any]]:
-        margin, cell_m = self._grid_margin(), self._grid_cell_m
-        ix0, ix1 = _cell_index(lo[0] - margin, cell_m), _cell_index(hi[0] + margin, cell_m)
-        iy0, iy1 = _cell_index(lo[1] - margin, cell_m), _cell_index(hi[1] + margin, cell_m)
-        iz0, iz1 = _cell_index(lo[2] - margin, cell_m), _cell_index(hi[2] + margin, cell_m)
         bounds = [hi[0], lo[0], hi[1], lo[1], hi[2], lo[2]]
         where = ("g.min_x <= ? AND g.max_x >= ? AND g.min_y <= ? AND g.max_y >= ? "
                  "AND g.min_z <= ? AND g.max_z >= ?")
-        select = "SELECT d.body FROM obs_cells g CROSS JOIN docs d ON d.id = g.id WHERE "
-        # the staged rows (at most STAGED_ROWS, not yet in obs_cells) are scanned
-        out: list[dict[str, Any]] = [
-            self._decode(b) for (b,) in self._db.execute(select.replace("obs_cells", "obs_cells_new") + where,
-                                                         bounds)
-        ]
-        if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 4096:  # a huge box: scan
-            rows = self._db.execute(select + where, bounds)
-            out += [self._decode(b) for (b,) in rows]
-        else:
-            for ix in range(ix0, ix1 + 1):
-                for iy in range(iy0, iy1 + 1):
-                    rows = self._db.execute(select + "g.cell BETWEEN ? AND ? AND " + where,
-                                            [_cell_key(ix, iy, iz0), _cell_key(ix, iy, iz1), *bounds])
-                    out.extend(self._decode(b) for (b,) in rows)
-                if limit is not None and len(out) >= limit:
-                    break
+        select = "SELECT d.body FROM {table} g CROSS JOIN docs d ON d.id = g.id WHERE "
+        rows = grid_rows(self._db, select, where, bounds, lo, hi, self._grid_cell_m,
+                         margin_m=self._grid_margin(), limit=limit)
+        out = [self._decode(b) for (b,) in rows]
         return out if limit is None else out[:limit]
 
     def counts(self) -> list[tuple[str, str | None, str | None, int]]:

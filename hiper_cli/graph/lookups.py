@@ -5,10 +5,10 @@ blob). A mixin of ``DocumentStore``."""
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from typing import Any
 
+from hiper_cli.graph.grid import grid_rows
 from hiper_cli.graph.sqlite_guard import GuardedConnection
 
 __all__ = ["Lookups"]
@@ -25,7 +25,6 @@ class Lookups:
     ) -> list[tuple[str, str | None, float, float, float, float]]:
         """(uuid, instance uuid, stamp_s, x, y, z) of the observations whose map box centre lies
         in [lo, hi] (of class ``class_name`` when given)."""
-        cell = self._grid_cell_m
         where = (
             "(g.min_x + g.max_x) / 2 BETWEEN ? AND ? AND (g.min_y + g.max_y) / 2 BETWEEN ? AND ? "
             "AND (g.min_z + g.max_z) / 2 BETWEEN ? AND ?"
@@ -39,19 +38,7 @@ class Lookups:
             "(g.min_y + g.max_y) / 2, (g.min_z + g.max_z) / 2 FROM {table} g "
             "CROSS JOIN docs d ON d.id = g.id WHERE "
         )
-        out = list(self._db.execute(select.format(table="obs_cells_new") + where, params))
-        ix0, ix1 = math.floor(lo[0] / cell), math.floor(hi[0] / cell)
-        iy0, iy1 = math.floor(lo[1] / cell), math.floor(hi[1] / cell)
-        iz0, iz1 = math.floor(lo[2] / cell), math.floor(hi[2] / cell)
-        from hiper_cli.graph.documents import _cell_key
-
-        if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 4096:  # a huge box: scan
-            out += self._db.execute(select.format(table="obs_cells") + where, params)
-        else:
-            sql = select.format(table="obs_cells") + "g.cell BETWEEN ? AND ? AND " + where
-            for ix in range(ix0, ix1 + 1):
-                for iy in range(iy0, iy1 + 1):
-                    out += self._db.execute(sql, [_cell_key(ix, iy, iz0), _cell_key(ix, iy, iz1), *params])
+        out = grid_rows(self._db, select, where, params, lo, hi, self._grid_cell_m)
         return [(str(u), i, float(t), float(x), float(y), float(z)) for u, i, t, x, y, z in out]
 
     def observation_links(self, instance_uuids: Sequence[str]) -> dict[str, list[str]]:
