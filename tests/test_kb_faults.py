@@ -38,6 +38,16 @@ def test_foreign_database_is_refused_before_any_write(tmp_path):
     assert sqlite3.connect(db_path).execute("PRAGMA journal_mode").fetchone()[0] == "delete"
 
 
+def test_a_store_whose_creation_was_killed_before_its_schema_opens_as_new(tmp_path):
+    # what a kill -9 right after the journal-mode pragma leaves: an SQLite file with no tables
+    (tmp_path / "cut").mkdir()
+    db = sqlite3.connect(tmp_path / "cut" / "documents.sqlite")
+    db.execute("PRAGMA journal_mode=WAL")
+    db.close()
+    with open_kb(tmp_path / "cut") as kb:
+        assert kb.docs.meta("schema_version") is not None
+
+
 def test_unsupported_kb_schemes_are_refused(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for location in ("ftp://example.org/kb", "s3://bucket/kb", "HTTP://"):

@@ -221,14 +221,17 @@ class DocumentStore(ChangeFeed, Lookups):
                 # 4 KiB pages, another ~+6 % for 40,000 2 KiB pages at 100 k; memory stays bounded.
                 self._db.execute("PRAGMA cache_size=-32768")
                 self._db.execute("PRAGMA wal_autocheckpoint=40000")
-                self._db.executescript(_SCHEMA + TRAJECTORIES_SCHEMA)
+                # the tables and the schema version in one transaction: a process killed while
+                # creating the store leaves an empty file (which the next open initialises), never
+                # tables without a version (which would read as another program's database)
+                self._db.executescript(
+                    "BEGIN IMMEDIATE;\n" + _SCHEMA + TRAJECTORIES_SCHEMA
+                    + f"\nINSERT OR IGNORE INTO meta VALUES ('schema_version', '{SCHEMA_VERSION}');"
+                    "\nINSERT OR IGNORE INTO meta VALUES ('seq', '0');\nCOMMIT;"
+                )
                 columns = {str(r[1]) for r in self._db.execute("PRAGMA table_info(docs)")}
                 if "created_seq" not in columns:  # a store written before it existed: NULL = old
                     self._db.execute("ALTER TABLE docs ADD COLUMN created_seq INTEGER")
-                self._db.execute(
-                    "INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
-                )
-                self._db.execute("INSERT OR IGNORE INTO meta VALUES ('seq', '0')")
         except (sqlite3.Error, KnowledgeBaseError) as err:
             if hasattr(self, "_db"):
                 self._db.close()

@@ -142,6 +142,8 @@ def inspect_existing(path: Path) -> None:
         db = connect_read_only(path)
         try:
             tables = {str(r[0]) for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+            if not tables:  # a store whose creation was cut before its schema: nothing to lose
+                return
             if not {"meta", "docs"} <= tables:
                 theirs = ", ".join(sorted(tables)[:5]) or "none"
                 raise KnowledgeBaseError(
