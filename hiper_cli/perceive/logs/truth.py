@@ -1,4 +1,5 @@
-"""Ground truth of a simulated log (the ``gt/`` folder written by ``hiper sim``): a log format.
+"""Ground truth of a log: the ``gt/`` folder written by ``hiper sim`` (a realistic world's
+``gt/instances.json`` is read by ``world_truth.py`` into the same ``Truth``).
 
 The layout, beside the TUM RGB-D files of the log (``rgb.txt``, ``depth.txt``,
 ``groundtruth.txt`` = T_map_cam per stamp, ``camera.json``)::
@@ -58,6 +59,12 @@ class TruthInstance:
     box: Box3D
     plane: tuple[float, float, float, float] | None = None
     speed_mps: float | None = None
+    # Other classes a detector may fairly report (a realistic world's ``alt_classes``).
+    alt_classes: tuple[str, ...] = ()
+    # Whether depth could map it (a realistic world's ``observed``; sim truth lists only these).
+    observed: bool = True
+    # First and last stamp with a visible pixel, where the truth records them.
+    seen_s: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -78,6 +85,9 @@ class Truth:
     # id -> (T, 7) rows [stamp_s, x, y, z, vx, vy, vz], sorted by stamp
     tracks: dict[int, NDArray[np.float64]] = field(default_factory=dict)
     root: Path = Path(".")
+    # Folder of the per-pixel id images under gt/, and the per-frame visibility file (or None).
+    ids_dir: str = "instance_ids"
+    frames_file: str | None = None
 
     def phase_at(self, stamp_s: float) -> str:
         for phase in self.phases:
@@ -87,7 +97,31 @@ class Truth:
 
     def instance_ids_path(self, rgb_relpath: str) -> Path:
         """The per-pixel id image that belongs to an rgb image path of ``rgb.txt``."""
-        return self.root / "gt" / "instance_ids" / (Path(rgb_relpath).stem + ".png")
+        return self.root / "gt" / self.ids_dir / (Path(rgb_relpath).stem + ".png")
+
+    def has_instance_ids(self, rgb_relpath: str) -> bool:
+        """Whether this frame has an id image (realistic worlds label every 5th frame)."""
+        return self.instance_ids_path(rgb_relpath).exists()
+
+    def load_visibility(self) -> dict[float, dict[int, int]]:
+        """Visible pixels per instance per stamp (``gt/frames.jsonl``, realistic worlds)."""
+        if self.frames_file is None:
+            raise LogError(f"{self.root / 'gt'}: this truth has no per-frame visibility file")
+        path = self.root / "gt" / self.frames_file
+        try:
+            lines = path.read_text().splitlines()
+        except OSError as err:
+            raise LogError(f"{path}: cannot read ({err.strerror})") from err
+        out: dict[float, dict[int, int]] = {}
+        for lineno, line in enumerate(lines, 1):
+            if not line.strip():
+                continue
+            try:
+                rec = json.loads(line)
+                out[float(rec["t"])] = {int(k): int(v) for k, v in rec["visible"].items()}
+            except (json.JSONDecodeError, KeyError, TypeError, ValueError, AttributeError) as err:
+                raise LogError(f"{path}:{lineno}: bad frame record ({err})") from err
+        return out
 
     def load_instance_ids(self, rgb_relpath: str) -> NDArray[np.uint16]:
         import cv2
@@ -124,12 +158,20 @@ class Truth:
 
 
 def load_truth(log_dir: str | Path) -> Truth:
-    """Read ``LOG/gt``; raise ``LogError`` naming the file when it is missing or malformed."""
+    """Read ``LOG/gt`` (``hiper sim`` truth, or a realistic world's ``gt/instances.json``).
+
+    Raises ``LogError`` naming the file when it is missing or malformed.
+    """
     root = Path(log_dir)
     world_path = root / "gt" / "world.json"
     if not world_path.exists():
+        from .world_truth import WORLD_TRUTH_FILE, load_world_truth
+
+        if (root / "gt" / WORLD_TRUTH_FILE).exists():
+            return load_world_truth(root)
         raise LogError(
-            f"{world_path}: not found; ground truth exists only for logs written by hiper sim"
+            f"{world_path}: not found; ground truth is gt/world.json (hiper sim) or "
+            f"gt/{WORLD_TRUTH_FILE} (a realistic world)"
         )
     try:
         world = json.loads(world_path.read_text())
