@@ -18,7 +18,7 @@ from pathlib import Path
 
 from hiper_cli.errors import DataError
 
-__all__ = ["atomic_output", "os_error", "refuse_inside"]
+__all__ = ["atomic_output", "os_error", "output_folder", "refuse_inside"]
 
 KB_MARKER = "documents.sqlite"
 
@@ -47,6 +47,21 @@ def refuse_inside(path: Path, what: str) -> None:
         where = inside[0] if inside else resolved.parent
         raise DataError(f"{path}: inside the knowledge base {where}; only hiper's store writes there; "
                         f"write the {what} elsewhere")
+
+
+def output_folder(path: Path | str) -> Path:
+    """Create the folder ``path`` (and its parents) for outputs; a one-line error when a file
+    stands there or it cannot be made."""
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise DataError(f"{folder}: a file, not a folder; pass a folder for the outputs (-o DIR)")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise DataError(f"{folder}: a file stands in its path; pass another folder") from None
+    except OSError as err:
+        raise os_error(folder, err, "create") from err
+    return folder
 
 
 def _umask() -> int:

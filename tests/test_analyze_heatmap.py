@@ -225,3 +225,16 @@ def test_heatmap_cli_json_and_errors(hospital, tmp_path):
     )
     assert m.exit_code == 0, m.output
     assert json.loads(m.output)["occupied_cells"] > 0 and (tmp_path / "floor.pgm").exists()
+
+
+def test_outputs_that_cannot_be_written_get_one_line_errors(hospital, tmp_path):
+    path, _ = hospital
+    runner = CliRunner()
+    a_file = tmp_path / "maps"
+    a_file.write_text("not a folder")
+    heat = runner.invoke(app, ["analyze", "heatmap", "--kb", str(path), "-o", str(a_file)])
+    assert heat.exit_code != 0 and "not a folder" in heat.output
+    assert a_file.read_text() == "not a folder"
+    plain = runner.invoke(app, ["analyze", "map", "--kb", str(path), "-o", str(tmp_path / "floor")])
+    assert plain.exit_code != 0 and ".yaml" in plain.output
+    assert not (tmp_path / "floor").exists() and not (tmp_path / "floor.pgm").exists()

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from hiper_cli.analyze.gridmap import FREE, OCCUPIED, UNKNOWN, write_map_server
 from hiper_cli.analyze.heatmap import Heatmap
 from hiper_cli.errors import ConfigError
+from hiper_cli.files import output_folder
 
 __all__ = ["MaskConfig", "keepout_mask", "render_png", "speed_mask", "write_outputs"]
 
@@ -162,8 +163,7 @@ def write_outputs(
     ``inverse``, the filter servers' parameters and the costmap ``filters:`` snippet into
     ``out_dir``; returns name -> path."""
     config = config or MaskConfig()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     stem = f"heatmap_{hm.class_name.replace(' ', '_')}"
     known = hm.grid.cells != UNKNOWN
     files: dict[str, str] = {"png": str(render_png(hm, out / f"{stem}.png"))}

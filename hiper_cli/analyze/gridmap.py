@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError, DataError
+from hiper_cli.files import output_folder
 
 __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "read_map_server", "write_map_server"]
 
@@ -163,7 +164,9 @@ def write_map_server(
         raise ConfigError(f"map mode {mode!r}; expected trinary or raw")
     yaml_p = Path(yaml_path)
     pgm = yaml_p.with_suffix(".pgm")
-    yaml_p.parent.mkdir(parents=True, exist_ok=True)
+    if yaml_p.suffix.lower() not in (".yaml", ".yml"):
+        raise ConfigError(f"{yaml_p}: a map is written as map_server YAML; pass a .yaml path (PGM beside it)")
+    output_folder(yaml_p.parent)
     if image is None:
         c = grid.cells
         if mode == "raw":
