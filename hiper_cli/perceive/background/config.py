@@ -42,6 +42,8 @@ class BackgroundConfig:
     # the image, so its second difference is ~0 even at grazing angles
     jump_inv_m: float = 0.02
     grow_angle_deg: float = 12.0
+    # far cells may differ by the angle their depth noise explains (``planes._grow_angle``)
+    grow_noise_angle: bool = True
     grow_offset_m: float = 0.04
     inlier_m: float = 0.03  # point-to-plane distance of an inlier at 1 m (grows with depth)
     min_plane_cells: int = 4
