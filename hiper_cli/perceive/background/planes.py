@@ -138,7 +138,8 @@ def _extract_fast(grid: SampleGrid, cfg: BackgroundConfig) -> list[PlaneSegment]
         ((slice(0, gh - 1), slice(None)), (slice(1, gh), slice(None))),
     ):
         na, nb = normal[sa], normal[sb]
-        ok = planar[sa] & planar[sb] & (np.einsum("...i,...i->...", na, nb) > np.maximum(cos_grow[sa], cos_grow[sb]))
+        cos_ab = np.maximum(cos_grow[sa], cos_grow[sb])  # the stricter of the two cells
+        ok = planar[sa] & planar[sb] & (np.einsum("...i,...i->...", na, nb) > cos_ab)
         off_ab = np.abs(np.einsum("...i,...i->...", na, mean[sb]) + d[sa])
         off_ba = np.abs(np.einsum("...i,...i->...", nb, mean[sa]) + d[sb])
         ok &= (off_ab < offset[sa]) & (off_ba < offset[sb])
