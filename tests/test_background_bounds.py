@@ -57,3 +57,18 @@ def test_a_wardrobe_seen_near_after_far_stays_out_of_the_walls():
     assert all(abs(abs(w.data["plane_map"][3]) - 3.0) > 0.2 for w in _walls_facing_minus_y(world))
     offsets = sorted(abs(w.data["plane_map"][3]) for w in _walls_facing_minus_y(world))
     assert np.isclose(offsets[-1], 5.0, atol=0.05)
+
+
+def test_a_far_wall_over_shelves_is_as_tall_as_the_view_shows_it():
+    # from 4.8 m, pitched 15 degrees down, the camera sees the wall at y = 6 up to 2.0 m only;
+    # bookshelves 1.06 m tall stand at it: 0.94 m of wall shows, less than wall_min_height_m
+    shelves = SceneBox(41, "shelf", (0.0, 5.75, 0.0), (6.0, 6.0, 1.06))
+    pose = look_at((3.0, 1.2, 1.2), (3.0, 6.0, 1.2 - 4.8 * np.tan(np.radians(15.0))))
+    far = [*box_room(size=(6.0, 6.0, 3.0)), shelves]
+
+    def far_walls(**options):
+        world = _run(far, [pose], **options)
+        return [w for w in _walls_facing_minus_y(world) if abs(abs(w.data["plane_map"][3]) - 6.0) < 0.05]
+
+    assert len(far_walls()) == 1
+    assert far_walls(wall_view_bounded=False) == []

@@ -19,10 +19,13 @@ BACKGROUND_CLASSES: tuple[str, ...] = ("wall", "floor", "ceiling", "table")
 
 
 def classify_plane(plane_map: NDArray[np.float64], contour_map: NDArray[np.float64],
-                   cfg: BackgroundConfig) -> str | None:
+                   cfg: BackgroundConfig, *, view_bounded: bool = False) -> str | None:
     """The class of a plane seen with outline ``contour_map`` (K, 3), or None (unknown).
 
     ``plane_map`` is [n, d] in the map frame with the unit normal facing the camera.
+    ``view_bounded``: a vertical plane seen up to the image's top and down to an occluder in
+    front (``bounds.view_bounded``): it is as tall as the view lets it be seen, so the wall
+    height test does not apply (the others do).
     """
     if len(contour_map) < 3:
         return None
@@ -52,7 +55,7 @@ def classify_plane(plane_map: NDArray[np.float64], contour_map: NDArray[np.float
         tall = float(z.max() - z.min())
         if (
             width >= cfg.wall_min_width_m
-            and tall >= cfg.wall_min_height_m
+            and (tall >= cfg.wall_min_height_m or view_bounded)
             and area >= cfg.wall_min_area_m2
             and float(z.max()) >= cfg.wall_top_min_m
         ):

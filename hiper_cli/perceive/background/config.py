@@ -85,6 +85,9 @@ class BackgroundConfig:
     wall_probe_max_depth_m: float = 4.5  # no return where the plane would be nearer: nothing there
     wall_probe_min_columns: int = 3
     wall_open_share: float = 0.5  # of the columns with evidence, this share open: not a wall
+    # a vertical plane seen up to the image's top and down to an occluder in front is as tall
+    # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
+    wall_view_bounded: bool = True
     wall_tall_m: float = 2.2  # seen reaching this high: a wall, though its views saw both ends open
     # merging (Algorithm 2)
     merge_angle_deg: float = 10.0

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, Instance, Observation
-from hiper_cli.perceive.background.bounds import edge_evidence, is_open
+from hiper_cli.perceive.background.bounds import edge_evidence, is_open, view_bounded
 from hiper_cli.perceive.background.classify import classify_plane
 from hiper_cli.perceive.background.config import BackgroundConfig
 from hiper_cli.perceive.background.contour import (
@@ -51,7 +51,12 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
     if area < cfg.min_area_m2:
         return None
     plane_map = transform_plane(seg.plane_cam, frame.T_map_cam)
-    class_name = classify_plane(plane_map, transform_points(contour_cam, frame.T_map_cam), cfg)
+    contour_map = transform_points(contour_cam, frame.T_map_cam)
+    class_name = classify_plane(plane_map, contour_map, cfg)
+    vertical = abs(plane_map[2]) < np.sin(np.radians(cfg.vertical_deg))
+    if class_name is None and vertical and cfg.wall_view_bounded and view_bounded(grid, frame.camera, seg,
+                                                                                 cfg):
+        class_name = classify_plane(plane_map, contour_map, cfg, view_bounded=True)
     if class_name is None:
         return None
     uv = pf.to_2d(contour_cam)
