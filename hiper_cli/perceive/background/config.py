@@ -70,6 +70,9 @@ class BackgroundConfig:
     table_max_height_m: float = 1.1
     table_min_area_m2: float = 0.15
     table_max_extent_m: float = 3.5
+    # a table top stands on legs: below its near edge the camera sees under it, not a solid
+    # front (a box stack, a cabinet, a bed; ``under.py``)
+    table_needs_legs: bool = True
     wall_min_height_m: float = 1.2  # a standing person is ~1.8 m tall but narrow and not flat
     wall_min_width_m: float = 1.0
     wall_min_area_m2: float = 1.0

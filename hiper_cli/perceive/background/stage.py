@@ -29,6 +29,7 @@ from hiper_cli.perceive.background.merge import (
 )
 from hiper_cli.perceive.background.not_walls import NotWalls
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extract_planes
+from hiper_cli.perceive.background.under import solid_below
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Frame
 
@@ -57,6 +58,8 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
     if class_name is None and vertical and cfg.wall_view_bounded and view_bounded(grid, frame.camera, seg,
                                                                                  cfg):
         class_name = classify_plane(plane_map, contour_map, cfg, view_bounded=True)
+    if class_name == "table" and cfg.table_needs_legs and solid_below(grid, seg, cfg):
+        return None  # the top of a box stack, a cabinet or a bed: a solid front under its edge
     if class_name is None:
         return None
     uv = pf.to_2d(contour_cam)
