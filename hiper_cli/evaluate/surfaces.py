@@ -96,8 +96,10 @@ def load_surfaces(log_dir: str | Path) -> SurfaceTruth:
         records = json.loads((gt / "instances.json").read_text())["instances"]
         pieces = {int(d["id"]): d for d in records if d.get("plane") and d.get("area_m2") is not None}
     except (OSError, KeyError, ValueError, TypeError, json.JSONDecodeError) as err:
+        hint = ("; a hiper sim log is scored by hiper eval background and hiper eval foreground"
+                if (gt / "world.json").exists() else "")
         raise LogError(f"{path}: cannot read the true surfaces ({err}); scoring a realistic "
-                       f"world's log needs gt/{SURFACE_FILE} and gt/instances.json") from err
+                       f"world's log needs gt/{SURFACE_FILE} and gt/instances.json{hint}") from err
     norms = np.linalg.norm(sn, axis=1, keepdims=True)
     sn = sn / np.where(norms > 0, norms, 1.0)
     planes: dict[int, FloatArray] = {}
