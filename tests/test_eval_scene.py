@@ -133,3 +133,17 @@ def test_cli_scores_a_world(tmp_path):
     data = json.loads(out)
     assert data["background"]["pieces"] == 6
     assert data["background"]["instances"] > 0 and data["background"]["coverage"] is not None
+
+
+def test_eval_background_leaves_out_instances_seen_only_in_unlabelled_frames(tiny):
+    from collections import Counter
+
+    from hiper_cli.evaluate.background import BackgroundReport, score_background
+
+    floor, wall = _instances()[:2]
+    floor.observation_uuids[:] = ["labelled"]
+    wall.observation_uuids[:] = ["unlabelled"]
+    report = score_background([floor, wall], {"labelled": Counter({1: 40})}, load_truth(tiny),
+                              BackgroundReport(log=str(tiny), world="tiny", method="fast"))
+    assert report.unscored == 1 and report.unlabelled == 0
+    assert report.semantic_precision == pytest.approx(1.0)

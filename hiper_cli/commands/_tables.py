@@ -204,6 +204,9 @@ def show_background_eval(out: Any, data: dict[str, Any]) -> None:
     for row in _rows(data, data.get("paper")):
         table.add_row(*row)
     out.print(table)
+    if data.get("unscored"):
+        out.print(f"{data['unscored']} instances seen only in frames without an id image are left out "
+                  "of the precisions (hiper eval scene scores every instance of a realistic world)")
 
 
 def show_kb_info(out: Any, data: dict[str, Any]) -> None:
