@@ -243,6 +243,14 @@ class MatchConfig(_Part):
     unknown_class: str = "unknown"
     keep_unknown: bool = True
     """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
+    unknown_max_extent_m: float = 1.0
+    """An unmatched blob is seen *whole* (``whole.py``: evidence for an ``unknown`` instance)
+    only when inside the image (not within one ``pixel_step`` of its edge: a shelf, a wall or a
+    floor remnant cut by the border is a piece of something larger), no longer than this ..."""
+    unknown_min_thickness_m: float = 0.01
+    """... and not flat: the thinnest spread σ of its points at least this plus
+    ``background_margin_per_m2`` · depth² (a flat blob is a piece of a wall, a floor or a
+    furniture side the background did not claim)."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -257,6 +265,14 @@ class TrackerConfig(_Part):
     unknown_vote_weight: float = 0.15
     """A track's class is the score-weighted vote of its observations; ``unknown`` ones weigh
     this much each, so a few confused detections cannot name a mostly unmatched track."""
+    unknown_confirm_whole: int = 3
+    """A track detections do not name becomes an instance only after this many *whole*
+    observations (``Measurement.whole``; 0: off, ``confirm_hits`` as for the rest) ..."""
+    unknown_min_span_s: float = 0.5
+    """... seen over at least this long (what shows in a few frames is not a lasting object) ..."""
+    unknown_min_whole_share: float = 0.5
+    """... and making at least this share of its observations (a track that mostly took pieces of
+    something larger, cut by the border, is that larger thing)."""
     motion_model: str = "constant_velocity"
     """How a track moves (``motion.MOTION_MODELS``): the paper's constant-velocity Kalman filter."""
     association: str = "hungarian"

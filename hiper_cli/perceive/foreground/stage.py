@@ -34,6 +34,7 @@ from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.tables import drop_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
+from hiper_cli.perceive.foreground.whole import seen_whole
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
 
@@ -241,7 +242,10 @@ class ForegroundStage:
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
             measurements.append(
-                Measurement(blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid)
+                Measurement(
+                    blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
+                    whole=match.detection_index is not None or seen_whole(blob, cfg, frame.camera),
+                )
             )
         t_match = time.perf_counter()
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))

@@ -29,7 +29,8 @@
   of view keeps the identity for ``lost_max_s``.
 - Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother (every row
   then uses all observations of the track, so the first rows are no longer noisy).
-- Life cycle: tentative → confirmed after ``confirm_hits`` observations → closed after
+- Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
+  after ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``) → closed after
   ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
 """
 
@@ -72,6 +73,8 @@ class Measurement:
     class_name: str
     score: float
     observation_uuid: str
+    whole: bool = True
+    """Seen whole: inside the image, compact and solid (``unknown_confirm_whole``)."""
 
 
 @dataclass(frozen=True)
@@ -94,6 +97,7 @@ class Track:
     extent_m: FloatArray
     max_size_m: float = 0.0  # the largest blob seen (``_size_m``: footprint diagonal or height)
     hits: int = 1
+    whole_stamps_s: list[float] = field(default_factory=list)  # of the whole observations
     unseen_in_view_s: float = 0.0
     confirmed: bool = False
     closed: bool = False
@@ -314,8 +318,28 @@ class Tracker:
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * m.extent_map_m
         self._vote(track, m)
-        if not track.confirmed and track.hits >= self.config.confirm_hits:
+        if not track.confirmed and self._evidence_enough(track):
             track.confirmed = True
+
+    def _evidence_enough(self, track: Track) -> bool:
+        """Whether a tentative track may become an instance: ``confirm_hits`` observations, and
+        for one detections named fewer than ``min_class_observations`` times and in less
+        than ``min_class_share`` of its observations ``unknown_confirm_whole`` whole ones over
+        ``unknown_min_span_s``, at least ``unknown_min_whole_share`` of its observations."""
+        cfg = self.config
+        if track.hits < cfg.confirm_hits:
+            return False
+        named = sum(n for k, n in track.class_counts.items() if k != UNKNOWN)
+        if cfg.unknown_confirm_whole <= 0 or named >= cfg.min_class_observations or (
+            named >= cfg.min_class_share * track.hits
+        ):
+            return True  # detections name it (often, or most of the time): the usual evidence
+        stamps = track.whole_stamps_s
+        return (
+            len(stamps) >= cfg.unknown_confirm_whole
+            and stamps[-1] - stamps[0] >= cfg.unknown_min_span_s
+            and len(stamps) >= cfg.unknown_min_whole_share * track.hits
+        )
 
     def _vote(self, track: Track, m: Measurement) -> None:
         weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
@@ -323,6 +347,8 @@ class Tracker:
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
         track._class_name = None
         track.score_sum += m.score
+        if m.whole:
+            track.whole_stamps_s.append(track.last_update_s)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
         track.observation_uuids.append(m.observation_uuid)
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
@@ -469,7 +495,7 @@ class Tracker:
             min_class_share=self.config.min_class_share,
         )
         self._vote(track, m)
-        track.confirmed = self.config.confirm_hits <= 1
+        track.confirmed = self._evidence_enough(track)
         return track
 
     def close_all(self) -> list[Track]:
