@@ -355,6 +355,10 @@ class TrackerConfig(_Part):
     walker_classes: tuple[str, ...] = ("person",)
     """Classes that walk: their tracks use ``walker_accel_noise_mps2`` and
     ``walker_min_size_ratio``."""
+    walker_level: bool = True
+    """Tracks of a walker class (or, before a track has a class, observations of one) have no
+    vertical velocity: people walk on the floor, so their height is the filtered mean of the
+    observed centres and is never extrapolated (issue 17: person boxes below the floor)."""
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving
     (``moving_speed_mps``), is settled: it only takes an observation whose box overlaps its

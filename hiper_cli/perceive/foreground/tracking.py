@@ -62,6 +62,7 @@ LOST_AFTER_FRAMES = 2.5  # a track is lost after more than one missed frame (gap
 EXTENT_GAIN = 0.2  # exponential smoothing of a track's box extent by each new observation
 MIN_VELOCITY_INIT_DT_S = 1e-6  # two observations closer in time give no velocity
 MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
+WALKER_VZ_VAR = 1e-4  # (m/s)²: a walker's vertical velocity held at zero (``walker_level``)
 
 
 @dataclass(frozen=True)
@@ -270,8 +271,33 @@ class Tracker:
         if dt <= 0:
             return
         q = self._accel_noise(track.class_name) ** 2
-        track.motion.predict(dt, q, q * self.config.vertical_noise_ratio**2)
+        track.motion.predict(dt, q, self._vertical_noise(track, q))
         track.last_time_s = stamp_s
+
+    def _walks(self, track: Track, m: Measurement | None = None) -> bool:
+        """Whether ``track`` is held level (``walker_level``): its class walks, or, while it has
+        none yet, this observation's does."""
+        if not self.config.walker_level:
+            return False
+        name = track.class_name
+        if name == UNKNOWN and m is not None:
+            name = m.class_name
+        return name in self.config.walker_classes
+
+    def _vertical_noise(self, track: Track, q: float) -> float:
+        return 0.0 if self._walks(track) else q * self.config.vertical_noise_ratio**2
+
+    @staticmethod
+    def _hold_level(motion: MotionModel) -> None:
+        """No vertical velocity: people walk on the floor, so a walker's height is the filtered
+        mean of its observed centres, never extrapolated (a centre below the floor or metres
+        above it came from a vertical velocity a blob's growing or shrinking gave the filter)."""
+        x, P = motion.x.copy(), np.array(motion.P, dtype=np.float64)
+        x[5] = 0.0
+        P[5, :] = 0.0
+        P[:, 5] = 0.0
+        P[5, 5] = WALKER_VZ_VAR
+        motion.reset(x, P)
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
         """Shrink the velocity of a track that got no update (after a grace of two frames).
@@ -313,6 +339,8 @@ class Tracker:
                 motion.update(m.center_map_m)
         else:
             motion.update(m.center_map_m)
+        if self._walks(track, m):
+            self._hold_level(motion)
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
@@ -354,7 +382,7 @@ class Tracker:
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
         q = self._accel_noise(track.class_name) ** 2
         track.covariances.append(np.array(track.motion.P, dtype=np.float64))
-        track.noises.append((q, q * self.config.vertical_noise_ratio**2))
+        track.noises.append((q, self._vertical_noise(track, q)))
 
     # --- association ------------------------------------------------------------------------
     def _gate(self, track: Track, stamp_s: float, variance_m2: float | None = None) -> tuple[float, float]:
