@@ -132,17 +132,42 @@ def feature_from_analysis(analysis: Analysis) -> ObjectDynamics | SizeFeature | 
     return cls.from_values(analysis.values)  # type: ignore[return-value]
 
 
+SPEED_WINDOW_S = 0.3
+"""``path_speed_mps`` measures the path between positions at least this far apart in time: a
+few centimetres of per-row jitter at 30 Hz would otherwise add up to tenths of a m/s, while a
+walker's turn at an end point cuts at most a few centimetres of path."""
+SPEED_MAX_GAP_S = 1.0
+"""A gap between rows longer than this (the track unseen, then re-identified) splits the path:
+neither its path nor its time counts (what happened in it is unknown; counted, a person picked
+up again 10 s later read half their walking speed)."""
+
+
 def path_speed_mps(rows: Sequence[Sequence[Any]] | np.ndarray) -> float | None:
-    """Mean speed along trajectory rows [stamp_s, x, y, z, ...]: path length over duration.
-    None for fewer than two rows, no elapsed time, or rows that are not numbers."""
+    """Mean speed along trajectory rows [stamp_s, x, y, z, ...]: path length over duration,
+    the path through positions ``SPEED_WINDOW_S`` apart (robust to jitter), gaps longer than
+    ``SPEED_MAX_GAP_S`` left out. None for fewer than two rows, no elapsed time, or rows
+    that are not numbers."""
     try:
         arr = np.asarray([r[:4] for r in rows], dtype=np.float64)
     except (TypeError, ValueError, IndexError):
         return None
     if arr.ndim != 2 or arr.shape[0] < 2 or arr.shape[1] != 4:
         return None
-    dt = float(arr[-1, 0] - arr[0, 0])
-    if not dt > 0:
+    if not float(arr[-1, 0] - arr[0, 0]) > 0:
         return None
-    speed = float(np.linalg.norm(np.diff(arr[:, 1:4], axis=0), axis=1).sum() / dt)
+    length_m = duration_s = 0.0
+    breaks = np.flatnonzero(np.diff(arr[:, 0]) > SPEED_MAX_GAP_S) + 1
+    for part in np.split(arr, breaks):  # the stretches the track was seen without a long gap
+        keep = [0]
+        for i in range(1, len(part)):
+            if part[i, 0] - part[keep[-1], 0] >= SPEED_WINDOW_S:
+                keep.append(i)
+        if keep[-1] != len(part) - 1:
+            keep.append(len(part) - 1)
+        kept = part[keep]
+        length_m += float(np.linalg.norm(np.diff(kept[:, 1:4], axis=0), axis=1).sum())
+        duration_s += float(part[-1, 0] - part[0, 0])
+    if not duration_s > 0:
+        return None
+    speed = length_m / duration_s
     return speed if math.isfinite(speed) else None

@@ -1,9 +1,10 @@
 """Walkers are held level (``walker_level``): no vertical velocity, so a person's height is
-never extrapolated below the floor or above it."""
+never extrapolated below the floor or above it; and path speeds are robust to jitter."""
 
 import numpy as np
 import pytest
 
+from hiper_cli.learned import path_speed_mps
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
 
@@ -29,4 +30,16 @@ def test_a_person_has_no_vertical_velocity():
 def test_other_classes_and_the_switch_keep_it():
     assert _rising_person(TrackerConfig(), cls="chair").velocity[2] > 0.3
     assert _rising_person(TrackerConfig(walker_level=False)).velocity[2] > 0.3
+
+
+def test_path_speed_ignores_jitter_and_gaps():
+    t = np.arange(0.0, 10.0, 1.0 / RATE_HZ)
+    jitter = np.random.default_rng(0).normal(0.0, 0.01, (len(t), 3))  # 1 cm per axis
+    rows = np.c_[t, np.c_[0.6 * t, 0 * t, 0 * t] + jitter]
+    assert path_speed_mps(rows) == pytest.approx(0.6, abs=0.03)  # row to row: 0.86
+    gap = rows.copy()
+    gap[150:, 0] += 10.0  # unseen for 10 s, then picked up where it was
+    assert path_speed_mps(gap) == pytest.approx(0.6, abs=0.02)
+    back_and_forth = np.abs((0.6 * t) % 4.8 - 2.4)
+    assert path_speed_mps(np.c_[t, back_and_forth, 0 * t, 0 * t]) == pytest.approx(0.6, abs=0.03)
 
