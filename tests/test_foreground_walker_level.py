@@ -43,3 +43,22 @@ def test_path_speed_ignores_jitter_and_gaps():
     back_and_forth = np.abs((0.6 * t) % 4.8 - 2.4)
     assert path_speed_mps(np.c_[t, back_and_forth, 0 * t, 0 * t]) == pytest.approx(0.6, abs=0.03)
 
+
+def test_a_person_blob_high_above_the_floor_is_no_walker():
+    from hiper_cli.model import Box3D, Instance
+    from hiper_cli.perceive.foreground.segment import Blob
+    from hiper_cli.perceive.foreground.stage import ForegroundStage, floor_height_m
+
+    floor = Instance(layer="background", class_name="floor", first_seen_s=0.0, last_seen_s=0.0,
+                     box=Box3D(np.array([0.0, 0.0, 0.0]), np.array([5.0, 5.0, 0.02])))
+    assert floor_height_m([floor]) == pytest.approx(0.01)
+    assert floor_height_m([]) == 0.0
+    stage = ForegroundStage(detector="log")
+
+    def blob(z0):
+        pts = np.random.default_rng(0).uniform([0, 0, z0], [0.3, 0.3, z0 + 0.4], (50, 3))
+        return Blob(pts, pts, np.zeros((50, 2), np.int32), np.array([0.0, 0.0, 10.0, 10.0]))
+
+    assert stage._stands("person", blob(0.9))  # the upper body behind a counter
+    assert not stage._stands("person", blob(1.5))  # on a shelf's top
+    assert stage._stands("book", blob(1.5))

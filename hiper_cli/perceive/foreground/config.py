@@ -355,6 +355,10 @@ class TrackerConfig(_Part):
     walker_classes: tuple[str, ...] = ("person",)
     """Classes that walk: their tracks use ``walker_accel_noise_mps2`` and
     ``walker_min_size_ratio``."""
+    walker_max_base_m: float = 1.2
+    """A blob named by a walker class whose lowest point lies more than this above the floor
+    (the lowest floor instance's top; the map's z = 0 before one) is no walker: it stays
+    ``unknown`` (0: off). People stand on the floor; behind a counter they still show below."""
     walker_level: bool = True
     """Tracks of a walker class (or, before a track has a class, observations of one) have no
     vertical velocity: people walk on the floor, so their height is the filtered mean of the

@@ -73,6 +73,13 @@ def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
     return out
 
 
+def floor_height_m(background: Iterable[Instance]) -> float:
+    """The height of the floor, map frame: the lowest top of the floor instances (their box's
+    top; 0, the map's origin, before the background found one)."""
+    tops = [float(inst.box.aabb()[1][2]) for inst in background if inst.class_name == "floor"]
+    return min(tops) if tops else 0.0
+
+
 @lru_cache(maxsize=4096)
 def _spread(n: int, k: int) -> NDArray[np.int64]:
     """``min(n, k)`` indices evenly spread over ``range(n)`` (the organised grid order:
@@ -114,6 +121,7 @@ class ForegroundStage:
         self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
         self._priors: dict[tuple[str, str], ObjectDynamics | SizeFeature | AltitudeFeature] = {}
         self._analyses_seen = -1
+        self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
         self.tracker = Tracker(cfg, self._class_prior)
         self._instances: dict[str, Instance] = {}
 
@@ -159,6 +167,15 @@ class ForegroundStage:
                 return False
         return True
 
+    def _stands(self, class_name: str, blob: Blob) -> bool:
+        """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
+        above the floor: people stand on it, and even behind a counter their visible part
+        reaches below that (a person detection on a poster, a shelf's top or a reflection)."""
+        cfg = self.config
+        if cfg.walker_max_base_m <= 0 or class_name not in cfg.walker_classes:
+            return True
+        return float(blob.bounds_map[0][2]) - self._floor_z_m <= cfg.walker_max_base_m
+
     # --- the stage --------------------------------------------------------------------------
     def _detect_timed(self, frame: Frame) -> tuple[Detections, float]:
         t0 = time.perf_counter()
@@ -188,6 +205,7 @@ class ForegroundStage:
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
+        self._floor_z_m = floor_height_m(world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
             for inst in world.background.values():
                 if inst.class_name == "table":
@@ -235,7 +253,9 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
-            if match.detection_index is not None and not self._fits_priors(match.class_name, blob):
+            if match.detection_index is not None and not (
+                self._fits_priors(match.class_name, blob) and self._stands(match.class_name, blob)
+            ):
                 match = Match(cfg.unknown_class, 0.0, None, match.iou)
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
