@@ -13,7 +13,8 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "hiper_cli"
 
 _UI = ("hiper_cli.commands", "hiper_cli.cli", "typer", "rich")
 _ABOVE_PERCEIVE = ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
-                   "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", "hiper_cli.view")
+                   "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", "hiper_cli.view",
+                   "hiper_cli.agent", "hiper_cli.mcp", "hiper_cli.qa")
 _CORE_FORBIDDEN = ("hiper_cli.perceive", *_ABOVE_PERCEIVE, *_UI)
 
 # package (folder) or module (file stem) -> prefixes its modules may not import
@@ -40,10 +41,19 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
              "hiper_cli.evaluate", *_UI),
     # questions over perceive types, the graph and the analyses
     "query": ("hiper_cli.serve", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
-              "hiper_cli.evaluate", "hiper_cli.view", *_UI),
+              "hiper_cli.evaluate", "hiper_cli.view", "hiper_cli.agent", "hiper_cli.mcp", "hiper_cli.qa",
+              *_UI),
     # the SPARQL endpoint over a knowledge base's graph
     "serve": ("hiper_cli.query", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
               "hiper_cli.evaluate", "hiper_cli.view", *_UI),
+    # the agent tools: the query verbs and analyses as named, schema'd, read-only tools
+    "agent": ("hiper_cli.mcp", "hiper_cli.qa", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+              "hiper_cli.evaluate", "hiper_cli.view", "hiper_cli.serve", *_UI, "mcp"),
+    # hiper mcp: the agent tools over the Model Context Protocol (the only user of the mcp SDK)
+    "mcp": ("hiper_cli.qa", "hiper_cli.pipeline", "hiper_cli.reanchor", "hiper_cli.sim",
+            "hiper_cli.evaluate", "hiper_cli.view", *_UI),
+    # hiper eval qa: questions from a log's truth, asked through the query layer, scored
+    "qa": ("hiper_cli.agent", "hiper_cli.mcp", "hiper_cli.serve", "hiper_cli.view", *_UI),
     # the simulator writes logs (perceive.logs writers), never reads a knowledge base
     "sim": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
             "hiper_cli.reanchor", "hiper_cli.evaluate", *_UI),

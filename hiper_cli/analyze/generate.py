@@ -57,11 +57,12 @@ def generate_heatmap(
     store: bool = True,
 ) -> HeatmapResult:
     """The heatmap of ``class_name`` in ``window`` on the environment's map, its files in
-    ``out_dir`` and (``store``) a ``heatmap`` analysis listing them."""
+    ``out_dir`` and (``store``) a ``heatmap`` analysis listing them; ``store=False`` writes
+    nothing to the knowledge base (nor the map it builds)."""
     window = window or TimeWindow()
     check_classes(kb, [class_name])
     env = environment_of(kb, env_name)
-    grid = map_for(kb, env, map_yaml, map_config)
+    grid = map_for(kb, env, map_yaml, map_config, store=store)
     tracks = trajectory_columns(kb.docs, class_name, window.t_start_s, window.t_end_s)
     speed = learned_speed_mps(kb, class_name)
     source = "ods analysis"

@@ -139,14 +139,21 @@ def load_map(env: Environment) -> OccupancyGrid | None:
 
 
 def map_for(
-    kb: KnowledgeBase, env: Environment, map_yaml: str | None = None, config: MapConfig | None = None
+    kb: KnowledgeBase,
+    env: Environment,
+    map_yaml: str | None = None,
+    config: MapConfig | None = None,
+    *,
+    store: bool = True,
 ) -> OccupancyGrid:
     """The map to draw on: ``map_yaml`` when given (then stored as the environment's map), else
     a map loaded that way before, else the map built from the knowledge base, rebuilt (and
-    stored) when perception has added or changed instances since."""
+    stored) when perception has added or changed instances since. ``store=False`` leaves the
+    knowledge base as it is (a read-only caller)."""
     if map_yaml is not None:
         grid = read_map_server(map_yaml)
-        store_map(kb, env, grid, str(map_yaml))
+        if store:
+            store_map(kb, env, grid, str(map_yaml))
         return grid
     stored = load_map(env)
     meta = env.data.get("map") or {}
@@ -160,7 +167,8 @@ def map_for(
     ):
         return stored
     grid = build_map(kb, config)
-    store_map(kb, env, grid, KB_SOURCE, key)
+    if store:
+        store_map(kb, env, grid, KB_SOURCE, key)
     return grid
 
 
