@@ -81,7 +81,8 @@ OPTION_RANGES: dict[str, Range] = {
     "start_s": Range(-1e11, 1e11), "end_s": Range(-1e11, 1e11), "recent_s": Range(0.0, 1e9),
     "limit": Range(1, 1 << 31, integer=True), "resolution": Range(0.001, 10.0),
     "instances": Range(1, 10_000_000, integer=True), "observations": Range(1, 100_000_000, integer=True),
-    "port": Range(0, 65535, integer=True), "image_hz": Range(0.0, 1000.0, lo_open=True),
+    "port": Range(0, 65535, integer=True),
+    "short_s": Range(0.0, 1e9, lo_open=True), "image_hz": Range(0.0, 1000.0, lo_open=True),
 }
 
 

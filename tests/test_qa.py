@@ -1,0 +1,72 @@
+"""``hiper eval qa``: questions from truth, asked through the query layer, scored. On a KB
+built from the truth itself every answer must be right (a wrong one is the benchmark's
+fault); the worlds' gt/ format yields questions too; the CLI prints --json and one-line errors."""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from hiper_cli.cli import app
+from hiper_cli.qa import KINDS, evaluate_qa, generate_questions, load_scene_truth
+from tests.query_truth_kb import MIN_PIXELS, house_truth_kb
+
+runner = CliRunner()
+WORLDS = Path(__file__).resolve().parents[1] / ".." / "shared" / "worlds"
+FRACTION = MIN_PIXELS / (160 * 120)  # the truth KB's own visibility threshold
+
+
+def test_a_truth_kb_answers_every_question_right(tmp_path):
+    k = house_truth_kb()
+    report = evaluate_qa(k.path.parent / "log", kb=str(k.path), out_dir=tmp_path, min_pixel_fraction=FRACTION)
+    data = report.to_dict()
+    assert data["binary_accuracy"] == 1.0 and data["count_accuracy"] == 1.0
+    assert data["position_error_median_m"] < 1e-3 and data["time_error_median_s"] < 1e-6
+    assert data["duration_error_median_s"] < 1e-6
+    kinds = Counter((s.question.kind, s.question.horizon) for s in report.scored)
+    for kind in KINDS:
+        assert kinds[(kind, "long")] > 0
+    for kind in ("yes_no", "count", "position", "time"):
+        assert kinds[(kind, "short")] > 0
+    yes_no = data["by_kind"]["yes_no"]["all"]
+    assert 0 < yes_no["true_yes"] < yes_no["n"]  # both answers occur
+
+
+def test_questions_are_deterministic_and_written_with_their_answers(tmp_path):
+    k = house_truth_kb()
+    scene = load_scene_truth(k.path.parent / "log")
+    a = [q.to_dict() for q in generate_questions(scene, seed=3)]
+    assert a == [q.to_dict() for q in generate_questions(scene, seed=3)]
+    assert a != [q.to_dict() for q in generate_questions(scene, seed=4)]  # "after T" times differ
+    report = evaluate_qa(k.path.parent / "log", kb=str(k.path), out_dir=tmp_path, seed=3)
+    lines = [json.loads(x) for x in Path(report.files["questions"]).read_text().splitlines()]
+    assert lines == json.loads(json.dumps(a))
+    assert {"text", "answer", "kind", "horizon", "now_s", "pose"} <= set(lines[0])
+
+
+@pytest.mark.skipif(not (WORLDS / "bookstore" / "gt" / "instances.json").exists(),
+                    reason="the realistic worlds are not in ../shared/worlds")
+def test_a_world_gt_yields_questions():
+    scene = load_scene_truth(WORLDS / "bookstore")
+    questions = generate_questions(scene)
+    assert {"chair", "person"} <= set(scene.classes())
+    assert {q.kind for q in questions} == set(KINDS)
+    person = [q for q in questions if q.text == "how many people"]
+    assert person and person[0].answer == 2
+
+
+def test_cli_json_and_errors(tmp_path):
+    k = house_truth_kb()
+    result = runner.invoke(app, ["eval", "qa", str(k.path.parent / "log"), "--kb", str(k.path),
+                                 "-o", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["format"] == "hiper-eval-qa" and data["questions"] > 50
+    result = runner.invoke(app, ["eval", "qa", str(tmp_path / "nothing")])
+    assert result.exit_code != 0 and "not found" in result.output and "Traceback" not in result.output
+    result = runner.invoke(app, ["eval", "qa", str(tmp_path), "--short-s", "0"])
+    assert result.exit_code != 0 and "--short-s" in result.output
