@@ -16,6 +16,11 @@ def _fmt(v: Any, digits: int = 3) -> str:
     return "-" if v is None else f"{v:.{digits}f}" if isinstance(v, float) else str(v)
 
 
+def _err(v: Any) -> str:
+    """A median error; None when over half the questions went unanswered (infinite)."""
+    return "inf" if v is None else _fmt(v)
+
+
 @eval_app.command("qa")
 def qa(
     log: Annotated[Path, typer.Argument(help="A log with ground truth: hiper sim's gt/ or a world's gt/.")],
@@ -52,7 +57,7 @@ def qa(
     from rich.table import Table
 
     out = console()
-    table = Table("kind", "horizon", "questions", "answered", "accuracy / median error", "note",
+    table = Table("kind", "horizon", "questions", "answered", "accuracy / median error", "detail",
                   title=f"hiper eval qa {log} (detector {report.detector or 'none: --kb'})")
     for kind, by in data["by_kind"].items():
         for horizon in ("short", "long", "all"):
@@ -60,15 +65,18 @@ def qa(
             if not f.get("n"):
                 continue
             unit = {"position": " m", "time": " s", "duration": " s"}.get(kind, "")
-            value = _fmt(f.get("accuracy")) if "accuracy" in f else _fmt(f.get("median_error")) + unit
+            if "accuracy" in f:
+                value = _fmt(f.get("accuracy"))
+            else:  # None: more than half unanswered, an infinite median
+                value = ("inf" if f.get("median_error") is None else _fmt(f["median_error"])) + unit
             note = (f"yes {_fmt(f.get('accuracy_on_yes'))} / no {_fmt(f.get('accuracy_on_no'))}"
-                    if kind == "yes_no" else "")
+                    if kind == "yes_no" else f"answered: median {_fmt(f.get('median_error_answered'))}{unit}")
             table.add_row(kind, horizon, str(f["n"]), str(f["answered"]), value, note)
     out.print(table)
     out.print(
         f"binary accuracy {_fmt(data['binary_accuracy'])}, count accuracy {_fmt(data['count_accuracy'])}, "
-        f"position error {_fmt(data['position_error_median_m'])} m, time error "
-        f"{_fmt(data['time_error_median_s'])} s, duration error {_fmt(data['duration_error_median_s'])} s "
+        f"position error {_err(data['position_error_median_m'])} m, time error "
+        f"{_err(data['time_error_median_s'])} s, duration error {_err(data['duration_error_median_s'])} s "
         f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); questions in {data['files']['questions']}"
     )
 

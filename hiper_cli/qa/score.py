@@ -78,7 +78,7 @@ def _figures(rows: list[Scored]) -> dict[str, Any]:
         errs = np.array([r.error for r in rows], dtype=np.float64)
         out["median_error"] = float(np.median(errs))
         finite = errs[np.isfinite(errs)]
-        out["mean_error_answered"] = float(finite.mean()) if len(finite) else None
+        out["median_error_answered"] = float(np.median(finite)) if len(finite) else None
     if rows[0].question.kind == "yes_no":  # most questions are "no": show both sides
         yes = [r for r in rows if r.question.answer]
         no = [r for r in rows if not r.question.answer]
