@@ -251,3 +251,18 @@ def test_without_the_mcp_package_the_command_says_how_to_install_it(monkeypatch)
     monkeypatch.setitem(sys.modules, "mcp", None)
     with pytest.raises(ConfigError, match=r"pip install 'hiper\[mcp\]'"):
         require_mcp()
+
+
+def test_the_tools_leave_the_knowledge_base_as_it_is(kb_path, tmp_path):
+    copy = tmp_path / "kb.hiper"
+    shutil.copytree(kb_path, copy)
+
+    def state() -> Any:
+        with open_kb_for_reading(str(copy)) as kb:
+            envs = [e.to_dict() for e in kb.environments()]
+            return kb.info()["counts"], json.dumps(envs, sort_keys=True, default=str)
+
+    before = state()
+    results = _in_process(str(copy), [("heatmap", {"class": "person"}), ("features", {}), ("describe", {})])
+    assert not any(r.isError for r in results)
+    assert state() == before
