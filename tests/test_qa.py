@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from hiper_cli.cli import app
 from hiper_cli.qa import KINDS, evaluate_qa, generate_questions, load_scene_truth
+from hiper_cli.qa.run import vocabulary_of
 from tests.query_truth_kb import MIN_PIXELS, house_truth_kb
 
 runner = CliRunner()
@@ -38,11 +39,14 @@ def test_a_truth_kb_answers_every_question_right(tmp_path):
 
 def test_questions_are_deterministic_and_written_with_their_answers(tmp_path):
     k = house_truth_kb()
-    scene = load_scene_truth(k.path.parent / "log")
-    a = [q.to_dict() for q in generate_questions(scene, seed=3)]
-    assert a == [q.to_dict() for q in generate_questions(scene, seed=3)]
+    log = k.path.parent / "log"
+    scene = load_scene_truth(log)
+    vocabulary = vocabulary_of(log, "truth")
+    a = [q.to_dict() for q in generate_questions(scene, seed=3, vocabulary=vocabulary)]
+    assert a == [q.to_dict() for q in generate_questions(scene, seed=3, vocabulary=vocabulary)]
     assert a != [q.to_dict() for q in generate_questions(scene, seed=4)]  # "after T" times differ
-    report = evaluate_qa(k.path.parent / "log", kb=str(k.path), out_dir=tmp_path, seed=3)
+    assert {q["class_name"] for q in a if not q["named"]} >= {"shelf"}  # the truth detector's classes
+    report = evaluate_qa(log, kb=str(k.path), out_dir=tmp_path, seed=3, min_pixel_fraction=0.001)
     lines = [json.loads(x) for x in Path(report.files["questions"]).read_text().splitlines()]
     assert lines == json.loads(json.dumps(a))
     assert {"text", "answer", "kind", "horizon", "now_s", "pose"} <= set(lines[0])

@@ -42,8 +42,9 @@ def qa(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """NaVQA-style questions (yes/no, count, position, time, duration; short and long
-    horizons) generated from the log's truth, asked through the query layer and scored;
-    the questions with their true answers are written as JSONL for any agent.
+    horizons) generated from the log's truth, asked through the query layer and scored
+    (position error horizontal, 3-D beside it); questions about classes the detector cannot
+    name are scored apart. The questions with their true answers are written as JSONL.
 
     Example: hiper eval qa out/house -o out/house_qa --json
     """
@@ -58,7 +59,8 @@ def qa(
 
     out = console()
     table = Table("kind", "horizon", "questions", "answered", "accuracy / median error", "detail",
-                  title=f"hiper eval qa {log} (detector {report.detector or 'none: --kb'})")
+                  title=f"hiper eval qa {log} (detector {report.detector}"
+                  + (f", answers from {kb})" if kb else ")"))
     for kind, by in data["by_kind"].items():
         for horizon in ("short", "long", "all"):
             f = by[horizon]
@@ -79,6 +81,14 @@ def qa(
         f"{_err(data['time_error_median_s'])} s, duration error {_err(data['duration_error_median_s'])} s "
         f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); questions in {data['files']['questions']}"
     )
+    other = data["unnamed"]
+    if other["questions"]:
+        out.print(
+            f"classes the perceiver cannot name ({', '.join(data['unnamed_classes'])}), apart: "
+            f"{other['questions']} questions, binary accuracy {_fmt(other['binary_accuracy'])}, count "
+            f"accuracy {_fmt(other['count_accuracy'])}, position error "
+            f"{_err(other['position_error_median_m'])} m"
+        )
 
 
 def register(app: typer.Typer) -> None:

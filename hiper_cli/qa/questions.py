@@ -37,6 +37,9 @@ class Question:
     now_s: float
     pose: tuple[float, float, float, float]
     class_name: str
+    # Whether the perceiver can name the class (its detector's vocabulary, or a background
+    # class); the headline figures are over these, the others are reported apart.
+    named: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         return {"format": QUESTION_FORMAT, "version": 1, **asdict(self),
@@ -62,15 +65,24 @@ def _in_view_s(stamps: np.ndarray, gap_s: float) -> float:
 
 
 class _Builder:
-    def __init__(self, scene: SceneTruth, short_s: float, seed: int, view_gap_s: float) -> None:
-        self.scene, self.short_s, self.gap = scene, short_s, view_gap_s
+    def __init__(
+        self,
+        scene: SceneTruth,
+        short_s: float,
+        seed: int,
+        view_gap_s: float,
+        vocabulary: frozenset[str] | None,
+    ) -> None:
+        self.scene, self.short_s, self.gap, self.vocabulary = scene, short_s, view_gap_s, vocabulary
         self.rng = np.random.default_rng(seed)
         self.out: list[Question] = []
         self.since = scene.now_s - short_s
 
     def add(self, kind: str, horizon: str, text: str, answer: Any, cls: str) -> None:
         qid = f"q{len(self.out):04d}"
-        self.out.append(Question(qid, kind, horizon, text, answer, self.scene.now_s, self.scene.pose, cls))
+        named = self.vocabulary is None or cls in self.vocabulary
+        self.out.append(Question(qid, kind, horizon, text, answer, self.scene.now_s, self.scene.pose, cls,
+                                 named))
 
     def seen_in(self, cls: str, lo: float, hi: float) -> list[int]:
         """Instances of ``cls`` seen at some stamp in [lo, hi]."""
@@ -143,14 +155,21 @@ class _Builder:
 
 
 def generate_questions(
-    scene: SceneTruth, *, short_s: float = 15.0, seed: int = 0, view_gap_s: float = 1.0
+    scene: SceneTruth,
+    *,
+    short_s: float = 15.0,
+    seed: int = 0,
+    view_gap_s: float = 1.0,
+    vocabulary: frozenset[str] | None = None,
 ) -> list[Question]:
     """Every question of every kind about the classes the log shows (and, for yes/no, common
-    indoor classes it may not show); ``view_gap_s`` as the query layer's ``QueryConfig``."""
+    indoor classes it may not show); ``view_gap_s`` as the query layer's ``QueryConfig``;
+    ``vocabulary``: the classes the perceiver can name (None: all), which marks each question
+    ``named`` or not."""
     from hiper_cli.query.vocabulary import resolve_class
 
     present = [c for c in scene.classes() if resolve_class(c) == c]
-    b = _Builder(scene, short_s, seed, view_gap_s)
+    b = _Builder(scene, short_s, seed, view_gap_s, vocabulary)
     b.yes_no(sorted(set(present) | set(COMMON_CLASSES)))
     b.counts(present)
     b.positions(present)

@@ -47,6 +47,29 @@ def pick_detector(log: Path, detector: str) -> str:
     return "truth" if (log / "gt" / "detections.jsonl").exists() else "yolox"
 
 
+def vocabulary_of(log: Path, detector: str) -> frozenset[str]:
+    """The classes a perceiver with ``detector`` can name: the ``truth`` detector's classes
+    (``gt/noise.json``), else COCO less the indoor exclusion list; plus the background's table."""
+    from hiper_cli.perceive.foreground.classes import INDOOR_EXCLUDED
+    from hiper_cli.query.vocabulary import COCO
+
+    noise = log / "gt" / "noise.json"
+    if detector == "truth" and noise.exists():
+        classes = set(json.loads(noise.read_text()).get("classes", []))
+    else:
+        classes = set(COCO) - set(INDOOR_EXCLUDED)
+    return frozenset(classes | {"table"})
+
+
+def seen_fraction(log: Path, default: float) -> float:
+    """The share of the image an instance must cover to count as seen: the ``hiper sim``
+    truth detector's own ``min_pixels`` (of 640×480) where the log has it."""
+    noise = log / "gt" / "noise.json"
+    if noise.exists():
+        return float(json.loads(noise.read_text()).get("min_pixels", default * 640 * 480)) / (640 * 480)
+    return default
+
+
 def _perceive(log: Path, kb: Path, detector: str) -> None:
     from hiper_cli.pipeline import PerceiveOptions, perceive_log
 
@@ -63,12 +86,14 @@ def evaluate_qa(
     out_dir: str | Path | None = None,
     short_s: float = 15.0,
     seed: int = 0,
-    min_pixel_fraction: float = 0.001,
+    min_pixel_fraction: float | None = None,
 ) -> QaReport:
     """Generate the questions of ``log``, answer them from ``kb`` (default: perceive the log
     with ``detector`` into ``OUT/kb.hiper``) and score them; writes ``OUT/questions.jsonl``
     (questions with true answers) and ``OUT/answers.jsonl`` (hiper's answers, scored).
-    ``min_pixel_fraction``: how much of the image an instance must cover to count as seen."""
+    ``min_pixel_fraction``: how much of the image an instance must cover to count as seen
+    (default: the sim truth detector's threshold, else 0.1 %). ``detector`` also says which
+    classes the perceiver can name when ``kb`` is given."""
     from hiper_cli.graph import open_kb_for_reading
 
     log = Path(log)
@@ -77,12 +102,12 @@ def evaluate_qa(
     out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="hiper-qa-"))
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    scene = load_scene_truth(log, min_pixel_fraction=min_pixel_fraction)
-    questions = generate_questions(scene, short_s=short_s, seed=seed)
+    fraction = seen_fraction(log, 0.001) if min_pixel_fraction is None else min_pixel_fraction
+    scene = load_scene_truth(log, min_pixel_fraction=fraction)
+    used = pick_detector(log, detector)
+    questions = generate_questions(scene, short_s=short_s, seed=seed, vocabulary=vocabulary_of(log, used))
     seconds = {"questions": time.perf_counter() - t0}
-    used = None
     if kb is None:
-        used = pick_detector(log, detector)
         kb = str(out / "kb.hiper")
         t0 = time.perf_counter()
         _perceive(log, Path(kb), used)
@@ -94,5 +119,6 @@ def evaluate_qa(
     files = {"questions": str(out / "questions.jsonl"), "answers": str(out / "answers.jsonl")}
     Path(files["questions"]).write_text("".join(json.dumps(q.to_dict()) + "\n" for q in questions))
     Path(files["answers"]).write_text("".join(json.dumps(s.to_dict()) + "\n" for s in scored))
-    return QaReport(str(log), kb, used, short_s, seed, summarise(scored), scored, files,
+    figures = summarise(scored) | {"seen_min_pixels": scene.min_pixels}
+    return QaReport(str(log), kb, used, short_s, seed, figures, scored, files,
                     {k: round(v, 2) for k, v in seconds.items()})

@@ -21,19 +21,22 @@ __all__ = ["Scored", "answer_question", "summarise"]
 @dataclass(frozen=True)
 class Scored:
     """A question, what hiper answered (None: no answer) and its score: ``correct`` for yes/no
-    and count, ``error`` (m or s, ``inf`` when unanswered) for the others."""
+    and count, ``error`` (m or s, ``inf`` when unanswered) for the others; a position's error
+    is horizontal (where a robot would go), ``error_3d`` the full one."""
 
     question: Question
     predicted: Any
     correct: bool | None
     error: float | None
     text: str
+    error_3d: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         err = None if self.error is None or math.isinf(self.error) else self.error
         return {"id": self.question.id, "kind": self.question.kind, "horizon": self.question.horizon,
                 "question": self.question.text, "truth": self.question.answer, "predicted": self.predicted,
-                "correct": self.correct, "error": err, "answered": self.predicted is not None,
+                "correct": self.correct, "error": err, "error_3d": self.error_3d,
+                "answered": self.predicted is not None, "named": self.question.named,
                 "hiper_text": self.text}
 
 
@@ -62,10 +65,9 @@ def answer_question(kb: KnowledgeBase, q: Question) -> Scored:
     if p is None:
         return Scored(q, None, None, math.inf, a.text)
     if q.kind == "position":
-        error = float(np.linalg.norm(np.asarray(p) - np.asarray(q.answer)))
-    else:
-        error = abs(float(p) - float(q.answer))
-    return Scored(q, p, None, error, a.text)
+        delta = np.asarray(p) - np.asarray(q.answer)
+        return Scored(q, p, None, float(np.linalg.norm(delta[:2])), a.text, float(np.linalg.norm(delta)))
+    return Scored(q, p, None, abs(float(p) - float(q.answer)), a.text)
 
 
 def _figures(rows: list[Scored]) -> dict[str, Any]:
@@ -79,6 +81,9 @@ def _figures(rows: list[Scored]) -> dict[str, Any]:
         out["median_error"] = float(np.median(errs))
         finite = errs[np.isfinite(errs)]
         out["median_error_answered"] = float(np.median(finite)) if len(finite) else None
+        if rows[0].question.kind == "position":
+            full = np.array([math.inf if r.error_3d is None else r.error_3d for r in rows])
+            out["median_error_3d"] = float(np.median(full))
     if rows[0].question.kind == "yes_no":  # most questions are "no": show both sides
         yes = [r for r in rows if r.question.answer]
         no = [r for r in rows if not r.question.answer]
@@ -89,7 +94,15 @@ def _figures(rows: list[Scored]) -> dict[str, Any]:
 
 
 def summarise(scored: list[Scored]) -> dict[str, Any]:
-    """Headline figures and the breakdown per kind and horizon."""
+    """Headline figures and the breakdown per kind and horizon over the questions about classes
+    the perceiver can name; the same for the others under ``unnamed``."""
+    named = [r for r in scored if r.question.named]
+    return _summary(named) | {"unnamed": _summary([r for r in scored if not r.question.named]),
+                              "unnamed_classes": sorted({r.question.class_name for r in scored
+                                                         if not r.question.named})}
+
+
+def _summary(scored: list[Scored]) -> dict[str, Any]:
     by: dict[str, Any] = {}
     for kind in KINDS:
         rows = [r for r in scored if r.question.kind == kind]
@@ -108,6 +121,7 @@ def summarise(scored: list[Scored]) -> dict[str, Any]:
         "binary_accuracy": get("yes_no", "accuracy"),
         "count_accuracy": get("count", "accuracy"),
         "position_error_median_m": finite(get("position", "median_error")),
+        "position_error_3d_median_m": finite(get("position", "median_error_3d")),
         "time_error_median_s": finite(get("time", "median_error")),
         "duration_error_median_s": finite(get("duration", "median_error")),
         "by_kind": {k: {h: {key: finite(val) for key, val in f.items()} for h, f in v.items()}
