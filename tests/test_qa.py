@@ -74,3 +74,10 @@ def test_cli_json_and_errors(tmp_path):
     assert result.exit_code != 0 and "not found" in result.output and "Traceback" not in result.output
     result = runner.invoke(app, ["eval", "qa", str(tmp_path), "--short-s", "0"])
     assert result.exit_code != 0 and "--short-s" in result.output
+
+
+def test_without_a_kb_the_log_is_perceived_with_the_truth_detector(tmp_path):
+    log = house_truth_kb().path.parent / "log"
+    report = evaluate_qa(log, out_dir=tmp_path)
+    assert report.detector == "truth" and (tmp_path / "kb.hiper").is_dir()
+    assert report.figures["questions"] > 50 and "perceive" in report.seconds

@@ -8,7 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, frame_progress, print_json
 from hiper_cli.commands.eval import eval_app
 
 
@@ -50,7 +50,9 @@ def qa(
     """
     from hiper_cli.qa import evaluate_qa
 
-    report = evaluate_qa(log, kb=kb, detector=detector, out_dir=out_dir, short_s=short_s, seed=seed)
+    with frame_progress("perceive", console(), enabled=not as_json and kb is None) as bar:
+        report = evaluate_qa(log, kb=kb, detector=detector, out_dir=out_dir, short_s=short_s, seed=seed,
+                             progress=None if bar is None else bar.update)
     data = report.to_dict()
     if as_json:
         print_json(data)

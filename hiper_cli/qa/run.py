@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -70,12 +71,12 @@ def seen_fraction(log: Path, default: float) -> float:
     return default
 
 
-def _perceive(log: Path, kb: Path, detector: str) -> None:
+def _perceive(log: Path, kb: Path, detector: str, progress: Callable[[int, int], None] | None) -> None:
     from hiper_cli.pipeline import PerceiveOptions, perceive_log
 
     options = PerceiveOptions(stages=("background", "foreground"),
                               stage_options={"foreground": {"detector": detector}}, on_existing="replace")
-    perceive_log(log, str(kb), options=options)
+    perceive_log(log, str(kb), options=options, progress=progress)
 
 
 def evaluate_qa(
@@ -87,13 +88,15 @@ def evaluate_qa(
     short_s: float = 15.0,
     seed: int = 0,
     min_pixel_fraction: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> QaReport:
     """Generate the questions of ``log``, answer them from ``kb`` (default: perceive the log
     with ``detector`` into ``OUT/kb.hiper``) and score them; writes ``OUT/questions.jsonl``
     (questions with true answers) and ``OUT/answers.jsonl`` (hiper's answers, scored).
     ``min_pixel_fraction``: how much of the image an instance must cover to count as seen
     (default: the sim truth detector's threshold, else 0.1 %). ``detector`` also says which
-    classes the perceiver can name when ``kb`` is given."""
+    classes the perceiver can name when ``kb`` is given. ``progress(done, total)`` after each
+    frame perceived."""
     from hiper_cli.graph import open_kb_for_reading
 
     log = Path(log)
@@ -110,7 +113,7 @@ def evaluate_qa(
     if kb is None:
         kb = str(out / "kb.hiper")
         t0 = time.perf_counter()
-        _perceive(log, Path(kb), used)
+        _perceive(log, Path(kb), used, progress)
         seconds["perceive"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     with open_kb_for_reading(kb) as knowledge:
