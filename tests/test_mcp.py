@@ -215,8 +215,11 @@ def test_streamable_http_serves_the_same_tools(kb_path):
     import subprocess
     import time
 
+    from mcp.client import streamable_http
     from mcp.client.session import ClientSession
-    from mcp.client.streamable_http import streamablehttp_client
+
+    # newer 1.x: streamable_http_client; older 1.x: streamablehttp_client (deprecated)
+    client = getattr(streamable_http, "streamable_http_client", None) or streamable_http.streamablehttp_client
 
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
@@ -232,7 +235,7 @@ def test_streamable_http_serves_the_same_tools(kb_path):
         time.sleep(0.2)
 
         async def main() -> Any:
-            async with streamablehttp_client(f"http://127.0.0.1:{port}/mcp") as (read, write, _), \
+            async with client(f"http://127.0.0.1:{port}/mcp") as (read, write, *_), \
                     ClientSession(read, write) as session:
                 await session.initialize()
                 return await session.call_tool("count", {"what": "chairs"})
