@@ -83,6 +83,9 @@ OPTION_RANGES: dict[str, Range] = {
     "instances": Range(1, 10_000_000, integer=True), "observations": Range(1, 100_000_000, integer=True),
     "port": Range(0, 65535, integer=True),
     "short_s": Range(0.0, 1e9, lo_open=True), "image_hz": Range(0.0, 1000.0, lo_open=True),
+    # hiper bench
+    "runs": Range(1, 1000, integer=True), "log_s": Range(10.0, 24 * 3600.0),
+    "time_limit_s": Range(1.0, 24 * 3600.0),
 }
 
 

@@ -1,0 +1,155 @@
+"""Navigation for the benchmark's tasks: the map, A* with a cost layer, and what the camera sees.
+
+The map is an ``OccupancyGrid`` (``hiper_cli.analyze.gridmap``) of the world's walls and
+furniture inflated by the robot's radius: the SLAM map every configuration has. A* runs over its
+free cells, 8-connected, with an optional cost layer (the people heatmap, paper VI-B: a crowded
+corridor costs the planner, never blocks it). A target is seen when it lies in the camera's
+horizontal field of view, within range, and no wall stands between (walls rasterised apart).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.analyze.gridmap import FREE, OCCUPIED, OccupancyGrid
+from hiper_cli.errors import ConfigError
+from hiper_cli.sim.route import Grid
+from hiper_cli.sim.worlds import World
+
+__all__ = ["NavConfig", "NavMap", "XY"]
+
+XY = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class NavConfig:
+    """The robot's drive and camera (the paper's robot drives at most 0.9 m/s)."""
+
+    speed_mps: float = 0.8
+    turn_rate_rps: float = 0.7
+    robot_radius_m: float = 0.35
+    resolution_m: float = 0.2
+    hfov_deg: float = 62.0  # 640 px at 525 px focal length
+    focal_px: float = 525.0
+    sensor_range_m: float = 5.0  # depth range: what the 3D pipeline can localise
+    min_box_px: float = 16.0  # the 2D detector needs a box at least this tall
+    heat_weight: float = 4.0  # path cost per metre is 1 + weight * heat (heat in [0, 0.8])
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.speed_mps <= 0.9:
+            raise ConfigError(f"robot speed {self.speed_mps} m/s: expected 0 < speed <= 0.9")
+
+
+class NavMap:
+    """The world's occupancy grid for planning, and a wall raster for line of sight."""
+
+    def __init__(self, world: World, config: NavConfig | None = None) -> None:
+        self.cfg = config or NavConfig()
+        self.world = world
+        grid = Grid(world, self.cfg.robot_radius_m, self.cfg.resolution_m)
+        cells = np.where(grid.free.T, FREE, OCCUPIED).astype(np.int8)  # Grid is [ix, iy]
+        self.grid = OccupancyGrid(cells, self.cfg.resolution_m, grid.origin)
+        walls = Grid(world, 0.0, 0.05)
+        self._walls = ~walls.free  # [ix, iy], furniture included: it occludes too
+        only_walls = np.zeros_like(self._walls)
+        x0, y0 = walls.origin
+        for rx0, ry0, rx1, ry1 in world.walls:
+            i0, i1 = int((rx0 - x0) / 0.05), int(math.ceil((rx1 - x0) / 0.05))
+            j0, j1 = int((ry0 - y0) / 0.05), int(math.ceil((ry1 - y0) / 0.05))
+            only_walls[max(i0, 0) : i1, max(j0, 0) : j1] = True
+        self._walls = only_walls
+        self._walls_origin = walls.origin
+
+    @property
+    def free(self) -> NDArray[np.bool_]:
+        """(H, W) bool, bottom-up like the grid's cells."""
+        return np.asarray(self.grid.cells == FREE)
+
+    def cell(self, p: XY) -> tuple[int, int]:
+        iy, ix, _ = self.grid.cell_of(np.array([p]))
+        return int(iy[0]), int(ix[0])
+
+    def center(self, c: tuple[int, int]) -> XY:
+        r = self.grid.resolution_m
+        return (self.grid.origin_xy_m[0] + (c[1] + 0.5) * r, self.grid.origin_xy_m[1] + (c[0] + 0.5) * r)
+
+    def nearest_free(self, p: XY) -> XY:
+        iy, ix = self.cell(p)
+        free = self.free
+        h, w = free.shape
+        if 0 <= iy < h and 0 <= ix < w and free[iy, ix]:
+            return p
+        idx = np.argwhere(free)
+        best = idx[np.argmin(((idx - np.array([iy, ix])) ** 2).sum(axis=1))]
+        return self.center((int(best[0]), int(best[1])))
+
+    def astar(self, a: XY, b: XY, heat: NDArray[np.float32] | None = None) -> tuple[list[XY], float]:
+        """Path of cell centres from ``a`` to ``b`` and its length in metres; ``heat`` (H, W) on
+        the grid's cells weighs each step by ``1 + heat_weight * heat``."""
+        a, b = self.nearest_free(a), self.nearest_free(b)
+        start, goal = self.cell(a), self.cell(b)
+        free = self.free
+        h, w = free.shape
+        extra = np.zeros((h, w)) if heat is None else self.cfg.heat_weight * np.asarray(heat, dtype=np.float64)
+        cost = {start: 0.0}
+        came: dict[tuple[int, int], tuple[int, int]] = {}
+        queue = [(0.0, start)]
+        steps = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj]
+        while queue:
+            _, cur = heapq.heappop(queue)
+            if cur == goal:
+                break
+            base = cost[cur]
+            for di, dj, step in steps:
+                nxt = (cur[0] + di, cur[1] + dj)
+                if not (0 <= nxt[0] < h and 0 <= nxt[1] < w) or not free[nxt]:
+                    continue
+                if di and dj and not (free[cur[0] + di, cur[1]] and free[cur[0], cur[1] + dj]):
+                    continue
+                c = base + step * (1.0 + extra[nxt])
+                if c < cost.get(nxt, math.inf):
+                    cost[nxt] = c
+                    came[nxt] = cur
+                    heapq.heappush(queue, (c + math.hypot(goal[0] - nxt[0], goal[1] - nxt[1]), nxt))
+        if goal not in cost:
+            raise ConfigError(f"bench: no free path from {a} to {b} in world {self.world.name}")
+        cells = [goal]
+        while cells[-1] != start:
+            cells.append(came[cells[-1]])
+        path = [a] + [self.center(c) for c in reversed(cells[1:-1])] + [b]
+        length = sum(math.dist(p, q) for p, q in zip(path, path[1:], strict=False))
+        return path, length
+
+    def line_of_sight(self, a: XY, b: XY) -> bool:
+        """No wall between ``a`` and ``b`` (sampled every 5 cm)."""
+        n = max(2, int(math.dist(a, b) / 0.05) + 1)
+        t = np.linspace(0.0, 1.0, n)
+        xs = a[0] + (b[0] - a[0]) * t
+        ys = a[1] + (b[1] - a[1]) * t
+        i = ((xs - self._walls_origin[0]) / 0.05).astype(np.int64)
+        j = ((ys - self._walls_origin[1]) / 0.05).astype(np.int64)
+        nx, ny = self._walls.shape
+        ok = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+        return not bool(self._walls[i[ok], j[ok]].any())
+
+    def detect_range_m(self, height_m: float, needs_depth: bool) -> float:
+        """How far a detector sees an object this tall (box of ``min_box_px``), capped by the
+        depth range when the pipeline localises it with depth."""
+        far = self.cfg.focal_px * height_m / self.cfg.min_box_px
+        return min(far, self.cfg.sensor_range_m) if needs_depth else far
+
+    def sees(self, robot: XY, yaw_rad: float, target: XY, range_m: float) -> bool:
+        """``target`` in the camera frustum (horizontal FOV), within ``range_m``, not behind a wall."""
+        d = math.dist(robot, target)
+        if d > range_m or d < 0.3:
+            return False
+        bearing = math.atan2(target[1] - robot[1], target[0] - robot[0])
+        off = (bearing - yaw_rad + math.pi) % (2 * math.pi) - math.pi
+        if abs(off) > math.radians(self.cfg.hfov_deg) / 2:
+            return False
+        return self.line_of_sight(robot, target)
