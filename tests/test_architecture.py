@@ -63,6 +63,8 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # runs of perception into a knowledge base
     "pipeline": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     "reanchor": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # hiper bench: simulates, perceives, scores and runs tasks on top of all the library
+    "bench": ("hiper_cli.serve", "hiper_cli.view", "hiper_cli.reanchor", *_UI),
     # the command line sits on top of everything
     "commands": (),
     "cli": (),
@@ -122,3 +124,12 @@ def test_view_rule_allows_what_it_draws_from():
         assert not allowed.startswith(FORBIDDEN["view"])
     for below in ("perceive", "graph", "analyze", "query"):
         assert "hiper_cli.view".startswith(FORBIDDEN[below])
+
+
+def test_only_the_cli_imports_the_bench():
+    """The benchmark sits on top: no library unit imports it."""
+    for unit in FORBIDDEN:
+        if unit in ("bench", "commands", "cli", "__main__"):
+            continue
+        offenders = [p for p in _modules(unit) if any(n.startswith("hiper_cli.bench") for n in _imports(p))]
+        assert not offenders, f"{unit} imports hiper_cli.bench: {offenders}"

@@ -10,6 +10,7 @@ horizontal field of view, within range, and no wall stands between (walls raster
 from __future__ import annotations
 
 import heapq
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -21,7 +22,7 @@ from hiper_cli.errors import ConfigError
 from hiper_cli.sim.route import Grid
 from hiper_cli.sim.worlds import World
 
-__all__ = ["NavConfig", "NavMap", "XY"]
+__all__ = ["XY", "NavConfig", "NavMap"]
 
 XY = tuple[float, float]
 
@@ -59,8 +60,8 @@ class NavMap:
         only_walls = np.zeros_like(self._walls)
         x0, y0 = walls.origin
         for rx0, ry0, rx1, ry1 in world.walls:
-            i0, i1 = int((rx0 - x0) / 0.05), int(math.ceil((rx1 - x0) / 0.05))
-            j0, j1 = int((ry0 - y0) / 0.05), int(math.ceil((ry1 - y0) / 0.05))
+            i0, i1 = int((rx0 - x0) / 0.05), math.ceil((rx1 - x0) / 0.05)
+            j0, j1 = int((ry0 - y0) / 0.05), math.ceil((ry1 - y0) / 0.05)
             only_walls[max(i0, 0) : i1, max(j0, 0) : j1] = True
         self._walls = only_walls
         self._walls_origin = walls.origin
@@ -95,7 +96,9 @@ class NavMap:
         start, goal = self.cell(a), self.cell(b)
         free = self.free
         h, w = free.shape
-        extra = np.zeros((h, w)) if heat is None else self.cfg.heat_weight * np.asarray(heat, dtype=np.float64)
+        extra = np.zeros((h, w))
+        if heat is not None:
+            extra = self.cfg.heat_weight * np.asarray(heat, dtype=np.float64)
         cost = {start: 0.0}
         came: dict[tuple[int, int], tuple[int, int]] = {}
         queue = [(0.0, start)]
@@ -122,7 +125,7 @@ class NavMap:
         while cells[-1] != start:
             cells.append(came[cells[-1]])
         path = [a] + [self.center(c) for c in reversed(cells[1:-1])] + [b]
-        length = sum(math.dist(p, q) for p, q in zip(path, path[1:], strict=False))
+        length = sum(math.dist(p, q) for p, q in itertools.pairwise(path))
         return path, length
 
     def line_of_sight(self, a: XY, b: XY) -> bool:

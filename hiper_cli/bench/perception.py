@@ -176,7 +176,9 @@ def _baseline(root: Path, truth: Any) -> tuple[BaselineRun, dict[str, Any], list
         [None, None], "frames_per_s": len(frames) / wall if wall > 0 else 0.0, "tp": tp, "fp": fp,
         "fp_share": fp / (tp + fp) if tp + fp else None, "sum_i": len(run.instances),
         "sum_o": run.observations,
-        "localisation_classified_m": [float(np.mean(errors)), float(np.std(errors))] if errors else [None, None],
+        "localisation_classified_m": (
+            [float(np.mean(errors)), float(np.std(errors))] if errors else [None, None]
+        ),
         "people_dynamic_ratio": None, "people_speed_mps": [None, None], "people_speed_ci_mps": None,
         # every point is an obstacle, sampled like the foreground stage's grid
         "points_after_background_mean": float(h * w) / _PIXEL_STEP**2, "classification": per_class,
@@ -184,7 +186,9 @@ def _baseline(root: Path, truth: Any) -> tuple[BaselineRun, dict[str, Any], list
     return run, table, labels
 
 
-def _knowledge_of_baseline(run: BaselineRun, labels: list[int | None], truth: Any, table: dict[str, Any]) -> Knowledge:
+def _knowledge_of_baseline(
+    run: BaselineRun, labels: list[int | None], truth: Any, table: dict[str, Any]
+) -> Knowledge:
     rows, track, bottles = [], [], []
     errors: list[tuple[float, float, float]] = []
     false_people: list[tuple[float, float]] = []

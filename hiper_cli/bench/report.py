@@ -111,7 +111,8 @@ def _task_table(summary: dict[str, Any], world: str) -> list[str]:
     lines = ["| config | " + " | ".join(f"{_TASK_NAMES[t]}: median s (success)" for t in TASKS) + " |",
              "|---|" + "---|" * 4]
     for c, row in cells.items():
-        parts = [f"{_fmt(row[t]['median_time_s'], 1)} ({row[t]['successes']}/{row[t]['runs']})" for t in TASKS]
+        parts = [f"{_fmt(row[t]['median_time_s'], 1)} ({row[t]['successes']}/{row[t]['runs']})"
+                 for t in TASKS]
         lines.append(f"| {c} | " + " | ".join(parts) + " |")
     lines += ["", "Why runs ended: " + "; ".join(
         f"{c} {t}: " + ", ".join(f"{k} {v}" for k, v in summary["reasons"][world][c][t].items())
@@ -138,7 +139,8 @@ def _table3(summary: dict[str, Any], world: str) -> list[str]:
         paper = PAPER_TABLE_III.get(paper_key, {}).get(world) if paper_key else None
         if key in ("tp", "fp"):
             paper = PAPER_TABLE_III["classification_tp_fp"][world][0 if key == "tp" else 1]
-        lines.append(f"| {label} | " + " | ".join(_fmt(t3[c].get(key)) for c in configs) + f" | {_fmt(paper)} |")
+        ours = " | ".join(_fmt(t3[c].get(key)) for c in configs)
+        lines.append(f"| {label} | {ours} | {_fmt(paper)} |")
     return lines
 
 
@@ -162,7 +164,8 @@ def write_report(result: BenchResult, summary: dict[str, Any], out: Path, comman
         "# hiper bench: the ablation study (C1-C5) on tasks T1-T4", "",
         f"Worlds {', '.join(s['worlds'])}; configurations {', '.join(s['configs'])}; {s['runs']} runs per "
         f"task, configuration and world; logs of {s['log_s']:.0f} s ({s['mapping_s']:.0f} s mapping) at "
-        f"{s['rate_hz']:g} Hz, {s['width_px']}x{s['height_px']} px; time limit {s['time_limit_s']:.0f} s.", "",
+        f"{s['rate_hz']:g} Hz, {s['width_px']}x{s['height_px']} px; time limit "
+        f"{s['time_limit_s']:.0f} s.", "",
         "Reproduce:", "", "```", command, "```", "",
         f"World seeds: {s['world_seeds']}. Run seeds (people's start and warm-up, detector luck; the same "
         f"for every configuration): {s['run_seeds']}.", "",
@@ -177,7 +180,8 @@ def write_report(result: BenchResult, summary: dict[str, Any], out: Path, comman
         md += ["", f"## {world}", ""]
         _times_plot(plt, summary, world, out / f"times_{world}.png")
         _success_plot(plt, summary, world, out / f"success_{world}.png")
-        md += [f"![task times {world}](times_{world}.png)", "", f"![success {world}](success_{world}.png)", ""]
+        md += [f"![task times {world}](times_{world}.png)", "",
+               f"![success {world}](success_{world}.png)", ""]
         if _heatmap_plot(plt, result, world, out / f"heatmaps_{world}.png"):
             md += [f"![heatmaps {world}](heatmaps_{world}.png)", ""]
         md += _task_table(summary, world)
@@ -188,13 +192,14 @@ def write_report(result: BenchResult, summary: dict[str, Any], out: Path, comman
         for c, v in summary["t3"][world].items():
             md.append(f"| {c} | {_fmt(v['support_known'], 2)} | {_fmt(v['movers_near_mean'], 2)} | "
                       f"{_fmt(v['movers_tracked'])} | {_fmt(v['plan_s'], 2)} | {_fmt(v['error_m_median'])} |")
-        md += ["", "T4 carry back:", "", "| config | path / m | waited / s | close encounters (steps < 0.5 m) |",
+        md += ["", "T4 carry back:", "",
+               "| config | path / m | waited / s | close encounters (steps < 0.5 m) |",
                "|---|---|---|---|"]
         for c, v in summary["t4"][world].items():
             md.append(f"| {c} | {_fmt(v['path_m_mean'], 1)} | {_fmt(v['waited_s_mean'], 1)} | "
                       f"{_fmt(v['close_encounters_mean'], 1)} |")
-        md += ["", f"### Table II ({world}, background on the mapping phase)", ""] + _table2(summary, world)
-        md += ["", f"### Table III ({world}, per configuration)", ""] + _table3(summary, world)
+        md += ["", f"### Table II ({world}, background on the mapping phase)", "", *_table2(summary, world)]
+        md += ["", f"### Table III ({world}, per configuration)", "", *_table3(summary, world)]
     path = out / "report.md"
     path.write_text("\n".join(md) + "\n", encoding="utf-8")
     return path

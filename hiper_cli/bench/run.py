@@ -37,9 +37,12 @@ class BenchSettings:
     def __post_init__(self) -> None:
         bad = [w for w in self.worlds if w not in WORLD_NAMES]
         if bad or not self.worlds:
-            raise ConfigError(f"--worlds: {', '.join(bad) or 'none'}; expected some of {', '.join(WORLD_NAMES)}")
+            names = ", ".join(bad) or "none"
+            raise ConfigError(f"--worlds: {names}; expected some of {', '.join(WORLD_NAMES)}")
         if self.mapping_s >= self.log_s:
-            raise ConfigError(f"bench: mapping phase {self.mapping_s} s must be shorter than the log {self.log_s} s")
+            raise ConfigError(
+                f"--mapping-s {self.mapping_s}: must be shorter than the log ({self.log_s} s)"
+            )
 
     def world_seed(self, world: str) -> int:
         return self.seed * 10 + WORLD_NAMES.index(world)
@@ -106,7 +109,9 @@ def run_bench(settings: BenchSettings, out: Path, progress: Progress | None = No
         for name in ("C1", "C2"):
             if name in kb:
                 k = kb[name]
-                maps[f"{name} person"] = heatmap_of(nav, "person", k.person_rows, k.person_track, k.person_speed_mps)
+                maps[f"{name} person"] = heatmap_of(
+                    nav, "person", k.person_rows, k.person_track, k.person_speed_mps
+                )
                 rows, track = points_as_rows(k.bottles)
                 maps[f"{name} bottle"] = heatmap_of(nav, "bottle", rows, track, 0.0)
         result.heatmaps[world_name] = {k: v for k, v in maps.items() if v is not None}

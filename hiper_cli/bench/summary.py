@@ -71,7 +71,9 @@ def summarize(result: BenchResult) -> dict[str, Any]:
     t4_extra = {
         w: {
             cfg.name: {
-                "close_encounters_mean": float(np.mean([r.extra["close_encounters"] for r in rs])) if rs else None,
+                "close_encounters_mean": (
+                    float(np.mean([r.extra["close_encounters"] for r in rs])) if rs else None
+                ),
                 "waited_s_mean": float(np.mean([r.extra["waited_s"] for r in rs])) if rs else None,
                 "path_m_mean": float(np.mean([r.extra["path_m"] for r in rs])) if rs else None,
             }

@@ -113,8 +113,8 @@ def _search_task(
         return TaskResult(**base, task=name, success=False, time_s=t, reason="time limit")
     ok = found["kind"] == "true" and t <= robot.deadline_s
     reason = "found" if ok else ("false positive" if found["kind"] == "false" else "time limit")
-    return TaskResult(**base, task=name, success=ok, time_s=t, reason=reason,
-                      extra={"driven_m": round(robot.driven_m, 2), "heat_goals": len(goals) if cfg.heatmaps else 0})
+    extra = {"driven_m": round(robot.driven_m, 2), "heat_goals": len(goals) if cfg.heatmaps else 0}
+    return TaskResult(**base, task=name, success=ok, time_s=t, reason=reason, extra=extra)
 
 
 def run_episode(
@@ -129,7 +129,7 @@ def run_episode(
     crowd = Crowd(world, seed, SocialForceConfig(dt_s=0.1))
     crowd.step(float(rng.uniform(*tc.warmup_s)))
     idle = nav.nearest_free(world.waypoints[0])
-    base = {"world": world.name, "config": cfg.name, "run": run, "seed": seed}
+    base: dict[str, Any] = {"world": world.name, "config": cfg.name, "run": run, "seed": seed}
     needs_depth = cfg.foreground
     results: list[TaskResult] = []
 
@@ -166,6 +166,7 @@ def run_episode(
     path, _ = nav.astar(robot.xy, target)
     robot.drive(path)
     robot.turn_to(target)
+    error: float | None
     known = [e for e in knowledge.bottle_errors_m if math.dist((e[0], e[1]), target) < 0.5]
     errors = [e[2] for e in knowledge.bottle_errors_m]
     if known:

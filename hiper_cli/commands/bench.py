@@ -19,7 +19,7 @@ HELP = (
     "(needs matplotlib: pip install 'hiper[plot]'). --quick: one world, 2 runs, a short log.\n\n"
     "Example: hiper bench --quick -o out/bench"
 )
-QUICK = {"worlds": "house", "runs": 2, "log_s": 90.0, "mapping_s": 30.0}
+QUICK_WORLDS, QUICK_RUNS, QUICK_LOG_S, QUICK_MAPPING_S = "house", 2, 90.0, 30.0
 
 
 def bench(
@@ -31,23 +31,31 @@ def bench(
     seed: int = typer.Option(0, "--seed", help="Seed of the worlds, logs and runs."),
     log_s: float | None = typer.Option(None, "--log-s", help="Length of each world's log in seconds (600)."),
     mapping_s: float | None = typer.Option(None, "--mapping-s", help="Its mapping phase in seconds (60)."),
-    time_limit_s: float = typer.Option(600.0, "--time-limit-s", help="A task fails beyond this (paper: 600)."),
+    time_limit_s: float = typer.Option(
+        600.0, "--time-limit-s", help="A task fails beyond this (paper: 600)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
-    from hiper_cli.bench import BenchSettings, parse_configs, require_matplotlib, run_bench, summarize, write_report
+    from hiper_cli.bench import (
+        BenchSettings,
+        parse_configs,
+        require_matplotlib,
+        run_bench,
+        summarize,
+        write_report,
+    )
     from hiper_cli.bench.tasks import TaskConfig
 
     require_matplotlib()
-    base = QUICK if quick else {}
-    world_text = worlds or str(base.get("worlds", "house,hospital,office"))
+    world_text = worlds or (QUICK_WORLDS if quick else "house,hospital,office")
     settings = BenchSettings(
         worlds=tuple(w.strip() for w in world_text.split(",") if w.strip()),
-        configs=parse_configs(configs), runs=runs or int(base.get("runs", 10)), seed=seed,
-        log_s=log_s or float(base.get("log_s", 600.0)), mapping_s=mapping_s or float(base.get("mapping_s", 60.0)),
+        configs=parse_configs(configs), runs=runs or (QUICK_RUNS if quick else 10), seed=seed,
+        log_s=log_s or (QUICK_LOG_S if quick else 600.0),
+        mapping_s=mapping_s or (QUICK_MAPPING_S if quick else 60.0),
         tasks=TaskConfig(time_limit_s=time_limit_s),
     )
     screen = console()
-    command = "hiper bench " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if len(sys.argv) > 2 else "hiper bench"
+    command = " ".join(["hiper bench", *(shlex.quote(a) for a in sys.argv[2:])])
     if as_json:
         result = run_bench(settings, out)
     else:
