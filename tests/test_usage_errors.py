@@ -24,8 +24,8 @@ def hiper(*args: str) -> subprocess.CompletedProcess[str]:
 @pytest.mark.parametrize(
     ("args", "usage", "message"),
     [
-        (["nosuch"], "Usage: hiper [OPTIONS] COMMAND",
-         "no such command 'nosuch' for 'hiper'; expected one of"),
+        (["zzz"], "Usage: hiper [OPTIONS] COMMAND",
+         "no such command 'zzz' for 'hiper'; expected one of"),
         (["perceve"], "Usage: hiper [OPTIONS] COMMAND", "did you mean 'perceive'?"),
         (["kb", "chek"], "Usage: hiper kb [OPTIONS] COMMAND",
          "no such command 'chek' for 'hiper kb'; did you "
