@@ -2,9 +2,10 @@
 
 The map is an ``OccupancyGrid`` (``hiper_cli.analyze.gridmap``) of the world's walls and
 furniture inflated by the robot's radius: the SLAM map every configuration has. A* runs over its
-free cells, 8-connected, with an optional cost layer (the people heatmap, paper VI-B: a crowded
-corridor costs the planner, never blocks it). A target is seen when it lies in the camera's
-horizontal field of view, within range, and no wall stands between (walls rasterised apart).
+free cells (the largest connected free region), 8-connected, with an optional cost layer (the
+people heatmap, paper VI-B: a crowded corridor costs the planner, never blocks it). A target is
+seen when it lies in the camera's horizontal field of view, within range, and no wall stands
+between (walls rasterised apart).
 """
 
 from __future__ import annotations
@@ -53,7 +54,14 @@ class NavMap:
         self.cfg = config or NavConfig()
         self.world = world
         grid = Grid(world, self.cfg.robot_radius_m, self.cfg.resolution_m)
-        cells = np.where(grid.free.T, FREE, OCCUPIED).astype(np.int8)  # Grid is [ix, iy]
+        from scipy import ndimage
+
+        free = grid.free.T  # Grid is [ix, iy]
+        labels, n = ndimage.label(free, structure=np.ones((3, 3)))
+        if n > 1:  # pockets the robot cannot reach (behind closed doors) count as occupied
+            sizes = np.bincount(labels.ravel())[1:]
+            free = labels == 1 + int(np.argmax(sizes))
+        cells = np.where(free, FREE, OCCUPIED).astype(np.int8)
         self.grid = OccupancyGrid(cells, self.cfg.resolution_m, grid.origin)
         walls = Grid(world, 0.0, 0.05)
         self._walls = ~walls.free  # [ix, iy], furniture included: it occludes too
@@ -88,6 +96,34 @@ class NavMap:
         idx = np.argwhere(free)
         best = idx[np.argmin(((idx - np.array([iy, ix])) ** 2).sum(axis=1))]
         return self.center((int(best[0]), int(best[1])))
+
+    def viewpoint(self, target: XY, max_m: float = 3.0) -> XY:
+        """The nearest free cell within ``max_m`` that sees ``target`` (no wall between; an
+        object on a table is seen from beside it), else the nearest free cell."""
+        iy, ix = self.cell(target)
+        r = int(max_m / self.grid.resolution_m)
+        free = self.free
+        h, w = free.shape
+        cands = []
+        for dy in range(-r, r + 1):
+            for dx in range(-r, r + 1):
+                y, x = iy + dy, ix + dx
+                if 0 <= y < h and 0 <= x < w and free[y, x]:
+                    cands.append((math.hypot(dx, dy), (y, x)))
+        for _, c in sorted(cands):
+            p = self.center(c)
+            if self.line_of_sight(p, target):
+                return p
+        return self.nearest_free(target)
+
+    def idle_position(self) -> XY:
+        """The robot's idle place: the route waypoint farthest from where the people start and
+        walk to (the paper's idle positions lie off the busy areas)."""
+        spots = [s.start_xy for s in self.world.walkers] + [g for s in self.world.walkers for g in s.goals]
+        wps = [self.nearest_free(p) for p in self.world.waypoints]
+        if not spots:
+            return wps[0]
+        return max(wps, key=lambda p: min(math.dist(p, q) for q in spots))
 
     def astar(self, a: XY, b: XY, heat: NDArray[np.float32] | None = None) -> tuple[list[XY], float]:
         """Path of cell centres from ``a`` to ``b`` and its length in metres; ``heat`` (H, W) on

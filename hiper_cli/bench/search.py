@@ -3,7 +3,7 @@
 ``heat_goals`` takes the heatmap's peaks (paper VI-B: the inverse map draws a search to where
 the class was found): the hottest cell, then the hottest outside ``suppress_m`` of the goals so
 far, while a peak holds at least ``min_share`` of the cap; each goal is moved onto a free cell.
-``coverage_goals`` is the mapping route's waypoints, nearest first from the start, in a tour.
+``coverage_goals`` is a lattice of viewpoints over the free space, nearest first, in a tour.
 Both lists are visited in order, scanning a full turn at each goal, and repeated until the time
 limit; the heat goals are followed by the coverage tour when they are exhausted.
 """
@@ -51,14 +51,30 @@ def heat_goals(nav: NavMap, hm: Heatmap, max_goals: int = 8, suppress_m: float =
         iy, ix = np.unravel_index(int(np.argmax(heat)), heat.shape)
         if heat[iy, ix] < min_share * cap:
             break
-        goals.append(nav.nearest_free(nav.center((int(iy), int(ix)))))
+        goals.append(nav.viewpoint(nav.center((int(iy), int(ix)))))
         heat[(ys - iy) ** 2 + (xs - ix) ** 2 <= r_cells**2] = 0.0
     return goals
 
 
-def coverage_goals(nav: NavMap, start: XY) -> list[XY]:
-    """The world's route waypoints as a nearest-neighbour tour from ``start``."""
-    left = [nav.nearest_free(p) for p in nav.world.waypoints]
+def coverage_goals(nav: NavMap, start: XY, spacing_m: float = 2.5) -> list[XY]:
+    """Viewpoints on a ``spacing_m`` lattice over the map's free space (each lattice point moved
+    to a free cell within half the spacing, else dropped) as a nearest-neighbour tour from
+    ``start``: a systematic coverage of every room."""
+    g = nav.grid
+    h, w = g.shape
+    x0, y0 = g.origin_xy_m
+    free = nav.free
+    idx = np.argwhere(free)
+    left: list[XY] = []
+    for y in np.arange(y0 + spacing_m / 2, y0 + h * g.resolution_m, spacing_m):
+        for x in np.arange(x0 + spacing_m / 2, x0 + w * g.resolution_m, spacing_m):
+            iy, ix = nav.cell((float(x), float(y)))
+            d = np.hypot(idx[:, 0] - iy, idx[:, 1] - ix) * g.resolution_m
+            k = int(np.argmin(d))
+            if d[k] <= spacing_m / 2:
+                p = nav.center((int(idx[k, 0]), int(idx[k, 1])))
+                if p not in left:
+                    left.append(p)
     tour: list[XY] = []
     here = start
     while left:

@@ -128,7 +128,7 @@ def run_episode(
     rng = np.random.default_rng(seed)
     crowd = Crowd(world, seed, SocialForceConfig(dt_s=0.1))
     crowd.step(float(rng.uniform(*tc.warmup_s)))
-    idle = nav.nearest_free(world.waypoints[0])
+    idle = nav.idle_position()
     base: dict[str, Any] = {"world": world.name, "config": cfg.name, "run": run, "seed": seed}
     needs_depth = cfg.foreground
     results: list[TaskResult] = []
@@ -163,7 +163,7 @@ def run_episode(
         k = int(np.argmin(np.hypot(bottles[:, 0] - robot.xy[0], bottles[:, 1] - robot.xy[1])))
         target = (float(bottles[k, 0]), float(bottles[k, 1]))
     robot = Robot(nav, crowd, robot.xy, robot.yaw, tc.time_limit_s)
-    path, _ = nav.astar(robot.xy, target)
+    path, _ = nav.astar(robot.xy, nav.viewpoint(target, 1.0))
     robot.drive(path)
     robot.turn_to(target)
     error: float | None
