@@ -33,7 +33,9 @@ from hiper_cli.bench.nav import XY, NavMap
 from hiper_cli.bench.perception import Knowledge
 from hiper_cli.bench.robot import Look, Robot
 from hiper_cli.bench.search import coverage_goals, heat_goals, heatmap_of, points_as_rows
+from hiper_cli.errors import ConfigError
 from hiper_cli.sim.people import Crowd, SocialForceConfig
+from hiper_cli.sim.route import Grid
 
 __all__ = ["TASKS", "TaskConfig", "TaskResult", "run_episode"]
 
@@ -68,6 +70,17 @@ class TaskResult:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+
+class _PeopleGrid(Grid):
+    """The people's planning grid; a person pushed into a pocket with no path waits there
+    (``hiper sim`` never meets this at its step; the tasks step the people at 0.1 s)."""
+
+    def astar(self, a: XY, b: XY) -> list[XY]:
+        try:
+            return super().astar(a, b)
+        except ConfigError:
+            return [a]
 
 
 def _search(robot: Robot, nav: NavMap, goals: list[XY], tour: list[XY], look: Look) -> bool:
@@ -127,6 +140,7 @@ def run_episode(
     world = nav.world
     rng = np.random.default_rng(seed)
     crowd = Crowd(world, seed, SocialForceConfig(dt_s=0.1))
+    crowd.grid.__class__ = _PeopleGrid
     crowd.step(float(rng.uniform(*tc.warmup_s)))
     idle = nav.idle_position()
     base: dict[str, Any] = {"world": world.name, "config": cfg.name, "run": run, "seed": seed}
