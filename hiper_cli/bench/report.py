@@ -80,7 +80,7 @@ def _heatmap_plot(plt: Any, result: BenchResult, world: str, path: Path) -> bool
         ax.imshow(np.where(nav.free, 1.0, 0.35), origin="lower", cmap="gray", vmin=0, vmax=1, extent=extent)
         heat = np.ma.masked_less(hm.heat, 0.02)
         ax.imshow(heat, origin="lower", cmap="inferno", alpha=0.8, vmin=0, vmax=0.8, extent=extent)
-        idle = nav.world.waypoints[0]
+        idle = nav.idle_position()
         ax.plot(*idle, "c^", ms=8, label="idle position")
         bottles = [o.box.center_m for o in nav.world.objects if o.class_name == "bottle"]
         if bottles:
