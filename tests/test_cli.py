@@ -53,3 +53,11 @@ def test_help_does_not_import_heavy_packages():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "", f"hiper --help imports {out.stdout.strip()}"
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) for p, _ in COMMANDS])
+def test_install_hints_keep_their_extra(path, cmd):
+    """Rich markup reads "[mcp]" as a style tag; a help text must escape it or lose it."""
+    result = runner.invoke(app, [*path, "--help"], terminal_width=200)
+    assert result.exit_code == 0
+    assert "pip install 'hiper'" not in result.output, f"hiper {' '.join(path)} --help drops an extra's name"

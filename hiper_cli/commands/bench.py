@@ -16,7 +16,7 @@ HELP = (
     "The paper's benchmark (section VII): per world a simulated log (mapping, then people), perceived "
     "in the ablation configurations C1-C5 (Tables II and III against the ground truth), then the "
     "fetch-and-carry tasks T1-T4 on the map, 10 runs each; writes OUT/report.md with PNG figures "
-    "(needs matplotlib: pip install 'hiper[plot]'). --quick: one world, 2 runs, a short log.\n\n"
+    "(needs matplotlib: pip install 'hiper\\[plot]'). --quick: one world, 2 runs, a short log.\n\n"
     "Example: hiper bench --quick -o out/bench"
 )
 QUICK_WORLDS, QUICK_RUNS, QUICK_LOG_S, QUICK_MAPPING_S = "house", 2, 90.0, 30.0

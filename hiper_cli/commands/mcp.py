@@ -35,7 +35,7 @@ def mcp_command(
 ) -> None:
     """Serve the query verbs as MCP tools (find, count, last_seen, when, trajectory, workspace,
     describe, features, heatmap, sparql, ask) and resources (vocabulary, summary); read-only.
-    Needs the mcp extra: pip install 'hiper[mcp]'.
+    Needs the mcp extra: pip install 'hiper\\[mcp]'.
 
     Example: hiper mcp --kb house.hiper   (stdio; or --http 127.0.0.1:8765)
     """
