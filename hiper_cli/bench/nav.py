@@ -10,7 +10,6 @@ between (walls rasterised apart).
 
 from __future__ import annotations
 
-import heapq
 import itertools
 import math
 from dataclasses import dataclass
@@ -20,7 +19,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.analyze.gridmap import FREE, OCCUPIED, OccupancyGrid
 from hiper_cli.errors import ConfigError
-from hiper_cli.sim.route import Grid
+from hiper_cli.sim.route import Grid, grid_path
 from hiper_cli.sim.worlds import World
 
 __all__ = ["XY", "NavConfig", "NavMap"]
@@ -129,38 +128,11 @@ class NavMap:
         """Path of cell centres from ``a`` to ``b`` and its length in metres; ``heat`` (H, W) on
         the grid's cells weighs each step by ``1 + heat_weight * heat``."""
         a, b = self.nearest_free(a), self.nearest_free(b)
-        start, goal = self.cell(a), self.cell(b)
-        free = self.free
-        h, w = free.shape
-        extra = np.zeros((h, w))
-        if heat is not None:
-            extra = self.cfg.heat_weight * np.asarray(heat, dtype=np.float64)
-        cost = {start: 0.0}
-        came: dict[tuple[int, int], tuple[int, int]] = {}
-        queue = [(0.0, start)]
-        steps = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj]
-        while queue:
-            _, cur = heapq.heappop(queue)
-            if cur == goal:
-                break
-            base = cost[cur]
-            for di, dj, step in steps:
-                nxt = (cur[0] + di, cur[1] + dj)
-                if not (0 <= nxt[0] < h and 0 <= nxt[1] < w) or not free[nxt]:
-                    continue
-                if di and dj and not (free[cur[0] + di, cur[1]] and free[cur[0], cur[1] + dj]):
-                    continue
-                c = base + step * (1.0 + extra[nxt])
-                if c < cost.get(nxt, math.inf):
-                    cost[nxt] = c
-                    came[nxt] = cur
-                    heapq.heappush(queue, (c + math.hypot(goal[0] - nxt[0], goal[1] - nxt[1]), nxt))
-        if goal not in cost:
+        weight = None if heat is None else self.cfg.heat_weight * np.asarray(heat, dtype=np.float64)
+        cells = grid_path(self.free, self.cell(a), self.cell(b), weight)
+        if cells is None:
             raise ConfigError(f"bench: no free path from {a} to {b} in world {self.world.name}")
-        cells = [goal]
-        while cells[-1] != start:
-            cells.append(came[cells[-1]])
-        path = [a] + [self.center(c) for c in reversed(cells[1:-1])] + [b]
+        path = [a] + [self.center(c) for c in cells[1:-1]] + [b]
         length = sum(math.dist(p, q) for p, q in itertools.pairwise(path))
         return path, length
 

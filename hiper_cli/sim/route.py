@@ -43,6 +43,43 @@ class RouteConfig:
             raise ConfigError(f"robot speed {self.speed_mps} m/s: expected 0 < speed <= 0.9")
 
 
+Cell = tuple[int, int]
+_STEPS = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj]
+
+
+def grid_path(
+    free: NDArray[np.bool_], start: Cell, goal: Cell, weight: NDArray[np.float64] | None = None
+) -> list[Cell] | None:
+    """A*: the cells of the cheapest 8-connected path from ``start`` to ``goal`` (both included)
+    through ``free`` cells, never cutting a corner; a step into a cell costs its length times
+    ``1 + weight`` there. None when there is no such path."""
+    nx, ny = free.shape
+    came: dict[Cell, Cell] = {}
+    cost = {start: 0.0}
+    heap = [(0.0, start)]
+    while heap:
+        _, cur = heapq.heappop(heap)
+        if cur == goal:
+            break
+        for di, dj, step in _STEPS:
+            nxt = (cur[0] + di, cur[1] + dj)
+            if not (0 <= nxt[0] < nx and 0 <= nxt[1] < ny) or not free[nxt]:
+                continue
+            if di and dj and not (free[cur[0] + di, cur[1]] and free[cur[0], cur[1] + dj]):
+                continue
+            c = cost[cur] + (step if weight is None else step * (1.0 + weight[nxt]))
+            if c < cost.get(nxt, math.inf):
+                cost[nxt] = c
+                came[nxt] = cur
+                heapq.heappush(heap, (c + math.hypot(goal[0] - nxt[0], goal[1] - nxt[1]), nxt))
+    if goal not in cost:
+        return None
+    cells = [goal]
+    while cells[-1] != start:
+        cells.append(came[cells[-1]])
+    return cells[::-1]
+
+
 class Grid:
     """Occupancy grid of a world: ``free[i, j]`` for cell centre (x0 + (i + ½)·res, y0 + (j + ½)·res)."""
 
@@ -91,33 +128,10 @@ class Grid:
     def astar(self, a: XY, b: XY) -> list[XY]:
         """Shortest 8-connected path from ``a`` to ``b`` through free cells, shortened by line of sight."""
         a, b = self.nearest_free(a), self.nearest_free(b)
-        start, goal = self.cell(a), self.cell(b)
-        nx, ny = self.free.shape
-        came: dict[tuple[int, int], tuple[int, int]] = {}
-        cost = {start: 0.0}
-        heap = [(0.0, start)]
-        steps = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj]
-        while heap:
-            _, cur = heapq.heappop(heap)
-            if cur == goal:
-                break
-            for di, dj, step in steps:
-                nxt = (cur[0] + di, cur[1] + dj)
-                if not (0 <= nxt[0] < nx and 0 <= nxt[1] < ny) or not self.free[nxt]:
-                    continue
-                if di and dj and not (self.free[cur[0] + di, cur[1]] and self.free[cur[0], cur[1] + dj]):
-                    continue
-                c = cost[cur] + step
-                if c < cost.get(nxt, math.inf):
-                    cost[nxt] = c
-                    came[nxt] = cur
-                    heapq.heappush(heap, (c + math.hypot(goal[0] - nxt[0], goal[1] - nxt[1]), nxt))
-        if goal not in cost:
+        cells = grid_path(self.free, self.cell(a), self.cell(b))
+        if cells is None:
             raise ConfigError(f"no free path from {a} to {b}; the world layout blocks the route")
-        cells = [goal]
-        while cells[-1] != start:
-            cells.append(came[cells[-1]])
-        points = [a] + [self.center(c) for c in reversed(cells[1:-1])] + [b]
+        points = [a] + [self.center(c) for c in cells[1:-1]] + [b]
         out = [points[0]]
         k = 0
         while k < len(points) - 1:
