@@ -84,18 +84,6 @@ def _last_pose(log: Path) -> tuple[float, float, float, float]:
     return (tx, ty, tz, float(math.atan2(axis[1], axis[0])))
 
 
-def _in_range_counts(truth: Truth) -> dict[float, dict[int, int]]:
-    """Per stamp, pixels with a depth return per instance (a world's ``frames.jsonl``)."""
-    path = truth.root / "gt" / str(truth.frames_file)
-    out: dict[float, dict[int, int]] = {}
-    for line in path.read_text().splitlines():
-        if line.strip():
-            rec = json.loads(line)
-            counts = rec.get("in_range", rec.get("visible", {}))
-            out[float(rec["t"])] = {int(k): int(v) for k, v in counts.items()}
-    return out
-
-
 def _id_image_counts(truth: Truth, rgb: list[list[str]]) -> dict[float, dict[int, int]]:
     out: dict[float, dict[int, int]] = {}
     for stamp, rel in ((float(r[0]), r[1]) for r in rgb):
@@ -112,7 +100,7 @@ def load_scene_truth(log: str | Path, *, min_pixel_fraction: float = 0.001) -> S
     rgb = _tum(root / "rgb.txt")
     camera = json.loads((root / "camera.json").read_text())
     min_px = max(1, round(min_pixel_fraction * int(camera["width"]) * int(camera["height"])))
-    counts = _in_range_counts(truth) if truth.frames_file else _id_image_counts(truth, rgb)
+    counts = truth.load_visibility(in_range=True) if truth.frames_file else _id_image_counts(truth, rgb)
     stamps = np.array(sorted(counts), dtype=np.float64)
     seen: dict[int, list[float]] = {}
     for stamp in stamps:

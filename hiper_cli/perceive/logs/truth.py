@@ -63,8 +63,6 @@ class TruthInstance:
     alt_classes: tuple[str, ...] = ()
     # Whether depth could map it (a realistic world's ``observed``; sim truth lists only these).
     observed: bool = True
-    # First and last stamp with a visible pixel, where the truth records them.
-    seen_s: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -103,8 +101,9 @@ class Truth:
         """Whether this frame has an id image (realistic worlds label every 5th frame)."""
         return self.instance_ids_path(rgb_relpath).exists()
 
-    def load_visibility(self) -> dict[float, dict[int, int]]:
-        """Visible pixels per instance per stamp (``gt/frames.jsonl``, realistic worlds)."""
+    def load_visibility(self, *, in_range: bool = False) -> dict[float, dict[int, int]]:
+        """Visible pixels per instance per stamp (``gt/frames.jsonl``, realistic worlds);
+        ``in_range``: only those with a depth return, where a record has them."""
         if self.frames_file is None:
             raise LogError(f"{self.root / 'gt'}: this truth has no per-frame visibility file")
         path = self.root / "gt" / self.frames_file
@@ -118,7 +117,8 @@ class Truth:
                 continue
             try:
                 rec = json.loads(line)
-                out[float(rec["t"])] = {int(k): int(v) for k, v in rec["visible"].items()}
+                counts = rec.get("in_range", rec["visible"]) if in_range else rec["visible"]
+                out[float(rec["t"])] = {int(k): int(v) for k, v in counts.items()}
             except (json.JSONDecodeError, KeyError, TypeError, ValueError, AttributeError) as err:
                 raise LogError(f"{path}:{lineno}: bad frame record ({err})") from err
         return out

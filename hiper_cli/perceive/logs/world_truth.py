@@ -4,9 +4,9 @@ The layout (documented in full by the log's own ``gt/README.md``)::
 
     gt/instances.json     {"log", "t0", "rate_hz", "seed", "instances": [...]}: every instance
                           seen, with "class", "alt_classes", "layer", "static", "aabb_min",
-                          "aabb_max", "plane" (building pieces), "observed", "first_seen_t",
-                          "last_seen_t", and for walking people "speed_mps", "active_from_t"
-                          and "trajectory" ([t, x, y, z] body-box centre per frame)
+                          "aabb_max", "plane" (building pieces), "observed", and for walking
+                          people "speed_mps", "active_from_t" and "trajectory" ([t, x, y, z]
+                          body-box centre per frame)
     gt/frames.jsonl       per frame: {"i", "t", "visible": {id: pixels}, "in_range": {...}}
     gt/instances/*.png    uint16 per-pixel ids, named like the rgb image, every 5th frame
 
@@ -70,7 +70,6 @@ def _instance(d: dict[str, Any]) -> TruthInstance:
     class_name = str(d["class"])
     static = bool(d.get("static", True))
     layer = "background" if class_name in _BACKGROUND_CLASSES else str(d.get("layer", "foreground"))
-    first, last = d.get("first_seen_t"), d.get("last_seen_t")
     box = Box3D((lo + hi) / 2.0, hi - lo)
     body = _triple(d.get("body_size"))
     if body is not None and d.get("trajectory"):
@@ -87,7 +86,6 @@ def _instance(d: dict[str, Any]) -> TruthInstance:
         speed_mps=float(d["speed_mps"]) if d.get("speed_mps") is not None else None,
         alt_classes=tuple(str(c) for c in d.get("alt_classes", ())),
         observed=bool(d.get("observed", True)),
-        seen_s=(float(first), float(last)) if first is not None and last is not None else None,
     )
 
 
