@@ -359,6 +359,10 @@ class TrackerConfig(_Part):
     """A blob named by a walker class whose lowest point lies more than this above the floor
     (the lowest floor instance's top; the map's z = 0 before one) is no walker: it stays
     ``unknown`` (0: off). People stand on the floor; behind a counter they still show below."""
+    walker_from_floor: bool = True
+    """An observation a detection names a walker class spans from the floor to its blob's top
+    (the centre halfway): people stand on the floor, and a person behind a shelf or a table
+    shows only the upper body (issue 17: person centres 0.5-0.8 m off in height)."""
     walker_level: bool = True
     """Tracks of a walker class (or, before a track has a class, observations of one) have no
     vertical velocity: people walk on the floor, so their height is the filtered mean of the
@@ -370,6 +374,24 @@ class TrackerConfig(_Part):
     sliver of a door frame must not take the person walking past it half a metre away, and
     turn its standing rows into the person's (0: off) ..."""
     settled_overlap_m: float = 0.05
+    stitch: bool = True
+    """A newly confirmed track that is an object already tracked joins that track's instance
+    (``stitch.py``): a walker picked up again, a second blob of one walker, a static object seen
+    again or a part of one ..."""
+    stitch_max_gap_s: float = 3.0
+    """... a walker's new track starting at most this long after the old one's last update ..."""
+    stitch_speed_mps: float = 1.5
+    stitch_margin_m: float = 0.5
+    """... within ``stitch_margin_m`` plus this speed times the gap of its last position ..."""
+    stitch_appearance_gap_s: float = 60.0
+    stitch_min_similarity: float = 0.8
+    """... or after a longer gap, up to ``stitch_appearance_gap_s``, with colour histograms
+    (Bhattacharyya coefficient) at least this similar: one person's tracks 0.92-1.0 and two
+    people's 0.46-0.55 on the realistic worlds ..."""
+    stitch_duplicate_m: float = 0.4
+    """... or, tracked at the same time, within this of it (median, horizontal) ..."""
+    stitch_overlap_m: float = 0.1
+    """... and a static track's centre in the other's box grown by this."""
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
@@ -396,6 +418,8 @@ class TrackerConfig(_Part):
         if self.confirm_hits < 1:
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
+        _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
+                            "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m"))
 
 
 def _own(cls: type, base: type | None) -> frozenset[str]:

@@ -25,6 +25,7 @@ from hiper_cli.learned import (
 )
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
@@ -176,6 +177,21 @@ class ForegroundStage:
             return True
         return float(blob.bounds_map[0][2]) - self._floor_z_m <= cfg.walker_max_base_m
 
+    def _standing_box(self, blob: Blob) -> tuple[FloatArray, FloatArray] | None:
+        """The blob's box if it were a walker (``walker_from_floor``): from the floor to the
+        blob's top. A person seen over a shelf or a table shows only the upper body, whose
+        centre lies far above the person's; people stand on the floor."""
+        if not self.config.walker_from_floor:
+            return None
+        top = float(blob.bounds_map[1][2])
+        if top <= self._floor_z_m:
+            return None
+        center = blob.center_map_m.copy()
+        extent = blob.extent_map_m.copy()
+        center[2] = (self._floor_z_m + top) / 2.0
+        extent[2] = top - self._floor_z_m
+        return center, extent
+
     # --- the stage --------------------------------------------------------------------------
     def _detect_timed(self, frame: Frame) -> tuple[Detections, float]:
         t0 = time.perf_counter()
@@ -260,11 +276,15 @@ class ForegroundStage:
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
+            walker = match.class_name in cfg.walker_classes
+            standing = self._standing_box(blob) if walker else None
             observations.append(obs)
             measurements.append(
                 Measurement(
                     blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
                     whole=match.detection_index is not None or seen_whole(blob, cfg, frame.camera),
+                    appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
+                    standing=standing,
                 )
             )
         t_match = time.perf_counter()
@@ -274,6 +294,8 @@ class ForegroundStage:
             if track_uuid in confirmed:
                 obs.instance_uuid = track_uuid
         instances = [self._instance(t) for t in changed]
+        # a track stitched into another after it became an instance: merged away
+        merged = [u for u in self.tracker.absorbed if self._instances.pop(u, None) is not None]
         t_end = time.perf_counter()
         timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}
         timings.update(
@@ -289,7 +311,8 @@ class ForegroundStage:
                 "foreground_points_after_background": float(seg.after_background),
             }
         )
-        return FrameResult(observations=observations, instances=instances, timings_s=timings)
+        return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
+                           timings_s=timings)
 
     def finish(self, world: World) -> FrameResult:
         closed = self.tracker.close_all()

@@ -32,6 +32,9 @@
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
   after ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``) → closed after
   ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
+- Stitching (``stitch``): a newly confirmed (or newly named) track that continues a known one (a walker picked
+  up again, a second blob of it, a static object seen again) is absorbed by it (``stitch.py``);
+  closed confirmed tracks wait for that: static ones for good, walkers ``stitch_max_gap_s``.
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, ne
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
+from hiper_cli.perceive.foreground.stitch import DUPLICATE, absorb, find_target, gap_ok, provisional_class
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
 
@@ -76,6 +80,15 @@ class Measurement:
     observation_uuid: str
     whole: bool = True
     """Seen whole: inside the image, compact and solid (``unknown_confirm_whole``)."""
+    appearance: FloatArray | None = None
+    """Colour histogram of the blob (``appearance.histogram``), None when not computed."""
+    standing: tuple[FloatArray, FloatArray] | None = None
+    """(centre, extent) of the blob as a walker's box, from the floor to its top
+    (``walker_from_floor``): what a walking track takes instead of the blob's own box."""
+
+    def for_walker(self) -> tuple[FloatArray, FloatArray]:
+        """The (centre, extent) a walking track takes."""
+        return self.standing if self.standing is not None else (self.center_map_m, self.extent_map_m)
 
 
 @dataclass(frozen=True)
@@ -102,6 +115,9 @@ class Track:
     unseen_in_view_s: float = 0.0
     confirmed: bool = False
     closed: bool = False
+    # summed colour histograms of the observations a detection named a walker (``stitch``)
+    appearance: FloatArray | None = None
+    stitch_class: str | None = None  # the class it had when last offered to ``find_target``
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -254,6 +270,8 @@ class Tracker:
         self._assign = get_association(config.association)
         self.priors = priors or (lambda _name: ClassPrior())
         self.tracks: list[Track] = []  # live (tentative or confirmed)
+        self.dormant: list[Track] = []  # closed confirmed tracks a new one may continue
+        self.absorbed: list[str] = []  # uuids of the tracks stitched into others this step
         self.last_stamp_s: float | None = None
         self._frame_dt_s = 0.0
 
@@ -323,28 +341,30 @@ class Tracker:
 
     def _update(self, track: Track, m: Measurement, stamp_s: float) -> None:
         motion = track.motion
+        walks = self._walks(track, m)
+        center, extent = m.for_walker() if walks else (m.center_map_m, m.extent_map_m)
         if not track.velocity_initialised and track.hits == 1:
             dt = stamp_s - track.last_update_s
             if dt > MIN_VELOCITY_INIT_DT_S:
                 # Two-point initialisation: v = (z2 - z1) / dt with its own covariance.
-                v = (m.center_map_m - track.first_center) / dt
+                v = (center - track.first_center) / dt
                 r = self.config.measurement_noise_m**2
                 var_v = 2.0 * r / dt**2 + (self._accel_noise(m.class_name) * dt) ** 2
-                motion.reset(np.r_[m.center_map_m, v], np.diag([r, r, r, var_v, var_v, var_v]))
+                motion.reset(np.r_[center, v], np.diag([r, r, r, var_v, var_v, var_v]))
                 track.velocity_initialised = True
                 if track.trajectory:  # the first row gets the velocity it could not know yet
                     track.trajectory[0][ROW_VELOCITY] = v.tolist()
                     track.covariances[0] = np.array(motion.P, dtype=np.float64)
             else:
-                motion.update(m.center_map_m)
+                motion.update(center)
         else:
-            motion.update(m.center_map_m)
-        if self._walks(track, m):
+            motion.update(center)
+        if walks:
             self._hold_level(motion)
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
-        track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * m.extent_map_m
+        track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
         self._vote(track, m)
         if not track.confirmed and self._evidence_enough(track):
             track.confirmed = True
@@ -379,6 +399,8 @@ class Tracker:
             track.whole_stamps_s.append(track.last_update_s)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
         track.observation_uuids.append(m.observation_uuid)
+        if m.appearance is not None and m.class_name in self.config.walker_classes:
+            track.appearance = m.appearance if track.appearance is None else track.appearance + m.appearance
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
         q = self._accel_noise(track.class_name) ** 2
         track.covariances.append(np.array(track.motion.P, dtype=np.float64))
@@ -419,6 +441,10 @@ class Tracker:
         pred = np.array([t.position for t in self.tracks])
         obs = np.array([m.center_map_m for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
+        walking = np.array([self._walks(t) for t in self.tracks])
+        if walking.any():  # a walker's distance to a blob's box as a walker's
+            obs_walker = np.array([m.for_walker()[0] for m in measurements])
+            cost[walking] = np.linalg.norm(pred[walking][:, None, :] - obs_walker[None, :, :], axis=2)
         # The filters' own uncertainty, all tracks in one eigenvalue call.
         P = np.array([t.motion.P[:3, :3] for t in self.tracks])
         variances = np.linalg.eigvalsh(P).max(axis=1)
@@ -497,12 +523,61 @@ class Tracker:
                     track.closed = True
                     if track.confirmed:
                         self._close(track)
+                        self._retire(track)
                         changed.append(track)
         self.tracks = [t for t in self.tracks if not t.closed]
         for j, m in enumerate(measurements):
             if joined[j] is None:
                 self.tracks.append(self._birth(m, stamp_s))
+        aliases = self._stitch(stamp_s) if self.config.stitch else {}
+        if aliases:
+            joined = [aliases[u].uuid if u in aliases else u for u in joined]
+            changed = [aliases.get(t.uuid, t) for t in changed]
+            changed.extend(aliases.values())
+            changed = list({id(t): t for t in changed}.values())
         return changed, joined
+
+    def _stitch(self, stamp_s: float) -> dict[str, Track]:
+        """Offer each newly confirmed track, and one whose (provisional) class changed, to
+        ``stitch.find_target``; absorbed ones leave the live tracks (a revived closed one takes
+        their place) and are listed in ``absorbed``. Returns new uuid -> target."""
+        self.absorbed = []
+        fresh = [t for t in self.tracks if t.confirmed and provisional_class(t) != t.stitch_class]
+        if not fresh:
+            return {}
+        self.dormant = [t for t in self.dormant if gap_ok(t, stamp_s, self.config)]
+        aliases: dict[str, Track] = {}
+        for new in fresh:
+            new.stitch_class = provisional_class(new)
+            live = [t for t in self.tracks if t.uuid not in aliases]
+            found = find_target(new, [*live, *self.dormant], self.config, self._moving)
+            if found is None:
+                continue
+            old, kind = found
+            absorb(old, new, kind)
+            self.absorbed.append(new.uuid)
+            aliases[new.uuid] = old
+            for uuid, target in aliases.items():  # a track absorbed earlier into ``new``
+                if target is new:
+                    aliases[uuid] = old
+            index = self.tracks.index(new)
+            if kind != DUPLICATE and old in self.dormant:
+                self.dormant.remove(old)
+                self.tracks[index] = old
+            else:
+                del self.tracks[index]
+        return aliases
+
+    def _moving(self, track: Track) -> bool:
+        return _was_moving(track, self.config)
+
+    def _retire(self, track: Track) -> None:
+        """Keep a closed confirmed track for stitching: a static one (it stays where it is) or
+        a walker (for ``stitch_max_gap_s``)."""
+        if not self.config.stitch:
+            return
+        if track.class_name in self.config.walker_classes or not _was_moving(track, self.config):
+            self.dormant.append(track)
 
     def _close(self, track: Track) -> None:
         if self.config.smooth_closed_tracks:
@@ -510,15 +585,16 @@ class Tracker:
         track.covariances, track.noises = [], []
 
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
+        walks = self.config.walker_level and m.class_name in self.config.walker_classes
+        center, extent = m.for_walker() if walks else (m.center_map_m, m.extent_map_m)
         track = Track(
             uuid=new_uuid(),
-            motion=make_motion_model(self.config.motion_model, m.center_map_m,
-                                     self.config.measurement_noise_m),
+            motion=make_motion_model(self.config.motion_model, center, self.config.measurement_noise_m),
             first_seen_s=stamp_s,
             last_update_s=stamp_s,
             last_time_s=stamp_s,
-            extent_m=np.asarray(m.extent_map_m, dtype=np.float64).copy(),
-            first_center=np.asarray(m.center_map_m, dtype=np.float64).copy(),
+            extent_m=np.asarray(extent, dtype=np.float64).copy(),
+            first_center=np.asarray(center, dtype=np.float64).copy(),
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
         )
@@ -535,4 +611,5 @@ class Tracker:
                 self._close(t)
                 out.append(t)
         self.tracks = []
+        self.dormant = []
         return out

@@ -1,0 +1,193 @@
+"""Stitching: a newly confirmed track that is an object the tracker already knows joins it.
+
+The frame-to-frame association misses in three ways that leave one object as several instances:
+
+- **resume**: a walker's track closed or lost it (an occluder, a turn, the image border, a blob
+  too small for ``walker_min_size_ratio``) and a new track picked the walker up; the new track
+  starts where the old one, walking at most ``stitch_speed_mps``, could be after the gap
+  (at most ``stitch_max_gap_s``) from any of its rows of that long before; lost for longer (at
+  most ``stitch_appearance_gap_s``), the walker's clothes tell: the colour histograms of the
+  two tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
+- **duplicate**: two blobs of one walker (the head above a shelf, the legs below it) fed two
+  tracks at once; the new one stays within ``stitch_duplicate_m`` of the old one at the stamps
+  both were updated;
+- **revisit**: a static object (a chair, a shelf's junk) seen again after its track closed, or
+  a part of it (a chair's back) tracked beside the whole: the new track's centre lies in the old
+  track's box grown by ``stitch_overlap_m``, or the old one's in the new one's.
+
+The old track absorbs the new one (``absorb``): its observations, trajectory rows and votes,
+so the instance keeps its uuid and the knowledge base one instance per object.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from hiper_cli.model import ROW_POSITION, ROW_STAMP
+from hiper_cli.perceive.foreground.appearance import similarity
+
+if TYPE_CHECKING:
+    from hiper_cli.perceive.foreground.config import TrackerConfig
+    from hiper_cli.perceive.foreground.tracking import Track
+
+__all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "find_target", "gap_ok",
+           "provisional_class"]
+
+RESUME, DUPLICATE, REVISIT = "resume", "duplicate", "revisit"
+UNKNOWN = "unknown"
+STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
+MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at 30 Hz)
+
+
+def find_target(
+    new: Track, candidates: Iterable[Track], config: TrackerConfig, moving: Callable[[Track], bool]
+) -> tuple[Track, str] | None:
+    """The older confirmed track ``new`` continues, and how (``RESUME``, ``DUPLICATE``,
+    ``REVISIT``), or None. ``moving(track)``: whether it was moving when last updated."""
+    walkers = config.walker_classes
+    name = provisional_class(new)
+    best: tuple[float, Track, str] | None = None
+    for old in candidates:
+        if old is new or not old.confirmed or old.first_seen_s > new.first_seen_s:
+            continue
+        old_name = provisional_class(old)
+        if name in walkers and old_name == name:
+            found = _walker_match(new, old, config)
+        elif (
+            name not in walkers and old_name not in walkers
+            and not moving(new) and not moving(old)
+            and (name == old_name or UNKNOWN in (name, old_name))
+        ):
+            found = _static_match(new, old, config)
+        else:
+            found = None
+        if found is not None and (best is None or found[0] < best[0]):
+            best = (found[0], old, found[1])
+    return None if best is None else (best[1], best[2])
+
+
+def provisional_class(track: Track) -> str:
+    """The track's class, or while it has none (fewer than ``min_class_observations``
+    detections) the known class detections named most: a person's new track is ``unknown``
+    for its first observations, and must be stitched before it becomes an instance."""
+    name = track.class_name
+    if name != UNKNOWN:
+        return name
+    known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
+    return max(sorted(known), key=lambda k: known[k]) if known else UNKNOWN
+
+
+def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float, str] | None:
+    """(score, kind): lower scores are better matches."""
+    if new.first_seen_s >= old.last_update_s - STAMP_MATCH_S:
+        # Any of the old track's rows of the last stitch_max_gap_s may be where the walker
+        # was last: a lost track's last rows are often junk blobs it took while searching.
+        rows = np.asarray(old.trajectory[-MAX_RESUME_ROWS:], dtype=np.float64)
+        gap_s = new.first_seen_s - rows[:, ROW_STAMP]
+        start = np.asarray(new.trajectory[0][ROW_POSITION][:2])
+        dist = np.hypot(*(rows[:, 1:3] - start).T)
+        reach = config.stitch_margin_m + config.stitch_speed_mps * np.maximum(gap_s, 0.0)
+        near = gap_s <= config.stitch_max_gap_s
+        if near.any() and (ratio := float((dist[near] / reach[near]).min())) <= 1.0:
+            return ratio, RESUME
+        # Lost for longer: the same clothes, and reachable walking from where it was.
+        similar = _similarity(new, old)
+        if (
+            similar >= config.stitch_min_similarity
+            and gap_s[-1] <= config.stitch_appearance_gap_s
+            and bool(np.any(dist <= reach))
+        ):
+            return 1.0 + (1.0 - similar), RESUME
+        return None
+    dist = _common_distance_m(new, old, config.confirm_hits)
+    if dist is not None and dist <= config.stitch_duplicate_m:
+        return dist / config.stitch_duplicate_m, DUPLICATE
+    return None
+
+
+def _similarity(new: Track, old: Track) -> float:
+    if new.appearance is None or old.appearance is None:
+        return 0.0
+    return similarity(new.appearance, old.appearance)
+
+
+def _common_distance_m(new: Track, old: Track, min_common: int) -> float | None:
+    """Median horizontal distance of the two tracks at the stamps both were updated, when
+    there are at least ``min_common`` of them (None otherwise)."""
+    a = np.asarray(new.trajectory, dtype=np.float64)
+    b = np.asarray(old.trajectory, dtype=np.float64)
+    if len(a) == 0 or len(b) == 0:
+        return None
+    idx = np.clip(np.searchsorted(b[:, ROW_STAMP], a[:, ROW_STAMP]), 0, len(b) - 1)
+    same = np.abs(b[idx, ROW_STAMP] - a[:, ROW_STAMP]) <= STAMP_MATCH_S
+    if int(same.sum()) < min_common:
+        return None
+    xy_a, xy_b = a[same][:, 1:3], b[idx[same]][:, 1:3]
+    return float(np.median(np.hypot(*(xy_a - xy_b).T)))
+
+
+def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float, str] | None:
+    grow = config.stitch_overlap_m
+    d = np.abs(new.position - old.position)
+    inside_old = bool(np.all(d <= old.extent_m / 2.0 + grow))
+    inside_new = bool(np.all(d <= new.extent_m / 2.0 + grow))
+    if not (inside_old or inside_new):
+        return None
+    return float(np.linalg.norm(d)), REVISIT
+
+
+def absorb(old: Track, new: Track, kind: str) -> None:
+    """Fold ``new`` into ``old`` (in place; ``old``'s lists only grow, the knowledge base links
+    an instance's observations by appending). ``DUPLICATE``: only the observations and votes;
+    the old track's own rows already describe the walker. Otherwise the old track goes on as
+    the live one: the new rows follow, the motion state is the new track's (a revisited static
+    object: at the hit-weighted mean of both positions)."""
+    old.observation_uuids.extend(new.observation_uuids)
+    for cls, votes in new.class_votes.items():
+        old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
+    for cls, count in new.class_counts.items():
+        old.class_counts[cls] = old.class_counts.get(cls, 0) + count
+    old.score_sum += new.score_sum
+    old._class_name = None
+    if new.appearance is not None:
+        old.appearance = new.appearance if old.appearance is None else old.appearance + new.appearance
+    if kind == DUPLICATE:
+        old.hits += new.hits
+        return
+    rows_before = len(old.trajectory)
+    old.trajectory.extend(new.trajectory)
+    if len(old.covariances) == rows_before and len(new.covariances) == len(new.trajectory):
+        old.covariances.extend(new.covariances)
+        old.noises.extend(new.noises)
+    else:  # a closed track's were dropped: no smoothing across the stitch
+        old.covariances.clear()
+        old.noises.clear()
+    if kind == REVISIT:
+        centre = (old.hits * old.position + new.hits * new.position) / (old.hits + new.hits)
+        x = np.array(new.motion.x, dtype=np.float64)
+        x[:3] = centre
+        new.motion.reset(x, np.array(new.motion.P, dtype=np.float64))
+    old.extent_m = new.extent_m
+    old.motion = new.motion
+    old.hits += new.hits
+    old.whole_stamps_s.extend(new.whole_stamps_s)
+    old.max_size_m = max(old.max_size_m, new.max_size_m)
+    old.last_update_s = new.last_update_s
+    old.last_time_s = new.last_time_s
+    old.unseen_in_view_s = 0.0
+    old.velocity_initialised = new.velocity_initialised or old.velocity_initialised
+    old.closed = False
+    old._moving = None
+
+
+def gap_ok(old: Track, now_s: float, config: TrackerConfig) -> bool:
+    """Whether a closed track may still be stitched at ``now_s``: a static one always (it is
+    where it was), a walker within ``stitch_appearance_gap_s``."""
+    if old.class_name not in config.walker_classes:
+        return True
+    longest = max(config.stitch_max_gap_s, config.stitch_appearance_gap_s)
+    return now_s - old.last_update_s <= longest + math.ulp(now_s)

@@ -1,0 +1,132 @@
+"""Stitching (``stitch.py``): one object stays one instance when the frame-to-frame association
+lets it go: a walker picked up again (by position after a short gap, by the colours of the
+clothes after a long one), a second blob of a walker, a static object seen again."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.perceive.foreground.appearance import HISTOGRAM_BINS, histogram, similarity
+from hiper_cli.perceive.foreground.config import TrackerConfig
+from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
+
+RATE_HZ = 15.0
+PERSON = np.array([0.5, 0.4, 1.7])
+CHAIR = np.array([0.45, 0.45, 0.9])
+
+
+def _colours(hot_bin):
+    h = np.full(HISTOGRAM_BINS, 0.01)
+    h[hot_bin] = 1.0
+    return h / h.sum()
+
+
+class _Run:
+    """A tracker fed frame by frame; collects the uuids of the instances it reports."""
+
+    def __init__(self, **config):
+        self.tracker = Tracker(TrackerConfig(**config))
+        self.seen: set[str] = set()  # uuids of the instances the tracker reported
+        self.t_s = 0.0
+        self.k = 0
+
+    def frame(self, blobs):
+        measurements = []
+        for centre, extent, cls, colours in blobs:
+            self.k += 1
+            measurements.append(Measurement(np.asarray(centre, float), extent, cls, 0.9, f"o{self.k}",
+                                            appearance=colours))
+        changed, _ = self.tracker.step(self.t_s, measurements)
+        self.seen.update(t.uuid for t in changed)
+        self.seen -= set(self.tracker.absorbed)
+        self.t_s += 1.0 / RATE_HZ
+
+    def idle(self, seconds):
+        for _ in range(int(seconds * RATE_HZ)):
+            self.frame([])
+
+    def walk(self, start, velocity, seconds, colours=None, cls="person"):
+        start, velocity = np.asarray(start, float), np.asarray(velocity, float)
+        t0 = self.t_s
+        for _ in range(int(seconds * RATE_HZ)):
+            self.frame([(start + velocity * (self.t_s - t0), PERSON, cls, colours)])
+        return start + velocity * (self.t_s - t0)
+
+    def uuids(self):
+        return self.seen
+
+
+def test_a_walker_picked_up_again_after_a_short_gap_is_one_instance():
+    run = _Run()
+    end = run.walk([0, 0, 0.85], [0.6, 0, 0], 3.0)
+    run.idle(2.0)  # behind a shelf for 2 s: the track closes after max_age_s
+    run.walk(end + np.array([1.2, 0, 0.0]), [0.6, 0, 0], 3.0)
+    assert len(run.uuids()) == 1
+    track = run.tracker.tracks[0]
+    assert track.hits == 90
+    rows = np.array(track.trajectory)
+    assert np.all(np.diff(rows[:, 0]) > 0)
+
+
+def test_the_switch_and_a_walker_too_far_away_keep_two():
+    run = _Run(stitch=False)
+    end = run.walk([0, 0, 0.85], [0.6, 0, 0], 3.0)
+    run.idle(2.0)
+    run.walk(end + np.array([1.2, 0, 0.0]), [0.6, 0, 0], 3.0)
+    assert len(run.uuids()) == 2
+    run = _Run()
+    end = run.walk([0, 0, 0.85], [0.6, 0, 0], 3.0)
+    run.idle(2.0)
+    run.walk(end + np.array([0, 6.0, 0.0]), [0.6, 0, 0], 3.0)  # 6 m in 2 s (or 3 s from before): no walk
+    assert len(run.uuids()) == 2
+
+
+@pytest.mark.parametrize(("colours_after", "instances"), [(0, 1), (20, 2)])
+def test_after_a_long_gap_the_clothes_tell(colours_after, instances):
+    run = _Run()
+    end = run.walk([0, 0, 0.85], [0.6, 0, 0], 3.0, colours=_colours(0))
+    run.idle(10.0)  # out of view while the robot toured
+    run.walk(end + np.array([-2.0, 1.0, 0.0]), [-0.6, 0, 0], 3.0, colours=_colours(colours_after))
+    assert len(run.uuids()) == instances
+
+
+def test_two_blobs_of_one_walker_are_one_instance():
+    run = _Run()
+    for k in range(45):
+        x = 0.6 * k / RATE_HZ
+        legs = ([x, 0.0, 0.4], np.array([0.4, 0.3, 0.8]), "person", None)
+        head = ([x + 0.1, 0.05, 1.5], np.array([0.3, 0.3, 0.4]), "person", None)
+        run.frame([legs, head] if k >= 5 else [legs])
+    assert len(run.uuids()) == 1
+    track = run.tracker.tracks[0]
+    # every observation links to it but the head's last few, of a track not yet confirmed
+    assert 45 + 40 - 3 <= len(track.observation_uuids) < 45 + 40
+
+
+def test_a_chair_seen_again_keeps_its_instance_and_its_neighbour_its_own():
+    run = _Run()
+    chair = ([2.0, 1.0, 0.45], CHAIR, "chair", None)
+    for _ in range(30):
+        run.frame([chair])
+    run.idle(5.0)  # the robot looks elsewhere; the chair's track closes
+    assert not run.tracker.tracks and len(run.tracker.dormant) == 1
+    back = ([2.05, 1.02, 0.4], np.array([0.45, 0.3, 0.5]), "chair", None)  # partly hidden now
+    neighbour = ([2.8, 1.0, 0.45], CHAIR, "chair", None)
+    for _ in range(30):
+        run.frame([back, neighbour])
+    assert len(run.uuids()) == 2
+    revisited = min(run.tracker.tracks, key=lambda t: t.first_seen_s)
+    assert revisited.hits == 60
+    assert np.allclose(revisited.position[:2], [2.03, 1.01], atol=0.03)
+
+
+def test_histograms_tell_colours_not_brightness():
+    rng = np.random.default_rng(0)
+    uv = np.stack(np.meshgrid(np.arange(20), np.arange(20)), axis=-1).reshape(-1, 2).astype(np.int32)
+    red = np.zeros((20, 20, 3), np.uint8)
+    red[..., 0] = rng.integers(150, 255, (20, 20))
+    dark_red = (red * 0.6).astype(np.uint8)
+    blue = red[..., ::-1].copy()
+    h_red, h_dark, h_blue = (histogram(img, uv) for img in (red, dark_red, blue))
+    assert similarity(h_red, h_dark) > 0.9
+    assert similarity(h_red, h_blue) < 0.2
+    assert histogram(red, uv[:5]) is None
