@@ -379,10 +379,10 @@ class TrackerConfig(_Part):
     (``stitch.py``): a walker picked up again, a second blob of one walker, a static object seen
     again or a part of one ..."""
     stitch_max_gap_s: float = 3.0
-    """... a walker's new track starting at most this long after the old one's last update ..."""
+    """... a walker's new track starting at most this long after one of the old one's rows ..."""
     stitch_speed_mps: float = 1.5
     stitch_margin_m: float = 0.5
-    """... within ``stitch_margin_m`` plus this speed times the gap of its last position ..."""
+    """... within ``stitch_margin_m`` plus this speed times the gap of that row's position ..."""
     stitch_appearance_gap_s: float = 60.0
     stitch_min_similarity: float = 0.8
     """... or after a longer gap, up to ``stitch_appearance_gap_s``, with colour histograms

@@ -21,7 +21,6 @@ so the instance keeps its uuid and the knowledge base one instance per object.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -189,5 +188,4 @@ def gap_ok(old: Track, now_s: float, config: TrackerConfig) -> bool:
     where it was), a walker within ``stitch_appearance_gap_s``."""
     if old.class_name not in config.walker_classes:
         return True
-    longest = max(config.stitch_max_gap_s, config.stitch_appearance_gap_s)
-    return now_s - old.last_update_s <= longest + math.ulp(now_s)
+    return now_s - old.last_update_s <= max(config.stitch_max_gap_s, config.stitch_appearance_gap_s)

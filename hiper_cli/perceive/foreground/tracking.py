@@ -32,9 +32,10 @@
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
   after ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``) → closed after
   ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
-- Stitching (``stitch``): a newly confirmed (or newly named) track that continues a known one (a walker picked
-  up again, a second blob of it, a static object seen again) is absorbed by it (``stitch.py``);
-  closed confirmed tracks wait for that: static ones for good, walkers ``stitch_max_gap_s``.
+- Stitching (``stitch``): a newly confirmed (or newly named) track that continues a known one
+  (a walker picked up again, a second blob of it, a static object seen again) is absorbed by it
+  (``stitch.py``); closed confirmed tracks wait for that: static ones for good, walkers
+  ``stitch_appearance_gap_s``.
 """
 
 from __future__ import annotations
@@ -117,7 +118,7 @@ class Track:
     closed: bool = False
     # summed colour histograms of the observations a detection named a walker (``stitch``)
     appearance: FloatArray | None = None
-    stitch_class: str | None = None  # the class it had when last offered to ``find_target``
+    stitch_class: str | None = None  # its ``provisional_class`` when last offered to ``find_target``
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -550,7 +551,8 @@ class Tracker:
         for new in fresh:
             new.stitch_class = provisional_class(new)
             live = [t for t in self.tracks if t.uuid not in aliases]
-            found = find_target(new, [*live, *self.dormant], self.config, self._moving)
+            found = find_target(new, [*live, *self.dormant], self.config,
+                                lambda t: _was_moving(t, self.config))
             if found is None:
                 continue
             old, kind = found
@@ -568,12 +570,9 @@ class Tracker:
                 del self.tracks[index]
         return aliases
 
-    def _moving(self, track: Track) -> bool:
-        return _was_moving(track, self.config)
-
     def _retire(self, track: Track) -> None:
         """Keep a closed confirmed track for stitching: a static one (it stays where it is) or
-        a walker (for ``stitch_max_gap_s``)."""
+        a walker (``stitch.gap_ok`` drops it later)."""
         if not self.config.stitch:
             return
         if track.class_name in self.config.walker_classes or not _was_moving(track, self.config):
