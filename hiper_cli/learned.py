@@ -1,5 +1,5 @@
 """The typed contract of learned features: what an ``Analysis`` of kind ``ods``, ``size`` or
-``altitude`` holds, and the one mean-speed function.
+``altitude`` holds, and the speed of a trajectory.
 
 ``hiper_cli.analyze`` computes these features from the knowledge base and stores them as
 analyses; the foreground stage (``hiper_cli.perceive``) reads them back as class priors. The
@@ -30,6 +30,7 @@ __all__ = [
     "SizeFeature",
     "feature_from_analysis",
     "path_speed_mps",
+    "typical_speed_mps",
 ]
 
 KIND_ODS = "ods"
@@ -170,4 +171,20 @@ def path_speed_mps(rows: Sequence[Sequence[Any]] | np.ndarray) -> float | None:
     if not duration_s > 0:
         return None
     speed = length_m / duration_s
+    return speed if math.isfinite(speed) else None
+
+
+def typical_speed_mps(rows: Sequence[Sequence[Any]] | np.ndarray) -> float | None:
+    """An instance's speed: the median of its rows' filtered speeds |v| (rows [stamp_s, x, y, z,
+    vx, vy, vz]), or ``path_speed_mps`` for rows without velocities (or all of them 0). The median reads a walker's
+    pace: a constant-velocity filter slows down at each reversal and cuts the end of the path
+    (the path speed of people walking back and forth read 5-10 % low), and a static object's
+    jitter stays near 0. None for no rows or rows that are not numbers."""
+    try:
+        arr = np.asarray([r[:7] for r in rows], dtype=np.float64)
+    except (TypeError, ValueError, IndexError):
+        return path_speed_mps(rows)
+    if arr.ndim != 2 or arr.shape[0] < 2 or arr.shape[1] != 7 or not np.any(arr[:, 4:7]):
+        return path_speed_mps(rows)  # no velocities (all zero: rows of a stage that has none)
+    speed = float(np.median(np.linalg.norm(arr[:, 4:7], axis=1)))
     return speed if math.isfinite(speed) else None

@@ -130,3 +130,39 @@ def test_histograms_tell_colours_not_brightness():
     assert similarity(h_red, h_dark) > 0.9
     assert similarity(h_red, h_blue) < 0.2
     assert histogram(red, uv[:5]) is None
+
+
+def test_a_resume_drops_the_junk_a_lost_walker_took_while_it_searched():
+    from hiper_cli.perceive.foreground.stitch import stale_rows
+
+    config = TrackerConfig()
+    tracker = Tracker(config)
+    old = tracker._birth(Measurement(np.array([0.0, 0.0, 0.85]), PERSON, "person", 0.9, "a"), 0.0)
+    old.trajectory = [[k / RATE_HZ, 0.6 * k / RATE_HZ, 0.0, 0.85, 0.6, 0.0, 0.0] for k in range(30)]
+    walked = old.trajectory[-1][1]
+    # lost, it took five junk blobs 2.5 m to the side; the walker is picked up where it went on
+    old.trajectory += [[2.0 + k / RATE_HZ, walked, 2.5, 0.85, 0.0, 0.0, 0.0] for k in range(5)]
+    new = tracker._birth(Measurement(np.array([walked + 0.3, 0.0, 0.85]), PERSON, "person", 0.9, "b"), 2.4)
+    assert stale_rows(new, old, config) == 5
+    new_far = tracker._birth(Measurement(np.array([9.0, 9.0, 0.85]), PERSON, "person", 0.9, "c"), 2.4)
+    assert stale_rows(new_far, old, config) == 0  # within a walk of no row: nothing to cut
+
+
+def test_a_walker_stands_on_the_floor_whatever_part_of_it_a_blob_shows():
+    run = _Run()
+    tracker = run.tracker
+    for k in range(60):
+        x = np.array([0.6 * k / RATE_HZ, 0.0, 0.0])
+        if k % 3 == 2:  # legs under a table: a blob 0.8 m tall
+            box = (x + [0, 0, 0.4], np.array([0.4, 0.3, 0.8]))
+        else:
+            box = (x + [0, 0, 0.85], PERSON)
+        m = Measurement(box[0], box[1], "person", 0.9, f"o{k}", standing=box)
+        tracker.step(run.t_s, [m])
+        run.t_s += 1.0 / RATE_HZ
+    (track,) = tracker.tracks
+    assert track.position[2] == pytest.approx(0.85, abs=1e-6)
+    assert track.extent_m[2] == pytest.approx(1.7, abs=1e-6)
+    assert track.velocity[2] == 0.0
+    (closed,) = tracker.close_all()
+    assert [row[3] for row in closed.trajectory] == pytest.approx([0.85] * 60, abs=1e-6)

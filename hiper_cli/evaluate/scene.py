@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.evaluate.surfaces import SurfaceTruth
-from hiper_cli.learned import path_speed_mps
+from hiper_cli.learned import typical_speed_mps
 from hiper_cli.model import Instance
 from hiper_cli.perceive.logs.truth import Truth, TruthInstance
 
@@ -180,7 +180,7 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
     for pi, (tid, _) in matched.items():
         t = truth.instances[tid]
         if t.state == "dynamic" and t.speed_mps is not None:
-            speed = path_speed_mps(preds[pi].data.get("trajectory") or [])
+            speed = typical_speed_mps(preds[pi].data.get("trajectory") or [])
             if speed is not None:
                 speeds.append((speed, t.speed_mps))
     return {

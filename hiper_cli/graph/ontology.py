@@ -17,7 +17,7 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from hiper_cli.learned import path_speed_mps
+from hiper_cli.learned import typical_speed_mps
 
 __all__ = [
     "HIPER",
@@ -108,13 +108,13 @@ def _vec(values: Sequence[float]) -> ox.Literal:
 
 
 def speed_mps(doc: dict[str, Any]) -> float | None:
-    """Mean speed of an instance along its ``data.trajectory`` rows (``TRAJECTORY_COLUMNS``), if any
+    """Speed of an instance (``typical_speed_mps``) from its ``data.trajectory`` rows, if any
     (a document whose long trajectory is stored apart carries it as ``trajectory_speed_mps``)."""
     data = doc.get("data") or {}
     if "trajectory_speed_mps" in data and "trajectory" not in data:
         speed = data["trajectory_speed_mps"]
         return None if speed is None else float(speed)
-    return path_speed_mps(data.get("trajectory") or [])
+    return typical_speed_mps(data.get("trajectory") or [])
 
 
 def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[ox.Quad]:

@@ -18,7 +18,7 @@ from typing import Any
 
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.sqlite_guard import GuardedConnection
-from hiper_cli.learned import path_speed_mps
+from hiper_cli.learned import typical_speed_mps
 
 __all__ = ["CHUNK_ROWS", "INLINE_ROWS", "SCHEMA", "TrajectoryStore"]
 
@@ -49,7 +49,7 @@ class TrajectoryStore:
         assert isinstance(data, dict)
         kept = {k: v for k, v in data.items() if k != "trajectory"}
         kept["trajectory_rows"] = len(rows)
-        kept["trajectory_speed_mps"] = path_speed_mps(rows)
+        kept["trajectory_speed_mps"] = typical_speed_mps(rows)
         return {**doc, "data": kept}, rows
 
     def write(self, uuid: str, rows: list[Any] | None) -> None:

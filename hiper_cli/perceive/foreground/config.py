@@ -304,6 +304,8 @@ class TrackerConfig(_Part):
     """A tentative (unconfirmed) track without an update for this long is dropped."""
     lost_max_s: float = 20.0
     """A track unseen for this long is closed even while out of view."""
+    tentative_lost_max_s: float = 2.0
+    """A tentative track unseen for this long is dropped even while out of view."""
     search_speed_mps: float = 0.6
     """The gate of an unseen track that was moving widens by this much per second unseen ..."""
     max_gate_m: float = 3.0

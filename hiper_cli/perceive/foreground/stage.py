@@ -277,14 +277,13 @@ class ForegroundStage:
                 continue
             obs = self._observation(frame, blob, match, dets)
             walker = match.class_name in cfg.walker_classes
-            standing = self._standing_box(blob) if walker else None
             observations.append(obs)
             measurements.append(
                 Measurement(
                     blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
                     whole=match.detection_index is not None or seen_whole(blob, cfg, frame.camera),
                     appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
-                    standing=standing,
+                    standing=self._standing_box(blob),  # a walking track takes any blob as standing
                 )
             )
         t_match = time.perf_counter()

@@ -25,6 +25,7 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiper_cli.model import ROW_POSITION, ROW_STAMP
 from hiper_cli.perceive.foreground.appearance import similarity
@@ -34,11 +35,13 @@ if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.tracking import Track
 
 __all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "find_target", "gap_ok",
-           "provisional_class"]
+           "provisional_class", "stale_rows"]
 
+FloatArray = NDArray[np.float64]
 RESUME, DUPLICATE, REVISIT = "resume", "duplicate", "revisit"
 UNKNOWN = "unknown"
 STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
+INTERPOLATE_MAX_S = 0.5  # a track's position between two of its rows at most this far apart
 MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at 30 Hz)
 
 
@@ -85,11 +88,7 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     if new.first_seen_s >= old.last_update_s - STAMP_MATCH_S:
         # Any of the old track's rows of the last stitch_max_gap_s may be where the walker
         # was last: a lost track's last rows are often junk blobs it took while searching.
-        rows = np.asarray(old.trajectory[-MAX_RESUME_ROWS:], dtype=np.float64)
-        gap_s = new.first_seen_s - rows[:, ROW_STAMP]
-        start = np.asarray(new.trajectory[0][ROW_POSITION][:2])
-        dist = np.hypot(*(rows[:, 1:3] - start).T)
-        reach = config.stitch_margin_m + config.stitch_speed_mps * np.maximum(gap_s, 0.0)
+        gap_s, dist, reach, _ = _resume_geometry(new, old, config)
         near = gap_s <= config.stitch_max_gap_s
         if near.any() and (ratio := float((dist[near] / reach[near]).min())) <= 1.0:
             return ratio, RESUME
@@ -108,6 +107,30 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     return None
 
 
+def _resume_geometry(
+    new: Track, old: Track, config: TrackerConfig
+) -> tuple[FloatArray, FloatArray, FloatArray, int]:
+    """Over the old track's last ``MAX_RESUME_ROWS`` rows: the gap from each to the new track's
+    start, the distance to it, the reach of a walk over the gap (``stitch_margin_m`` +
+    ``stitch_speed_mps`` · gap), and the index of the first of those rows."""
+    first = max(len(old.trajectory) - MAX_RESUME_ROWS, 0)
+    rows = np.asarray(old.trajectory[first:], dtype=np.float64)
+    gap_s = new.first_seen_s - rows[:, ROW_STAMP]
+    start = np.asarray(new.trajectory[0][ROW_POSITION][:2])
+    dist = np.hypot(*(rows[:, 1:3] - start).T)
+    reach = config.stitch_margin_m + config.stitch_speed_mps * np.maximum(gap_s, 0.0)
+    return gap_s, dist, reach, first
+
+
+def stale_rows(new: Track, old: Track, config: TrackerConfig) -> int:
+    """How many of the old track's last rows a resume drops: those after the last one the new
+    track's start is within a walk of (junk the lost track took while it searched; kept, a
+    walker's path jumped metres there and back and its speed read 50 % high)."""
+    _, dist, reach, first = _resume_geometry(new, old, config)
+    hits = np.flatnonzero(dist <= reach)
+    return 0 if len(hits) == 0 else len(old.trajectory) - (first + int(hits[-1]) + 1)
+
+
 def _similarity(new: Track, old: Track) -> float:
     if new.appearance is None or old.appearance is None:
         return 0.0
@@ -115,18 +138,25 @@ def _similarity(new: Track, old: Track) -> float:
 
 
 def _common_distance_m(new: Track, old: Track, min_common: int) -> float | None:
-    """Median horizontal distance of the two tracks at the stamps both were updated, when
-    there are at least ``min_common`` of them (None otherwise)."""
+    """Median horizontal distance of the two tracks at the stamps of ``new``'s rows where the
+    old track was where its rows say (at a row of that stamp, or between two rows at most
+    ``INTERPOLATE_MAX_S`` apart: two tracks that took one walker in turns), when there are
+    at least ``min_common`` of them (None otherwise)."""
     a = np.asarray(new.trajectory, dtype=np.float64)
     b = np.asarray(old.trajectory, dtype=np.float64)
-    if len(a) == 0 or len(b) == 0:
+    if len(a) == 0 or len(b) < 2:
         return None
-    idx = np.clip(np.searchsorted(b[:, ROW_STAMP], a[:, ROW_STAMP]), 0, len(b) - 1)
-    same = np.abs(b[idx, ROW_STAMP] - a[:, ROW_STAMP]) <= STAMP_MATCH_S
-    if int(same.sum()) < min_common:
+    stamps = a[:, ROW_STAMP]
+    after = np.clip(np.searchsorted(b[:, ROW_STAMP], stamps), 1, len(b) - 1)
+    t0, t1 = b[after - 1, ROW_STAMP], b[after, ROW_STAMP]
+    same = np.abs(b[after, ROW_STAMP] - stamps) <= STAMP_MATCH_S
+    inside = (stamps >= t0) & (stamps <= t1) & (t1 - t0 <= INTERPOLATE_MAX_S)
+    use = same | inside
+    if int(use.sum()) < min_common:
         return None
-    xy_a, xy_b = a[same][:, 1:3], b[idx[same]][:, 1:3]
-    return float(np.median(np.hypot(*(xy_a - xy_b).T)))
+    w = np.clip((stamps - t0) / np.maximum(t1 - t0, STAMP_MATCH_S), 0.0, 1.0)[:, None]
+    xy_b = (1.0 - w) * b[after - 1, 1:3] + w * b[after, 1:3]
+    return float(np.median(np.hypot(*(a[use, 1:3] - xy_b[use]).T)))
 
 
 def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float, str] | None:
@@ -139,7 +169,7 @@ def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     return float(np.linalg.norm(d)), REVISIT
 
 
-def absorb(old: Track, new: Track, kind: str) -> None:
+def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     """Fold ``new`` into ``old`` (in place; ``old``'s lists only grow, the knowledge base links
     an instance's observations by appending). ``DUPLICATE``: only the observations and votes;
     the old track's own rows already describe the walker. Otherwise the old track goes on as
@@ -152,11 +182,17 @@ def absorb(old: Track, new: Track, kind: str) -> None:
         old.class_counts[cls] = old.class_counts.get(cls, 0) + count
     old.score_sum += new.score_sum
     old._class_name = None
+    old.standing_tops_m.extend(new.standing_tops_m)
+    old.floor_z_m = new.floor_z_m if new.floor_z_m is not None else old.floor_z_m
     if new.appearance is not None:
         old.appearance = new.appearance if old.appearance is None else old.appearance + new.appearance
     if kind == DUPLICATE:
         old.hits += new.hits
         return
+    if drop_rows > 0:  # ``stale_rows``
+        del old.trajectory[-drop_rows:]
+        del old.covariances[-drop_rows:]
+        del old.noises[-drop_rows:]
     rows_before = len(old.trajectory)
     old.trajectory.extend(new.trajectory)
     if len(old.covariances) == rows_before and len(new.covariances) == len(new.trajectory):

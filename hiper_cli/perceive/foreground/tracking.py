@@ -53,7 +53,9 @@ from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, ne
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
-from hiper_cli.perceive.foreground.stitch import DUPLICATE, absorb, find_target, gap_ok, provisional_class
+from hiper_cli.perceive.foreground.stitch import (
+    DUPLICATE, RESUME, absorb, find_target, gap_ok, provisional_class, stale_rows,
+)
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
 
@@ -68,6 +70,9 @@ EXTENT_GAIN = 0.2  # exponential smoothing of a track's box extent by each new o
 MIN_VELOCITY_INIT_DT_S = 1e-6  # two observations closer in time give no velocity
 MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
 WALKER_VZ_VAR = 1e-4  # (m/s)²: a walker's vertical velocity held at zero (``walker_level``)
+# A walker's height: this quantile of its blobs' tops above the floor. A high one, since blobs
+# of a person are often only a part (legs under a table, a body cut at the image's lower edge).
+WALKER_HEIGHT_QUANTILE = 0.8
 
 
 @dataclass(frozen=True)
@@ -118,7 +123,13 @@ class Track:
     closed: bool = False
     # summed colour histograms of the observations a detection named a walker (``stitch``)
     appearance: FloatArray | None = None
-    stitch_class: str | None = None  # its ``provisional_class`` when last offered to ``find_target``
+    # its ``provisional_class`` and hits when last offered to ``find_target``; a walker's is
+    # offered again each time its hits double (two tracks that take one walker in turns)
+    stitch_class: str | None = None
+    stitch_hits: int = 0
+    # a walker's standing boxes seen (``Measurement.standing``): tops and floor, map z
+    standing_tops_m: list[float] = field(default_factory=list)
+    floor_z_m: float | None = None
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -185,6 +196,24 @@ def _decay_terms(
     scale_P.setflags(write=False)
     relax.setflags(write=False)
     return factor, scale_P, relax
+
+
+def _record_standing(track: Track, m: Measurement) -> None:
+    if m.standing is None:
+        return
+    center, extent = m.standing
+    track.standing_tops_m.append(float(center[2] + extent[2] / 2.0))
+    track.floor_z_m = float(center[2] - extent[2] / 2.0)
+
+
+def standing_level(track: Track) -> tuple[float, float] | None:
+    """(centre z, height) of a walker standing on the floor: the height is the
+    ``WALKER_HEIGHT_QUANTILE`` of its blobs' tops; None before a standing box was seen."""
+    if not track.standing_tops_m or track.floor_z_m is None:
+        return None
+    top = float(np.quantile(track.standing_tops_m, WALKER_HEIGHT_QUANTILE))
+    height = top - track.floor_z_m
+    return track.floor_z_m + height / 2.0, height
 
 
 def smooth_trajectory(track: Track) -> None:
@@ -306,16 +335,24 @@ class Tracker:
     def _vertical_noise(self, track: Track, q: float) -> float:
         return 0.0 if self._walks(track) else q * self.config.vertical_noise_ratio**2
 
-    @staticmethod
-    def _hold_level(motion: MotionModel) -> None:
-        """No vertical velocity: people walk on the floor, so a walker's height is the filtered
-        mean of its observed centres, never extrapolated (a centre below the floor or metres
-        above it came from a vertical velocity a blob's growing or shrinking gave the filter)."""
+    def _hold_level(self, track: Track) -> None:
+        """No vertical velocity: people walk on the floor, so a walker's centre is half its
+        height above the floor (``standing_level``), never extrapolated (a centre below the floor
+        or metres above it came from a vertical velocity a blob's growing or shrinking gave the
+        filter, or from the mean of partial blobs: legs, an upper body)."""
+        motion = track.motion
         x, P = motion.x.copy(), np.array(motion.P, dtype=np.float64)
         x[5] = 0.0
         P[5, :] = 0.0
         P[:, 5] = 0.0
         P[5, 5] = WALKER_VZ_VAR
+        level = standing_level(track)
+        if level is not None:
+            x[2] = level[0]
+            P[2, :] = 0.0
+            P[:, 2] = 0.0
+            P[2, 2] = self.config.measurement_noise_m**2
+            track.extent_m[2] = level[1]
         motion.reset(x, P)
 
     def _decay(self, track: Track, dt: float, stamp_s: float) -> None:
@@ -360,12 +397,13 @@ class Tracker:
                 motion.update(center)
         else:
             motion.update(center)
-        if walks:
-            self._hold_level(motion)
         track.hits += 1
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
+        if walks:
+            _record_standing(track, m)
+            self._hold_level(track)
         self._vote(track, m)
         if not track.confirmed and self._evidence_enough(track):
             track.confirmed = True
@@ -519,8 +557,12 @@ class Tracker:
                 self._decay(track, dt_frame, stamp_s)
                 if in_view:
                     track.unseen_in_view_s += dt_frame
-                limit = self.config.max_age_s if track.confirmed else self.config.tentative_max_age_s
-                if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > self.config.lost_max_s:
+                cfg = self.config
+                limit, lost = (
+                    (cfg.max_age_s, cfg.lost_max_s) if track.confirmed
+                    else (cfg.tentative_max_age_s, cfg.tentative_lost_max_s)
+                )
+                if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > lost:
                     track.closed = True
                     if track.confirmed:
                         self._close(track)
@@ -539,24 +581,31 @@ class Tracker:
         return changed, joined
 
     def _stitch(self, stamp_s: float) -> dict[str, Track]:
-        """Offer each newly confirmed track, and one whose (provisional) class changed, to
-        ``stitch.find_target``; absorbed ones leave the live tracks (a revived closed one takes
+        """Offer each newly confirmed track, one whose (provisional) class changed and a walker
+        whose hits doubled to ``stitch.find_target``; absorbed ones leave the live tracks (a revived closed one takes
         their place) and are listed in ``absorbed``. Returns new uuid -> target."""
         self.absorbed = []
-        fresh = [t for t in self.tracks if t.confirmed and provisional_class(t) != t.stitch_class]
+        walkers = self.config.walker_classes
+        fresh = [
+            t for t in self.tracks
+            if t.confirmed and (
+                provisional_class(t) != t.stitch_class
+                or (t.stitch_class in walkers and t.hits >= 2 * t.stitch_hits)
+            )
+        ]
         if not fresh:
             return {}
         self.dormant = [t for t in self.dormant if gap_ok(t, stamp_s, self.config)]
         aliases: dict[str, Track] = {}
         for new in fresh:
-            new.stitch_class = provisional_class(new)
+            new.stitch_class, new.stitch_hits = provisional_class(new), new.hits
             live = [t for t in self.tracks if t.uuid not in aliases]
             found = find_target(new, [*live, *self.dormant], self.config,
                                 lambda t: _was_moving(t, self.config))
             if found is None:
                 continue
             old, kind = found
-            absorb(old, new, kind)
+            absorb(old, new, kind, stale_rows(new, old, self.config) if kind == RESUME else 0)
             self.absorbed.append(new.uuid)
             aliases[new.uuid] = old
             for uuid, target in aliases.items():  # a track absorbed earlier into ``new``
@@ -581,6 +630,10 @@ class Tracker:
     def _close(self, track: Track) -> None:
         if self.config.smooth_closed_tracks:
             smooth_trajectory(track)
+        level = standing_level(track)
+        if self.config.walker_level and track.class_name in self.config.walker_classes and level is not None:
+            for row in track.trajectory:  # a walker stood on the floor all along
+                row[3], row[6] = level[0], 0.0
         track.covariances, track.noises = [], []
 
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
@@ -597,6 +650,9 @@ class Tracker:
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
         )
+        if walks:
+            _record_standing(track, m)
+            self._hold_level(track)
         self._vote(track, m)
         track.confirmed = self._evidence_enough(track)
         return track
