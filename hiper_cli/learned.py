@@ -175,11 +175,11 @@ def path_speed_mps(rows: Sequence[Sequence[Any]] | np.ndarray) -> float | None:
 
 
 def typical_speed_mps(rows: Sequence[Sequence[Any]] | np.ndarray) -> float | None:
-    """An instance's speed: the median of its rows' filtered speeds |v| (rows [stamp_s, x, y, z,
-    vx, vy, vz]), or ``path_speed_mps`` for rows without velocities (or all of them 0). The median reads a walker's
-    pace: a constant-velocity filter slows down at each reversal and cuts the end of the path
-    (the path speed of people walking back and forth read 5-10 % low), and a static object's
-    jitter stays near 0. None for no rows or rows that are not numbers."""
+    """An instance's speed: the median of its rows' filtered speeds |v| (rows [stamp_s, x, y,
+    z, vx, vy, vz]), or ``path_speed_mps`` for rows without velocities (or all of them 0). The
+    median reads a walker's pace: a constant-velocity filter slows down at each reversal and
+    cuts the end of the path (the path speed of people walking back and forth read 5-10 % low),
+    and a static object's jitter stays near 0. None for no rows or rows that are not numbers."""
     try:
         arr = np.asarray([r[:7] for r in rows], dtype=np.float64)
     except (TypeError, ValueError, IndexError):

@@ -152,11 +152,12 @@ def test_a_walker_stands_on_the_floor_whatever_part_of_it_a_blob_shows():
     run = _Run()
     tracker = run.tracker
     for k in range(60):
-        x = np.array([0.6 * k / RATE_HZ, 0.0, 0.0])
-        if k % 3 == 2:  # legs under a table: a blob 0.8 m tall
-            box = (x + [0, 0, 0.4], np.array([0.4, 0.3, 0.8]))
-        else:
-            box = (x + [0, 0, 0.85], PERSON)
+        x = 0.6 * k / RATE_HZ
+        legs = k % 3 == 2  # legs under a table: a blob 0.8 m tall
+        box = (
+            (np.array([x, 0.0, 0.4]), np.array([0.4, 0.3, 0.8])) if legs
+            else (np.array([x, 0.0, 0.85]), PERSON)
+        )
         m = Measurement(box[0], box[1], "person", 0.9, f"o{k}", standing=box)
         tracker.step(run.t_s, [m])
         run.t_s += 1.0 / RATE_HZ

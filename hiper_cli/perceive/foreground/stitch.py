@@ -101,9 +101,9 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
         ):
             return 1.0 + (1.0 - similar), RESUME
         return None
-    dist = _common_distance_m(new, old, config.confirm_hits)
-    if dist is not None and dist <= config.stitch_duplicate_m:
-        return dist / config.stitch_duplicate_m, DUPLICATE
+    apart_m = _common_distance_m(new, old, config.confirm_hits)
+    if apart_m is not None and apart_m <= config.stitch_duplicate_m:
+        return apart_m / config.stitch_duplicate_m, DUPLICATE
     return None
 
 

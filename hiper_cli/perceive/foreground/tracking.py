@@ -54,7 +54,13 @@ from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
 from hiper_cli.perceive.foreground.stitch import (
-    DUPLICATE, RESUME, absorb, find_target, gap_ok, provisional_class, stale_rows,
+    DUPLICATE,
+    RESUME,
+    absorb,
+    find_target,
+    gap_ok,
+    provisional_class,
+    stale_rows,
 )
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
@@ -582,8 +588,8 @@ class Tracker:
 
     def _stitch(self, stamp_s: float) -> dict[str, Track]:
         """Offer each newly confirmed track, one whose (provisional) class changed and a walker
-        whose hits doubled to ``stitch.find_target``; absorbed ones leave the live tracks (a revived closed one takes
-        their place) and are listed in ``absorbed``. Returns new uuid -> target."""
+        whose hits doubled to ``stitch.find_target``; absorbed ones leave the live tracks (a
+        revived closed one takes their place) and are listed in ``absorbed``. Returns new uuid -> target."""
         self.absorbed = []
         walkers = self.config.walker_classes
         fresh = [
