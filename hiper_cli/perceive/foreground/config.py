@@ -367,8 +367,9 @@ class TrackerConfig(_Part):
     shows only the upper body (issue 17: person centres 0.5-0.8 m off in height)."""
     walker_level: bool = True
     """Tracks of a walker class (or, before a track has a class, observations of one) have no
-    vertical velocity: people walk on the floor, so their height is the filtered mean of the
-    observed centres and is never extrapolated (issue 17: person boxes below the floor)."""
+    vertical velocity: people walk on the floor, so their centre is half their height up (a high
+    quantile of their blobs' tops) and is never extrapolated (issue 17: person boxes below the
+    floor, and 0.7 m low from the mean of partial blobs)."""
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving
     (``moving_speed_mps``), is settled: it only takes an observation whose box overlaps its

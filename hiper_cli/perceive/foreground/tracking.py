@@ -79,6 +79,7 @@ WALKER_VZ_VAR = 1e-4  # (m/s)²: a walker's vertical velocity held at zero (``wa
 # A walker's height: this quantile of its blobs' tops above the floor. A high one, since blobs
 # of a person are often only a part (legs under a table, a body cut at the image's lower edge).
 WALKER_HEIGHT_QUANTILE = 0.8
+MAX_STANDING_TOPS = 300  # tops kept for the quantile (20 s at 15 Hz)
 
 
 @dataclass(frozen=True)
@@ -209,6 +210,7 @@ def _record_standing(track: Track, m: Measurement) -> None:
         return
     center, extent = m.standing
     track.standing_tops_m.append(float(center[2] + extent[2] / 2.0))
+    del track.standing_tops_m[:-MAX_STANDING_TOPS]  # a long walk: its latest blobs
     track.floor_z_m = float(center[2] - extent[2] / 2.0)
 
 
