@@ -9,8 +9,8 @@ The frame-to-frame association misses in three ways that leave one object as sev
   most ``stitch_appearance_gap_s``), the walker's clothes tell: the colour histograms of the
   two tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
 - **duplicate**: two blobs of one walker (the head above a shelf, the legs below it) fed two
-  tracks at once; the new one stays within ``stitch_duplicate_m`` of the old one at the stamps
-  both were updated;
+  tracks at once, or two tracks took it in turns; the new one stays within
+  ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``);
 - **revisit**: a static object (a chair, a shelf's junk) seen again after its track closed, or
   a part of it (a chair's back) tracked beside the whole: the new track's centre lies in the old
   track's box grown by ``stitch_overlap_m``, or the old one's in the new one's.
@@ -170,11 +170,12 @@ def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
 
 
 def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
-    """Fold ``new`` into ``old`` (in place; ``old``'s lists only grow, the knowledge base links
-    an instance's observations by appending). ``DUPLICATE``: only the observations and votes;
-    the old track's own rows already describe the walker. Otherwise the old track goes on as
-    the live one: the new rows follow, the motion state is the new track's (a revisited static
-    object: at the hit-weighted mean of both positions)."""
+    """Fold ``new`` into ``old`` (in place; ``old``'s observations only grow, the knowledge base
+    links an instance's observations by appending). ``DUPLICATE``: only the observations and
+    votes; the old track's own rows already describe the walker. Otherwise the old track goes
+    on as the live one: its last ``drop_rows`` rows go (``stale_rows``), the new rows follow,
+    the motion state is the new track's (a revisited static object: at the hit-weighted mean
+    of both positions)."""
     old.observation_uuids.extend(new.observation_uuids)
     for cls, votes in new.class_votes.items():
         old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
@@ -189,7 +190,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     if kind == DUPLICATE:
         old.hits += new.hits
         return
-    if drop_rows > 0:  # ``stale_rows``
+    if drop_rows > 0:
         del old.trajectory[-drop_rows:]
         del old.covariances[-drop_rows:]
         del old.noises[-drop_rows:]

@@ -560,12 +560,12 @@ class Tracker:
                 if visible is not None
                 else np.ones(len(unseen), dtype=bool)
             )
+            cfg = self.config
             for i, in_view in zip(unseen, seen_now, strict=True):
                 track = self.tracks[i]
                 self._decay(track, dt_frame, stamp_s)
                 if in_view:
                     track.unseen_in_view_s += dt_frame
-                cfg = self.config
                 limit, lost = (
                     (cfg.max_age_s, cfg.lost_max_s) if track.confirmed
                     else (cfg.tentative_max_age_s, cfg.tentative_lost_max_s)
