@@ -45,6 +45,12 @@ def _nonnegative(config: object, names: tuple[str, ...]) -> None:
             raise ConfigError(f"{name} must be >= 0, got {getattr(config, name)}")
 
 
+def _in_unit_interval(config: object, names: tuple[str, ...]) -> None:
+    for name in names:
+        if not 0.0 <= getattr(config, name) <= 1.0:
+            raise ConfigError(f"{name} must be in [0, 1], got {getattr(config, name)}")
+
+
 class _Part:
     """The end of the ``__post_init__`` chain: each part checks its own fields."""
 
@@ -393,8 +399,11 @@ class TrackerConfig(_Part):
     people's 0.46-0.55 on the realistic worlds ..."""
     stitch_duplicate_m: float = 0.4
     """... or, tracked at the same time, within this of it (median, horizontal) ..."""
-    stitch_overlap_m: float = 0.1
-    """... and a static track's centre in the other's box grown by this."""
+    stitch_overlap_m: float = 0.3
+    """... and a static track whose box's footprint overlaps the other's, at most this far
+    apart vertically (a chair's back over a table, its seat under it) ..."""
+    stitch_min_overlap: float = 0.5
+    """... by this share of the smaller footprint (of the larger when one is ``unknown``)."""
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
@@ -423,6 +432,7 @@ class TrackerConfig(_Part):
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m"))
+        _in_unit_interval(self, ("stitch_min_overlap",))
 
 
 def _own(cls: type, base: type | None) -> frozenset[str]:

@@ -34,7 +34,7 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.tables import drop_unseen_tables
-from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker
+from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.whole import seen_whole
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
@@ -284,6 +284,7 @@ class ForegroundStage:
                     whole=match.detection_index is not None or seen_whole(blob, cfg, frame.camera),
                     appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
                     standing=self._standing_box(blob),  # a walking track takes any blob as standing
+                    bounds_map_m=_corners(blob),
                 )
             )
         t_match = time.perf_counter()
@@ -356,7 +357,7 @@ class ForegroundStage:
     def _instance(self, track: Track) -> Instance:
         speed = float(np.hypot(*track.velocity[:2]))
         state = "dynamic" if speed > self.config.dynamic_speed_mps and not track.closed else "static"
-        box = Box3D(track.position, track.extent_m)
+        box = Box3D(*object_box(track, self.tracker.config))
         inst = self._instances.get(track.uuid)
         if inst is None:
             inst = Instance(
@@ -399,6 +400,16 @@ class ForegroundStage:
             return np.asarray(ok & ~occluded)
 
         return visible
+
+
+def _corners(blob: Blob) -> tuple[FloatArray, FloatArray]:
+    """(lower, upper) corners of ``blob``'s box, map frame, down to its support when the
+    background filter cut its base."""
+    lo, hi = blob.bounds_map
+    centre, extent = blob.center_map_m, blob.extent_map_m
+    lo, hi = lo.copy(), hi.copy()
+    lo[2], hi[2] = centre[2] - extent[2] / 2.0, centre[2] + extent[2] / 2.0
+    return lo, hi
 
 
 def _check_classes(wanted: tuple[str, ...], known: Any, detector: str) -> None:

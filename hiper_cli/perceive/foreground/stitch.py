@@ -12,8 +12,9 @@ The frame-to-frame association misses in three ways that leave one object as sev
   tracks at once, or two tracks took it in turns; the new one stays within
   ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``);
 - **revisit**: a static object (a chair, a shelf's junk) seen again after its track closed, or
-  a part of it (a chair's back) tracked beside the whole: the new track's centre lies in the old
-  track's box grown by ``stitch_overlap_m``, or the old one's in the new one's.
+  a part of it (a chair's back) tracked beside the whole: the footprints of the boxes the two
+  tracks' blobs fill overlap by ``stitch_min_overlap``, at most ``stitch_overlap_m`` apart
+  vertically (``_static_match``).
 
 The old track absorbs the new one (``absorb``): its observations, trajectory rows and votes,
 so the instance keeps its uuid and the knowledge base one instance per object.
@@ -49,7 +50,7 @@ def find_target(
     new: Track, candidates: Iterable[Track], config: TrackerConfig, moving: Callable[[Track], bool]
 ) -> tuple[Track, str] | None:
     """The older confirmed track ``new`` continues, and how (``RESUME``, ``DUPLICATE``,
-    ``REVISIT``), or None. ``moving(track)``: whether it was moving when last updated."""
+    ``REVISIT``), or None. ``moving(track)``: whether it is no static object (``tracking.is_static``)."""
     walkers = config.walker_classes
     name = provisional_class(new)
     best: tuple[float, Track, str] | None = None
@@ -160,13 +161,25 @@ def _common_distance_m(new: Track, old: Track, min_common: int) -> float | None:
 
 
 def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float, str] | None:
-    grow = config.stitch_overlap_m
-    d = np.abs(new.position - old.position)
-    inside_old = bool(np.all(d <= old.extent_m / 2.0 + grow))
-    inside_new = bool(np.all(d <= new.extent_m / 2.0 + grow))
-    if not (inside_old or inside_new):
+    """By the boxes the two tracks' blobs fill (``SeenBox``; a filter's position drifts): their
+    footprints overlap by ``stitch_min_overlap`` of the smaller one (of the larger one when
+    one is ``unknown``: a blob around several things is not the object), and at most
+    ``stitch_overlap_m`` lies between them vertically (a chair's back over a table and its
+    seat under it stay one chair; two cups side by side stay two)."""
+    box_new, box_old = new.seen.box(), old.seen.box()
+    c_new, e_new = box_new if box_new is not None else (new.position, new.extent_m)
+    c_old, e_old = box_old if box_old is not None else (old.position, old.extent_m)
+    lo = np.maximum(c_new - e_new / 2.0, c_old - e_old / 2.0)
+    hi = np.minimum(c_new + e_new / 2.0, c_old + e_old / 2.0)
+    if float(lo[2] - hi[2]) > config.stitch_overlap_m:
         return None
-    return float(np.linalg.norm(d)), REVISIT
+    common = float(np.prod(np.maximum(hi[:2] - lo[:2], 0.0)))
+    areas = sorted((float(np.prod(e_new[:2])), float(np.prod(e_old[:2]))))
+    base = areas[1] if UNKNOWN in (provisional_class(new), provisional_class(old)) else areas[0]
+    share = common / max(base, 1e-9)
+    if share < config.stitch_min_overlap:
+        return None
+    return 1.0 - share, REVISIT
 
 
 def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
@@ -177,6 +190,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     the motion state is the new track's (a revisited static object: at the hit-weighted mean
     of both positions)."""
     old.observation_uuids.extend(new.observation_uuids)
+    old.seen.extend(new.seen)
     for cls, votes in new.class_votes.items():
         old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
     for cls, count in new.class_counts.items():

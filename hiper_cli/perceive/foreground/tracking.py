@@ -53,6 +53,7 @@ from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, ne
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
+from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
@@ -63,7 +64,7 @@ from hiper_cli.perceive.foreground.stitch import (
     stale_rows,
 )
 
-__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "smooth_trajectory"]
+__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "object_box", "smooth_trajectory"]
 
 FloatArray = NDArray[np.float64]
 UNKNOWN = "unknown"
@@ -98,6 +99,15 @@ class Measurement:
     standing: tuple[FloatArray, FloatArray] | None = None
     """(centre, extent) of the blob as a walker's box, from the floor to its top
     (``walker_from_floor``): what a walking track takes instead of the blob's own box."""
+    bounds_map_m: tuple[FloatArray, FloatArray] | None = None
+    """(lower, upper) corners of the blob's box, map frame (``SeenBox``); None: the box of
+    ``center_map_m`` and ``extent_map_m``."""
+
+    def corners(self) -> tuple[FloatArray, FloatArray]:
+        if self.bounds_map_m is not None:
+            return self.bounds_map_m
+        half = self.extent_map_m / 2.0
+        return self.center_map_m - half, self.center_map_m + half
 
     def for_walker(self) -> tuple[FloatArray, FloatArray]:
         """The (centre, extent) a walking track takes."""
@@ -137,6 +147,8 @@ class Track:
     # a walker's standing boxes seen (``Measurement.standing``): tops and floor, map z
     standing_tops_m: list[float] = field(default_factory=list)
     floor_z_m: float | None = None
+    # the boxes of its blobs: a static object's box (``object_box``)
+    seen: SeenBox = field(default_factory=SeenBox)
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -255,6 +267,31 @@ def smooth_trajectory(track: Track) -> None:
         Ps[k] = P_k + C @ (Ps[k + 1] - P_pred) @ C.T
     for row, x in zip(rows, xs, strict=True):
         row[ROW_STATE] = x.tolist()
+
+
+def is_static(track: Track, config: TrackerConfig) -> bool:
+    """Whether a track is a static object: not of a walking class, and its blobs stayed where
+    they were (``SeenBox.moved``; for ``unknown``, which may be a person not named yet: the
+    filter, ``_was_moving``). A static object's filtered velocity is no evidence: partial
+    views move a blob's centroid, and beds that never moved read 2 m/s."""
+    name = track.class_name
+    if name in config.walker_classes:
+        return False
+    if name == UNKNOWN:
+        return not _was_moving(track, config)
+    return not track.seen.moved()
+
+
+def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatArray]:
+    """(centre, extent), map frame, of the object a track is: a static one's seen box (the union
+    of its blobs, ``SeenBox``); a walker's or a moving object's filtered box where it was last
+    updated (not extrapolated past its last observation)."""
+    if is_static(track, config):
+        found = track.seen.box()
+        if found is not None:
+            return found
+    centre = np.asarray(track.trajectory[-1][ROW_POSITION]) if track.trajectory else track.position
+    return np.asarray(centre, dtype=np.float64), track.extent_m
 
 
 def _was_moving(track: Track, config: TrackerConfig) -> bool:
@@ -409,6 +446,7 @@ class Tracker:
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
+        track.seen.add(*m.corners())
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -609,7 +647,7 @@ class Tracker:
             new.stitch_class, new.stitch_hits = provisional_class(new), new.hits
             live = [t for t in self.tracks if t.uuid not in aliases]
             found = find_target(new, [*live, *self.dormant], self.config,
-                                lambda t: _was_moving(t, self.config))
+                                lambda t: not is_static(t, self.config))
             if found is None:
                 continue
             old, kind = found
@@ -632,7 +670,7 @@ class Tracker:
         a walker (``stitch.gap_ok`` drops it later)."""
         if not self.config.stitch:
             return
-        if track.class_name in self.config.walker_classes or not _was_moving(track, self.config):
+        if track.class_name in self.config.walker_classes or is_static(track, self.config):
             self.dormant.append(track)
 
     def _close(self, track: Track) -> None:
@@ -658,6 +696,7 @@ class Tracker:
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
         )
+        track.seen.add(*m.corners())
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

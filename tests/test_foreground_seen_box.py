@@ -1,0 +1,79 @@
+"""A static object's box is the union of the blobs it was seen as (``seen_box.py``), robust to a
+few stray blobs; a moved object is told from one seen from different sides; a chair's back above
+a table and its seat below stay one chair, two cups side by side stay two."""
+
+import numpy as np
+
+from hiper_cli.perceive.foreground.config import TrackerConfig
+from hiper_cli.perceive.foreground.seen_box import SeenBox
+from hiper_cli.perceive.foreground.tracking import Measurement, Tracker, object_box
+
+RATE_HZ = 15.0
+
+
+def _add(box, lower, upper, times=1):
+    for _ in range(times):
+        box.add(np.asarray(lower, float), np.asarray(upper, float))
+
+
+def test_the_union_of_partial_views_is_the_whole_bed():
+    box = SeenBox()
+    _add(box, [0.0, 0.0, 0.0], [1.0, 1.4, 0.5], times=20)  # the near half, from one side
+    _add(box, [0.9, 0.0, 0.0], [2.0, 1.4, 0.5], times=20)  # the far half, from the other
+    centre, extent = box.box()
+    assert np.allclose(centre, [1.0, 0.7, 0.25], atol=0.06)
+    assert np.allclose(extent, [2.0, 1.4, 0.5], atol=0.12)
+
+
+def test_a_few_stray_blobs_do_not_stretch_the_box():
+    box = SeenBox()
+    _add(box, [0.0, 0.0, 0.0], [0.5, 0.5, 0.9], times=45)
+    _add(box, [-1.0, 0.0, 0.0], [0.5, 0.5, 2.0], times=5)  # a wrong association, an edge's noise
+    lower, upper = box.corners()
+    assert np.allclose(lower, [0.0, 0.0, 0.0]) and np.allclose(upper, [0.5, 0.5, 0.9])
+
+
+def test_a_cart_that_drove_moved_a_chair_seen_from_two_sides_did_not():
+    chair = SeenBox()
+    _add(chair, [0.0, 0.0, 0.0], [0.3, 0.5, 0.9], times=20)
+    _add(chair, [0.2, 0.0, 0.0], [0.5, 0.5, 0.9], times=20)
+    assert not chair.moved()
+    cart = SeenBox()
+    for k in range(40):
+        x = 0.05 * k
+        _add(cart, [x, 0.0, 0.0], [x + 0.6, 0.4, 0.8])
+    assert cart.moved()
+    assert not SeenBox().moved() and SeenBox().box() is None
+
+
+def _static_run(frames):
+    """Feed ``frames`` (lists of (lower, upper, class)) at RATE_HZ; return the tracker."""
+    tracker = Tracker(TrackerConfig())
+    t_s, k = 0.0, 0
+    for blobs in frames:
+        measurements = []
+        for lower, upper, cls in blobs:
+            lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+            k += 1
+            measurements.append(Measurement((lower + upper) / 2, upper - lower, cls, 0.9, f"o{k}",
+                                            bounds_map_m=(lower, upper)))
+        tracker.step(t_s, measurements)
+        t_s += 1.0 / RATE_HZ
+    return tracker
+
+
+def test_a_chairs_back_over_a_table_and_its_seat_under_it_are_one_chair():
+    back = ([1.0, 1.0, 0.76], [1.45, 1.12, 1.0], "chair")   # above the table top at 0.75 m
+    seat = ([1.0, 0.95, 0.0], [1.45, 1.45, 0.5], "chair")   # seen under it, once the robot is close
+    tracker = _static_run([[back]] * 30 + [[]] * 75 + [[seat]] * 30)
+    alive = tracker.tracks + tracker.dormant
+    assert len({t.uuid for t in alive}) == 1
+    centre, extent = object_box(alive[0], tracker.config)
+    assert extent[2] > 0.8 and abs(centre[2] - 0.5) < 0.1
+
+
+def test_two_cups_side_by_side_stay_two():
+    left = ([0.0, 0.0, 0.75], [0.08, 0.08, 0.85], "cup")
+    right = ([0.19, 0.0, 0.75], [0.27, 0.08, 0.85], "cup")
+    tracker = _static_run([[left]] * 30 + [[]] * 75 + [[right]] * 30)
+    assert len({t.uuid for t in tracker.tracks + tracker.dormant}) == 2
