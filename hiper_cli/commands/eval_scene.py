@@ -15,11 +15,12 @@ from hiper_cli.commands.eval import eval_app
 @eval_app.command(
     "scene",
     help=(
-        "Score what a knowledge base holds of a log against the log's ground truth (a realistic "
-        "world's gt/: instances.json, surface_points.npz) and print Table II (background: semantic "
-        "and static/dynamic precision, distance error, coverage of the observed wall and floor "
-        "pieces) and Table III (foreground: TP/FP/FN per class, classified precision, centre error, "
-        "walker speed).\n\n"
+        "Score what a knowledge base holds of a log against the log's ground truth "
+        "(gt/instances.json and gt/surface_points.npz: a realistic world's, or a hiper sim log's) "
+        "and print Table II (background: semantic and static/dynamic precision, distance error, "
+        "coverage of the observed wall and floor pieces) and Table III (foreground: TP/FP/FN per "
+        "class, classified precision, centre error, "
+        "unknown instances on no real object, person instances per person, walker speed).\n\n"
         "Example: hiper perceive ../shared/worlds/bookstore --kb bs.hiper && "
         "hiper eval scene ../shared/worlds/bookstore --kb bs.hiper"
     ),
@@ -30,12 +31,17 @@ def eval_scene(
     kb_docs: KbDocsOption = None,
     json_out: bool = JSON_OPTION,
 ) -> None:
+    from hiper_cli.errors import LogError
     from hiper_cli.evaluate.scene import score_scene
     from hiper_cli.evaluate.surfaces import load_surfaces
     from hiper_cli.graph import open_kb_for_reading
-    from hiper_cli.perceive.logs.truth import load_truth
+    from hiper_cli.perceive.logs.world_truth import load_world_truth
 
-    truth = load_truth(log)
+    if not (log / "gt" / "instances.json").exists() and (log / "gt" / "world.json").exists():
+        raise LogError(f"{log / 'gt' / 'instances.json'}: not found; this hiper sim log was made before "
+                       "hiper sim wrote scene truth: make it again with hiper sim, or score it with "
+                       "hiper eval background / hiper eval foreground")
+    truth = load_world_truth(log)
     surfaces = load_surfaces(log)
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         instances = knowledge.instances()
@@ -65,9 +71,12 @@ def show_scene_eval(data: dict[str, Any]) -> None:
     out.print(f"Table III, foreground: {f['instances']} instances, TP {f['tp']} FP {f['fp']} FN(observed) "
               f"{f['fn_observed']}, precision {_f(f['precision'])}")
     out.print(f"  classified ('unknown' left out): TP {f['classified_tp']} FP {f['classified_fp']} precision "
-              f"{_f(f['classified_precision'])} ({f['unknown']} unknown)")
+              f"{_f(f['classified_precision'])} ({f['unknown']} unknown, "
+              f"{_f(f['unknown_on_nothing'])} of them on no real object); person instances per person "
+              f"{_f(f['persons_per_person'])}")
     for name, c in f["per_class"].items():
         out.print(f"  {name:<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
+    out.print(f"  unmatched, by what they lie on: {f['unmatched']}")
     out.print(f"  centre error (static, matched) mean/median {_f(f['centre_error_mean_m'])} / "
               f"{_f(f['centre_error_median_m'])} m; walkers matched {f['walkers_matched']}, speed mean "
               f"{_f(f['walker_speed_mean_mps'])} m/s, error {_f(f['walker_speed_error_mps'])} m/s")

@@ -11,9 +11,12 @@ The definitions follow the worlds' reference scorer (``gt/README.md`` of each wo
   building pieces of at least 1 m² (not the pooled ``*_misc``) that some sample lies on;
 - foreground: an instance matches a true object of its class (or an alt class) whose centre is
   within ``MATCH_M`` or whose axis-aligned box IoU exceeds ``MATCH_IOU`` (a walking person: the
-  mean distance at the instance's trajectory stamps, else the closest approach to the true
+  median distance at the instance's trajectory stamps, else the closest approach to the true
   path); greedy one-to-one by distance. TP / FP per class, FN = observed objects unmatched;
-  classified precision leaves ``unknown`` out (the paper's Table III);
+  classified precision leaves ``unknown`` out (the paper's Table III). Each unmatched instance
+  is put down to the class of the nearest true object it would match but for its class, or to
+  ``nothing`` (``unmatched``; ``unknown_on_nothing`` is the share of unknown instances that lie
+  on no real object); ``persons_per_person`` = person instances per true person observed;
 - localisation: centre error of matched static objects; person speed: the mean speed along
   the trajectory of each person matched to a walker, against the walker's own speed.
 """
@@ -144,8 +147,19 @@ def _distance(inst: Instance, t: TruthInstance, truth: Truth) -> float:
         if true is not None:
             dists.append(float(np.linalg.norm(row[1:4] - true)))
     if dists:
-        return float(np.mean(dists))
+        return float(np.median(dists))
     return float(np.min(np.linalg.norm(track[:, 1:4] - centre, axis=1)))
+
+
+def _nearest_class(inst: Instance, gt: list[TruthInstance], truth: Truth) -> str:
+    """The class of the nearest true object ``inst`` lies on (by the match rule, any class), or
+    ``nothing``."""
+    best: tuple[float, str] | None = None
+    for t in gt:
+        dist = _distance(inst, t, truth)
+        if (dist <= MATCH_M or _aabb_iou(inst, t) > MATCH_IOU) and (best is None or dist < best[0]):
+            best = (dist, t.class_name)
+    return best[1] if best else "nothing"
 
 
 def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, Any]:
@@ -172,6 +186,10 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
     for t in gt:
         if t.observed and t.id not in used:
             per_class.setdefault(t.class_name, {"tp": 0, "fp": 0, "fn": 0})["fn"] += 1
+    unmatched: Counter[str] = Counter()
+    for pi, p in enumerate(preds):
+        if pi not in matched:
+            unmatched[f"{p.class_name}->{_nearest_class(p, gt, truth)}"] += 1
     tp = len(matched)
     known = [pi for pi, p in enumerate(preds) if p.class_name != "unknown"]
     known_tp = sum(pi in matched for pi in known)
@@ -193,7 +211,11 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
         "classified_fp": len(known) - known_tp,
         "classified_precision": _ratio(known_tp, len(known)),
         "unknown": len(preds) - len(known),
+        "unknown_on_nothing": _ratio(unmatched["unknown->nothing"], len(preds) - len(known)),
+        "persons_per_person": _ratio(sum(p.class_name == "person" for p in preds),
+                                     sum(t.class_name == "person" and t.observed for t in gt)),
         "per_class": dict(sorted(per_class.items())),
+        "unmatched": dict(sorted(unmatched.items())),
         "centre_error_mean_m": float(np.mean(errors)) if errors else None,
         "centre_error_median_m": float(np.median(errors)) if errors else None,
         "walkers_matched": len(speeds),

@@ -1,4 +1,5 @@
-"""The true surfaces of a realistic world's log (``gt/surface_points.npz``), for scoring.
+"""The true surfaces of a log (``gt/surface_points.npz`` of a realistic world or of a
+``hiper sim`` log, ``sim/scene_truth.py``), for scoring.
 
 ``gt/surface_points.npz`` holds exact surface samples: ``static_xyz`` (N, 3), ``static_normal``
 (N, 3, int8 × 127), ``static_id`` (N,), and ``dynamic_xyz``, ``dynamic_id``, ``dynamic_t`` on
@@ -96,10 +97,10 @@ def load_surfaces(log_dir: str | Path) -> SurfaceTruth:
         records = json.loads((gt / "instances.json").read_text())["instances"]
         pieces = {int(d["id"]): d for d in records if d.get("plane") and d.get("area_m2") is not None}
     except (OSError, KeyError, ValueError, TypeError, json.JSONDecodeError) as err:
-        hint = ("; a hiper sim log is scored by hiper eval background and hiper eval foreground"
+        hint = ("; hiper sim writes both: make the log again with it"
                 if (gt / "world.json").exists() else "")
-        raise LogError(f"{path}: cannot read the true surfaces ({err}); scoring a realistic "
-                       f"world's log needs gt/{SURFACE_FILE} and gt/instances.json{hint}") from err
+        raise LogError(f"{path}: cannot read the true surfaces ({err}); scoring a scene "
+                       f"needs gt/{SURFACE_FILE} and gt/instances.json{hint}") from err
     norms = np.linalg.norm(sn, axis=1, keepdims=True)
     sn = sn / np.where(norms > 0, norms, 1.0)
     planes: dict[int, FloatArray] = {}

@@ -99,6 +99,11 @@ class RenderOutput:
     rgb: NDArray[np.uint8]  # (H, W, 3) RGB
     depth_m: NDArray[np.float32]  # (H, W), 0 = no return
     ids: NDArray[np.uint16]  # (H, W), 0 = no return
+    # the exact surface, for the scorer's truth (``scene_truth.py``): noise-free depth (0 = no
+    # hit, whatever the range), the id of every hit and its surface normal in the camera frame
+    true_z_m: NDArray[np.float32]  # (H, W)
+    hit_ids: NDArray[np.uint16]  # (H, W)
+    normal_cam: NDArray[np.float32]  # (H, W, 3), unit
 
 
 class Renderer:
@@ -166,6 +171,7 @@ class Renderer:
         rgb_u8 = np.minimum(base * shade[:, None] + 0.5, 255.0).astype(np.uint8).reshape(*shape, 3)
 
         z: NDArray[np.float32] = np.where(ok, t_hit, 0.0).astype(np.float32)
+        true_z = z.reshape(shape).copy()
         valid = ok & (z >= self.cfg.min_range_m) & (z <= self.cfg.max_range_m)
         if self.cfg.noise.enabled:
             sigma = self.cfg.noise.sigma_m(z).astype(np.float32)
@@ -174,8 +180,9 @@ class Renderer:
         z = (np.round(z * self.cfg.depth_scale) / self.cfg.depth_scale).astype(np.float32)
         valid &= z > 0
         depth = np.where(valid, z, np.float32(0.0)).astype(np.float32).reshape(shape)
-        inst = np.where(valid, ids[gids], 0).astype(np.uint16).reshape(shape)
-        return RenderOutput(rgb_u8, depth, inst)
+        hit_ids = ids[gids].astype(np.uint16)
+        inst = np.where(valid, hit_ids, 0).astype(np.uint16).reshape(shape)
+        return RenderOutput(rgb_u8, depth, inst, true_z, hit_ids.reshape(shape), n_cam.reshape(*shape, 3))
 
 
 def _tensor(array: NDArray[Any]) -> Any:

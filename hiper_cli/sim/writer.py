@@ -27,6 +27,7 @@ from hiper_cli.sim.noise import NoiseModel, detect
 from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
 from hiper_cli.sim.render import DepthNoise, RenderConfig, Renderer
 from hiper_cli.sim.route import Route, RouteConfig, plan_route
+from hiper_cli.sim.scene_truth import DynamicTruth, SceneTruthRecorder, StaticTruth
 from hiper_cli.sim.worlds import World, make_world
 
 __all__ = ["SimConfig", "SimResult", "simulate"]
@@ -169,6 +170,9 @@ def simulate(
             stale.unlink()
     first_box: dict[int, Box3D] = {}
     tracks_rows: list[list[Any]] = []
+    centres: dict[int, list[list[float]]] = {}  # id: [t, x, y, z] rows of the moving instances
+    all_ids = [o.id for o in w.objects] + [s.id for s in crowd.specs] + [c.id for c in carts.specs]
+    scene_truth = SceneTruthRecorder(renderer.camera, cfg.render.max_range_m, max(all_ids, default=0) + 1)
     png = [cv2.IMWRITE_PNG_COMPRESSION, int(cfg.png_compression)]
     op_start = next((k for k, t in enumerate(stamps) if t >= mapping_s - 1e-9), n_frames)
     started = time.perf_counter()
@@ -208,6 +212,7 @@ def simulate(
                     )
                     box = _person_box(spec.height_m, radius[i], float(px), float(py))
                     first_box.setdefault(spec.id, box)
+                    centres.setdefault(spec.id, []).append([float(t), *box.center_m])
                     vx, vy = crowd.vel[i]
                     tracks_rows.append(
                         [f"{t:.6f}", spec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
@@ -219,6 +224,7 @@ def simulate(
                 lo, hi = mesh.bounds()
                 box = Box3D((lo + hi) / 2.0, hi - lo)
                 first_box.setdefault(cspec.id, box)
+                centres.setdefault(cspec.id, []).append([float(t), *box.center_m])
                 vx, vy = carts.vel[i]
                 tracks_rows.append(
                     [f"{t:.6f}", cspec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
@@ -226,6 +232,8 @@ def simulate(
             T = route.pose_at(route_t)
             rng = np.random.default_rng([seed, k])
             image = renderer.render(T, dynamic, rng)
+            scene_truth.add(float(t), image.hit_ids, image.true_z_m, image.normal_cam, T,
+                            (i for i, _ in dynamic))
             detections = detect(image.ids, classes, cfg.noise, rng, picture_ids)
             det_fh.write(json.dumps({"stamp_s": round(float(t), 6), "detections": detections}) + "\n")
             frame = Frame(
@@ -253,6 +261,14 @@ def simulate(
     (gt / "noise.json").write_text(json.dumps(cfg.noise.to_dict(), indent=2) + "\n")
     (gt / "world.json").write_text(
         json.dumps(_world_doc(w, crowd, carts, first_box, cfg, stamps, op_start), indent=1) + "\n"
+    )
+    movers = [(s.id, s.name, "person", s.speed_mps) for s in crowd.specs]
+    movers += [(c.id, c.name, "cart", c.speed_mps) for c in carts.specs]
+    scene_truth.write(
+        gt, w.name, seed, cfg.rate_hz,
+        [StaticTruth(o.id, o.name, o.class_name, o.mesh, o.plane) for o in w.objects],
+        [DynamicTruth(i, name, cls, np.asarray(centres[i]), first_box[i].extent_m, float(speed))
+         for i, name, cls, speed in movers if i in centres],
     )
     return SimResult(
         root,
