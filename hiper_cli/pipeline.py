@@ -199,6 +199,29 @@ class PerceiveSummary:
     stage_mean_s: dict[str, float] = field(default_factory=dict)
     unavailable_stages: dict[str, str] = field(default_factory=dict)
     graph_sync_s: float = 0.0
+    # per step (the stages' named timings, ``kb_write_s``): total seconds and frames it ran in
+    step_total_s: dict[str, float] = field(default_factory=dict)
+    step_frames: dict[str, int] = field(default_factory=dict)
+
+    def add_steps(self, timings_s: dict[str, float]) -> None:
+        """Add one frame's step timings (names ending in ``_s``; others are counts)."""
+        for name, seconds in timings_s.items():
+            if name.endswith("_s"):
+                self.step_total_s[name] = self.step_total_s.get(name, 0.0) + seconds
+                self.step_frames[name] = self.step_frames.get(name, 0) + 1
+
+    def steps(self) -> dict[str, dict[str, float]]:
+        """Per step: frames it ran in, mean and total milliseconds, and mean per frame read."""
+        read = max(self.frames_read, 1)
+        return {
+            name: {
+                "frames": self.step_frames[name],
+                "mean_ms": round(1000.0 * total / self.step_frames[name], 3),
+                "per_frame_ms": round(1000.0 * total / read, 3),
+                "total_s": round(total, 3),
+            }
+            for name, total in sorted(self.step_total_s.items())
+        }
 
     @property
     def frames_per_s(self) -> float:
@@ -225,6 +248,7 @@ class PerceiveSummary:
             "deleted_instances": self.deleted_instances,
             "stage_mean_s": {k: round(v, 4) for k, v in self.stage_mean_s.items()},
             "graph_sync_s": round(self.graph_sync_s, 3),
+            "steps": self.steps(),
         }
 
 
@@ -336,12 +360,14 @@ def perceive(
 
     def write(frame: Frame | None, result: FrameResult) -> None:
         nonlocal last_sync
+        t_write = time.perf_counter()
         if frame is None:
             kb.write_frame(current, result)
         else:
             kb.write_frame(current, result, pose_id=frame.pose_id, stamp_s=frame.stamp_s,
                            T_map_cam=frame.T_map_cam)
             summary.frames_read += 1
+        summary.add_steps({**result.timings_s, "kb_write_s": time.perf_counter() - t_write})
         for obs in result.observations:
             obs_counts[(obs.layer, obs.class_name)] += 1
         summary.deleted_instances += len(result.deleted_instances)

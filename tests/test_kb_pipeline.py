@@ -246,6 +246,18 @@ def test_cli_perceive_progress_bar_and_table(tmp_path, probe_registry):
     assert "3 frames read" in _text(result) and "floor" in result.output
 
 
+def test_cli_perceive_timings_report_each_step(tmp_path, probe_registry):
+    log = _tum_log(tmp_path / "hall", 3)
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "kb"), "--stages", "probe",
+                                 "--json"])
+    assert result.exit_code == 0, result.output
+    steps = json.loads(result.output)["steps"]
+    assert steps["kb_write_s"]["frames"] >= 3 and steps["kb_write_s"]["total_s"] >= 0
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(tmp_path / "kb2"), "--stages", "probe",
+                                 "--timings"])
+    assert result.exit_code == 0 and "kb_write_s" in result.output and "per frame read ms" in _text(result)
+
+
 def test_cli_kb_bench_reports_every_figure():
     result = runner.invoke(app, ["kb", "bench", "--sizes", "300", "--queries", "5", "--json"])
     assert result.exit_code == 0, result.output

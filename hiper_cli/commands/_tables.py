@@ -16,6 +16,7 @@ __all__ = [
     "show_kb_info",
     "show_log_info",
     "show_perceive",
+    "show_steps",
 ]
 
 
@@ -39,6 +40,17 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
         for cls in classes:
             table.add_row(layer, cls, str(data["observations"].get(layer, {}).get(cls, 0)),
                           str(data["instances"].get(layer, {}).get(cls, 0)))
+    out.print(table)
+
+
+def show_steps(out: Any, steps: dict[str, dict[str, float]]) -> None:
+    """The cost of each step of a ``perceive`` run: mean per frame it ran in, per frame read."""
+    from rich.table import Table
+
+    table = Table("step", "frames", "mean ms", "per frame read ms", "total s")
+    for name, row in steps.items():
+        table.add_row(name, str(row["frames"]), f"{row['mean_ms']:.2f}", f"{row['per_frame_ms']:.2f}",
+                      f"{row['total_s']:.2f}")
     out.print(table)
 
 

@@ -39,6 +39,8 @@ Again = Annotated[bool, typer.Option(
 Env = Annotated[Text, typer.Option("--env", help="Environment name (default: the log folder's name).")]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
+Timings = Annotated[bool, typer.Option(
+    "--timings", help="Print the cost of each step per frame (always in --json, under 'steps').")]
 Log = Annotated[Path, typer.Argument(help="Sensor log: TUM folder, .bag, rosbag2 folder or .mcap.")]
 
 
@@ -47,7 +49,8 @@ def perceive_command(
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
     resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
-    view: View = False, as_json: bool = JSON_OPTION, *, log_options: LogOptions,
+    view: View = False, timings: Timings = False, as_json: bool = JSON_OPTION, *,
+    log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
@@ -55,7 +58,7 @@ def perceive_command(
 
     The log flags (camera, topics, frames, --poses) are those of hiper info.
 
-    Example: hiper perceive out/house --kb house.hiper --detector truth
+    Example: hiper perceive out/house --kb house.hiper --detector truth --timings
     """
     from hiper_cli.pipeline import PerceiveOptions, perceive_log
 
@@ -83,9 +86,11 @@ def perceive_command(
     if as_json:
         print_json(summary.to_dict())
     else:
-        from hiper_cli.commands._tables import show_perceive
+        from hiper_cli.commands._tables import show_perceive, show_steps
 
         show_perceive(out, summary.to_dict())
+        if timings:
+            show_steps(out, summary.to_dict()["steps"])
 
 
 def register(app: typer.Typer) -> None:
