@@ -8,11 +8,13 @@ it the camera sees farther, or nothing within range. ``edge_evidence`` probes a 
 beyond the plane's top and bottom edge in every image column it covers and says, for each
 edge, whether the plane is ``open`` there (most probes see farther than the plane),
 ``closed`` (the surface goes on, or the edge is the image's edge) or ``unknown`` (an
-occluder in front, too few probes).
+occluder in front, too few probes); ``fronts.py`` adds ``front`` at a side edge past which
+a parallel surface stands a furniture depth behind.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -22,10 +24,22 @@ from hiper_cli.perceive.background.config import BackgroundConfig
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["SIDES", "EdgeEvidence", "edge_evidence", "is_open", "view_bounded"]
+__all__ = [
+    "OPEN",
+    "SIDES",
+    "UNKNOWN",
+    "EdgeEvidence",
+    "EdgeProbes",
+    "edge_evidence",
+    "edge_probes",
+    "is_open",
+    "line_verdicts",
+    "view_bounded",
+]
 
-EdgeEvidence = Literal["open", "closed", "unknown"]
+EdgeEvidence = Literal["open", "closed", "unknown", "front"]
 _OPEN, _CLOSED, _UNKNOWN = 1, 0, -1
+OPEN, UNKNOWN = _OPEN, _UNKNOWN  # a probe or line that sees beyond the plane; no evidence
 
 
 def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.float64],
@@ -52,20 +66,30 @@ def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.flo
     return out
 
 
-def _edge(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: BackgroundConfig,
-          side: str) -> EdgeEvidence:
-    """The evidence beyond one edge of the plane's mask: ``side`` top, bottom, left or right.
+@dataclass(frozen=True)
+class EdgeProbes:
+    """The probes beyond one edge of a plane's mask, one row per image line across the edge
+    and one column per step out from it: ``cat`` open / closed / unknown (the image's edge is
+    closed), ``rows`` and ``cols`` their samples on the grid, ``inside`` whether the sample
+    is in the image."""
+
+    cat: NDArray[np.int64]
+    rows: NDArray[np.int64]
+    cols: NDArray[np.int64]
+    inside: NDArray[np.bool_]
+
+
+def edge_probes(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: BackgroundConfig,
+                side: str) -> EdgeProbes | None:
+    """The probes beyond one edge of the plane's mask: ``side`` top, bottom, left or right.
 
     In each image line across the edge the probes lie from ``wall_probe_gap_px`` to
-    ``wall_probe_reach_px`` past it: the line is open when one of them sees beyond the plane
-    (past a furniture front's convex corner the side bends away; past a room's concave corner
-    the next wall is nearer, an occluder), else closed when one lies on the plane or outside
-    the image."""
+    ``wall_probe_reach_px`` past it. None when the mask is empty."""
     mask = seg.mask if side in ("top", "bottom") else seg.mask.T
     n_along, _ = mask.shape  # probes move along axis 0 of ``mask``
     lines = np.flatnonzero(mask.any(axis=0))
     if len(lines) == 0:
-        return "unknown"
+        return None
     gap = max(round(cfg.wall_probe_gap_px / grid.stride), 1)
     reach = max(round(cfg.wall_probe_reach_px / grid.stride), gap)
     steps = np.arange(gap, reach + 1)
@@ -76,15 +100,32 @@ def _edge(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: Ba
         edge = n_along - 1 - np.argmax(mask[::-1, lines], axis=0)
         at = edge[:, None] + steps[None, :]
     line_idx = np.broadcast_to(lines[:, None], at.shape)
-    outside = (at < 0) | (at >= n_along)
+    inside = (at >= 0) & (at < n_along)
     cat = np.full(at.shape, _CLOSED, dtype=np.int64)  # the image's edge
-    inside = ~outside
-    rows, cols = at[inside], line_idx[inside]
-    if side in ("left", "right"):
-        rows, cols = cols, rows
-    cat[inside] = _probe(grid, camera, seg.plane_cam, rows, cols, cfg)
-    verdict = np.where((cat == _OPEN).any(axis=1), _OPEN,
-                       np.where((cat == _CLOSED).any(axis=1), _CLOSED, _UNKNOWN))
+    along = np.clip(at, 0, n_along - 1)
+    rows, cols = (along, line_idx) if side in ("top", "bottom") else (line_idx, along)
+    rows, cols = np.ascontiguousarray(rows), np.ascontiguousarray(cols)
+    cat[inside] = _probe(grid, camera, seg.plane_cam, rows[inside], cols[inside], cfg)
+    return EdgeProbes(cat, rows, cols, inside)
+
+
+def line_verdicts(probes: EdgeProbes) -> NDArray[np.int64]:
+    """Per image line: open when one of its probes sees beyond the plane (past a furniture
+    front's convex corner the side bends away; past a room's concave corner the next wall is
+    nearer, an occluder), else closed when one lies on the plane or outside the image, else
+    unknown."""
+    cat = probes.cat
+    return np.where((cat == _OPEN).any(axis=1), _OPEN,
+                    np.where((cat == _CLOSED).any(axis=1), _CLOSED, _UNKNOWN))
+
+
+def _edge(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: BackgroundConfig,
+          side: str) -> EdgeEvidence:
+    """The evidence beyond one edge of the plane's mask (``edge_probes``, ``line_verdicts``)."""
+    probes = edge_probes(grid, camera, seg, cfg, side)
+    if probes is None:
+        return "unknown"
+    verdict = line_verdicts(probes)
     n_open = int(np.sum(verdict == _OPEN))
     n_closed = int(np.sum(verdict == _CLOSED))
     if n_open + n_closed < cfg.wall_probe_min_columns:
@@ -103,11 +144,11 @@ def edge_evidence(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,
 
 def is_open(edges: dict[str, EdgeEvidence]) -> bool:
     """Whether a wall candidate ends in the room: open above or below (it does not reach the
-    ceiling or the floor), or at both sides (a free-standing panel; a wall ends at a corner,
-    or at one doorway)."""
+    ceiling or the floor), at both sides (a free-standing panel; a wall ends at a corner, or
+    at one doorway), or at one side in ``front`` of a parallel surface (``fronts.py``)."""
     return edges.get("top") == "open" or edges.get("bottom") == "open" or (
-        edges.get("left") == "open" and edges.get("right") == "open"
-    )
+        edges.get("left") in ("open", "front") and edges.get("right") in ("open", "front")
+    ) or "front" in (edges.get("left"), edges.get("right"))
 
 
 def view_bounded(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,

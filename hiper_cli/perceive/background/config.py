@@ -92,6 +92,12 @@ class BackgroundConfig:
     # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
     wall_view_bounded: bool = True
     wall_tall_m: float = 2.2  # seen reaching this high: a wall, though its views saw both ends open
+    # a furniture front stands before a wall (``fronts.py``): past a side edge the camera sees a
+    # plane parallel to it this far behind; deeper than a door's recess in its wall (a wall's
+    # thickness), no deeper than furniture (wardrobes, fridges, shelves: 0.3-0.8 m)
+    wall_fronts: bool = True
+    wall_front_min_m: float = 0.25
+    wall_front_max_m: float = 1.0
     # merging (Algorithm 2)
     merge_angle_deg: float = 10.0
     merge_offset_m: float = 0.1

@@ -20,6 +20,7 @@ from hiper_cli.perceive.background.contour import (
     transform_plane,
     transform_points,
 )
+from hiper_cli.perceive.background.fronts import front_sides, segment_labels
 from hiper_cli.perceive.background.merge import (
     MapObservation,
     match_instances,
@@ -40,8 +41,8 @@ MIN_PLANE_THICKNESS_M = 0.02  # a plane observation's box is at least this thick
 MIN_CONFIDENCE = 0.05  # the worst-fitting plane still gets this confidence
 
 
-def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
-                 cfg: BackgroundConfig) -> Observation | None:
+def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: BackgroundConfig,
+                 segments: list[PlaneSegment], labels: NDArray[np.int64]) -> Observation | None:
     contour_cam = contour_from_mask(
         seg.mask, grid.stride, frame.camera, seg.plane_cam, cfg.contour_epsilon_px, grid.points_cam
     )
@@ -67,6 +68,9 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame,
     thickness = max(2.0 * seg.rms_m, MIN_PLANE_THICKNESS_M)
     box = Box3D(pf.to_3d((lo + hi) / 2.0)[0], np.array([*(hi - lo), thickness]), pf.R)
     edges = edge_evidence(grid, frame.camera, seg, cfg) if class_name == "wall" and cfg.wall_bounds else None
+    if edges is not None and cfg.wall_fronts:
+        for side in front_sides(grid, frame.camera, seg, segments, labels, cfg):
+            edges[side] = "front"  # a furniture front before a wall
     rows, cols = np.nonzero(seg.mask)
     pick = np.linspace(0, len(rows) - 1, min(cfg.pixel_sample, len(rows))).astype(int)
     pixels_uv = np.stack([cols[pick], rows[pick]], axis=1) * grid.stride
@@ -105,8 +109,9 @@ def observe_all(frame: Frame, cfg: BackgroundConfig) -> tuple[list[Observation],
     grid, segments = extract_planes(frame.depth_m, frame.camera, cfg)
     out: list[Observation] = []
     open_walls: list[Observation] = []
+    labels = segment_labels(grid.shape, segments)
     for seg in segments:
-        obs = _observation(seg, grid, frame, cfg)
+        obs = _observation(seg, grid, frame, cfg, segments, labels)
         if obs is not None:
             (open_walls if _open(obs) else out).append(obs)
     return out, open_walls
