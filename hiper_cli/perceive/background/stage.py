@@ -30,7 +30,8 @@ from hiper_cli.perceive.background.merge import (
 )
 from hiper_cli.perceive.background.not_walls import NotWalls
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extract_planes
-from hiper_cli.perceive.background.under import solid_below
+from hiper_cli.perceive.background.table_votes import TableVotes
+from hiper_cli.perceive.background.under import under_evidence
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Frame
 
@@ -59,8 +60,6 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
     if class_name is None and vertical and cfg.wall_view_bounded and view_bounded(grid, frame.camera, seg,
                                                                                  cfg):
         class_name = classify_plane(plane_map, contour_map, cfg, view_bounded=True)
-    if class_name == "table" and cfg.table_needs_legs and solid_below(grid, seg, cfg):
-        return None  # the top of a box stack, a cabinet or a bed: a solid front under its edge
     if class_name is None:
         return None
     uv = pf.to_2d(contour_cam)
@@ -68,6 +67,8 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
     thickness = max(2.0 * seg.rms_m, MIN_PLANE_THICKNESS_M)
     box = Box3D(pf.to_3d((lo + hi) / 2.0)[0], np.array([*(hi - lo), thickness]), pf.R)
     edges = edge_evidence(grid, frame.camera, seg, cfg) if class_name == "wall" and cfg.wall_bounds else None
+    # a table top on legs, or the top of a box stack, a cabinet or a bed (``under.py``)
+    under = under_evidence(grid, seg, cfg) if class_name == "table" and cfg.table_needs_legs else None
     if edges is not None and cfg.wall_fronts:
         for side in front_sides(grid, frame.camera, seg, segments, labels, cfg):
             edges[side] = "front"  # a furniture front before a wall
@@ -94,6 +95,7 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
             "num_points": seg.n_points,
             "method": cfg.method,
             **({"edges": edges} if edges is not None else {}),
+            **({"under": under} if under is not None else {}),
         },
     )
 
@@ -118,8 +120,9 @@ def observe_all(frame: Frame, cfg: BackgroundConfig) -> tuple[list[Observation],
 
 
 def observe(frame: Frame, cfg: BackgroundConfig) -> list[Observation]:
-    """Algorithm 1 (``ExtractOb``): the classified plane observations of one frame."""
-    return observe_all(frame, cfg)[0]
+    """Algorithm 1 (``ExtractOb``): the classified plane observations of one frame (a table top
+    this frame sees on a solid front is none)."""
+    return [o for o in observe_all(frame, cfg)[0] if o.data.get("under") != "solid"]
 
 
 def _copy(inst: Instance) -> Instance:
@@ -171,6 +174,7 @@ class BackgroundStage:
         self.config = BackgroundConfig.from_options(**options)
         self._last_keyframe_s: float | None = None
         self._not_walls = NotWalls(self.config)
+        self._table_votes = TableVotes(self.config)
         _warm_up(self.config.method)
 
     def is_keyframe(self, stamp_s: float) -> bool:
@@ -191,13 +195,15 @@ class BackgroundStage:
             mo = to_map(obs, frame.T_map_cam)
             if obs.class_name == "wall" and self._not_walls.covers(mo):
                 continue  # a plane seen ending in the room before: not a wall
+            if "under" in obs.data and not self._table_votes.vote(mo, obs.data["under"]):
+                continue  # a top most views saw on a solid front: not a table
             kept.append(mo)
         observations = [mo.obs for mo in kept]
         touched, deleted = merge_observations(kept, live, self.config)
         for obs in observations:
             if obs.class_name == "wall":
                 self._not_walls.note(obs.instance_uuid, obs.data.get("edges", {}))
-        deleted = vetoed + deleted + self._not_walls.settle(live)
+        deleted = vetoed + deleted + self._not_walls.settle(live) + self._table_votes.settle(live)
         touched = {uuid: inst for uuid, inst in touched.items() if uuid in live}
         timings = {
             "background_s": time.perf_counter() - start,

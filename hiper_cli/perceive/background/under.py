@@ -13,12 +13,16 @@ give no evidence.
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 
 from hiper_cli.perceive.background.config import BackgroundConfig
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid
 
-__all__ = ["solid_below"]
+__all__ = ["UnderEvidence", "solid_below", "under_evidence"]
+
+UnderEvidence = Literal["solid", "legs", "unknown"]
 
 # The depth of a vertical front seen from above grows as the probes go down it
 # (optical axis pitched down): about 0.26 m per metre of drop at 15 degrees.
@@ -27,11 +31,17 @@ FRONT_SLOPE = 0.3
 
 def solid_below(grid: SampleGrid, seg: PlaneSegment, cfg: BackgroundConfig) -> bool:
     """Whether the top ``seg`` (camera frame, on ``grid``) has a solid front under its near edge."""
+    return under_evidence(grid, seg, cfg) == "solid"
+
+
+def under_evidence(grid: SampleGrid, seg: PlaneSegment, cfg: BackgroundConfig) -> UnderEvidence:
+    """What the camera sees under the near edge of the top ``seg`` (camera frame, on ``grid``):
+    a ``solid`` front, under it on ``legs``, or too few columns with evidence (``unknown``)."""
     mask = seg.mask
     h, _ = mask.shape
     cols = np.flatnonzero(mask.any(axis=0))
     if len(cols) == 0:
-        return False
+        return "unknown"
     edge = h - 1 - np.argmax(mask[::-1, cols], axis=0)
     gap = max(round(cfg.wall_probe_gap_px / grid.stride), 1)
     reach = max(round(cfg.wall_probe_reach_px / grid.stride), gap)
@@ -51,5 +61,5 @@ def solid_below(grid: SampleGrid, seg: PlaneSegment, cfg: BackgroundConfig) -> b
     is_solid = has_edge & ~is_open & level.any(axis=1)
     n_open, n_solid = int(is_open.sum()), int(is_solid.sum())
     if n_open + n_solid < cfg.wall_probe_min_columns:
-        return False
-    return n_solid > cfg.wall_open_share * (n_open + n_solid)
+        return "unknown"
+    return "solid" if n_solid > cfg.wall_open_share * (n_open + n_solid) else "legs"
