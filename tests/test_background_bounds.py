@@ -12,6 +12,8 @@ from hiper_cli.perceive.runner import run_stages
 # a wardrobe 1.2 m wide, 2.0 m tall, 0.6 m deep, 1.4 m in front of the wall at y = 5
 WARDROBE = SceneBox(40, "cabinet", (2.4, 3.0, 0.0), (3.6, 3.6, 2.0))
 FROM_NEAR = look_at((3.0, 1.0, 1.2), (3.0, 5.0, 0.9))  # its top above the image: only its sides tell
+# from its front left: the camera sees its left side face run 0.6 m back, then the room behind
+FROM_LEFT = look_at((1.2, 1.0, 1.2), (2.4, 3.0, 0.7))
 
 
 def _walls_facing_minus_y(world):
@@ -25,7 +27,11 @@ def _run(boxes, poses, **options):
 
 
 def test_a_wardrobe_front_is_not_a_wall_but_the_wall_behind_it_is():
-    world = _run([*box_room(), WARDROBE], [FROM_NEAR])
+    """Seen from the front only, open at both its sides, the front stayed no wall before; a
+    wall between two doorways looks the same (it was deleted in corridors), so both sides
+    open no longer end a wall: the view that sees its side face a furniture depth long does
+    (``fronts.deep_sides``)."""
+    world = _run([*box_room(), WARDROBE], [FROM_NEAR, FROM_LEFT])
     offsets = sorted({round(abs(w.data["plane_map"][3]), 1) for w in _walls_facing_minus_y(world)})
     assert offsets == [5.0]
 
@@ -47,8 +53,10 @@ def test_edges_of_a_room_wall_are_closed_and_of_the_front_open_at_its_sides():
             centre = frame.T_map_cam[:3, :3] @ grid.points_cam[seg.mask].mean(axis=0) + frame.T_map_cam[:3, 3]
             by_offset[round(float(centre[1]), 1)] = edge_evidence(grid, frame.camera, seg, cfg)
     front, wall = by_offset[3.0], by_offset[5.0]
-    assert front["left"] == "open" and front["right"] == "open" and is_open(front)
+    # open at both its sides, as a wall between two doorways is: that alone ends no wall
+    assert front["left"] == "open" and front["right"] == "open" and not is_open(front)
     assert not is_open(wall)
+    assert is_open({**front, "left": "front"})
 
 
 def test_a_wardrobe_seen_near_after_far_stays_out_of_the_walls():

@@ -89,3 +89,47 @@ def test_a_wall_whose_end_turns_away_seen_face_on_is_a_wall():
     assert len(facing) == 1
     assert edge_evidence(grid, frame.camera, facing[0], cfg)["right"] == "open"
     assert front_sides(grid, frame.camera, facing[0], others, segment_labels(grid.shape, others), cfg) == []
+
+
+def _corridor_with_doorways():
+    """A corridor 2.6 m wide along x (0..14 m), its north wall at y = 2.6 (0.15 m thick) with
+    three doorways 1.1 m wide, 2.1 m high, rooms beyond it."""
+    boxes = [
+        SceneBox(1, "floor", (-0.2, -0.2, -0.1), (14.2, 7.0, 0.0)),
+        SceneBox(2, "ceiling", (-0.2, -0.2, 2.7), (14.2, 7.0, 2.8)),
+        SceneBox(3, "wall", (-0.2, -0.2, 0.0), (14.2, 0.0, 2.7)),
+        SceneBox(4, "wall", (-0.2, 6.7, 0.0), (14.2, 6.9, 2.7)),
+        SceneBox(5, "wall", (-0.2, 0.0, 0.0), (0.0, 6.7, 2.7)),
+        SceneBox(6, "wall", (14.0, 0.0, 0.0), (14.2, 6.7, 2.7)),
+        SceneBox(7, "wall", (4.5, 2.6, 0.0), (4.6, 6.7, 2.7)),
+        SceneBox(8, "wall", (8.5, 2.6, 0.0), (8.6, 6.7, 2.7)),
+    ]
+    x0 = 0.0
+    for a, b in ((2.0, 3.1), (6.0, 7.1), (10.0, 11.1)):
+        boxes.append(SceneBox(10, "wall", (x0, 2.6, 0.0), (a, 2.75, 2.7)))
+        boxes.append(SceneBox(10, "wall", (a, 2.6, 2.1), (b, 2.75, 2.7)))
+        x0 = b
+    boxes.append(SceneBox(10, "wall", (x0, 2.6, 0.0), (14.0, 2.75, 2.7)))
+    return boxes
+
+
+def test_the_wall_pieces_between_doorways_of_a_corridor_stay_walls():
+    # driving down the corridor the camera sees each piece between two doorways whole, open at
+    # both its sides; past them only the doorways' jambs, the wall's thickness deep, and the
+    # rooms beyond
+    poses = [_pitched(x, 1.0, x + dx, 2.6) for x in np.arange(1.0, 13.0, 1.0) for dx in (-1.5, 0.0, 1.5)]
+    world = _run(_corridor_with_doorways(), poses)
+    pieces = sorted(
+        (round(float(np.min(c[:, 0])), 1), round(float(np.max(c[:, 0])), 1))
+        for c in (np.asarray(w.data["contour_map"]) for w in _walls_at_y(world, 2.6))
+    )
+    assert any(lo > 2.9 and hi < 6.3 for lo, hi in pieces)  # the piece from 3.1 to 6.0 m
+    assert any(lo > 6.9 and hi < 10.3 for lo, hi in pieces)  # the piece from 7.1 to 10.0 m
+
+
+def test_a_free_standing_bookcase_seen_along_its_side_is_not_a_wall():
+    # 1.5 m wide, 0.7 m deep, 2.1 m tall, in the middle of the room; from its front left the
+    # camera sees its side face run 0.7 m back from its front's edge, then the room behind
+    case = SceneBox(43, "shelf", (2.0, 3.0, 0.0), (3.5, 3.7, 2.1))
+    poses = [_pitched(0.8, 1.0, 2.6, 3.0), _pitched(1.0, 1.4, 2.8, 3.0)]
+    assert _walls_at_y(_run([*ROOM, case], poses), 3.0) == []

@@ -144,11 +144,11 @@ def edge_evidence(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,
 
 def is_open(edges: dict[str, EdgeEvidence]) -> bool:
     """Whether a wall candidate ends in the room: open above or below (it does not reach the
-    ceiling or the floor), at both sides (a free-standing panel; a wall ends at a corner, or
-    at one doorway), or at one side in ``front`` of a parallel surface (``fronts.py``)."""
-    return edges.get("top") == "open" or edges.get("bottom") == "open" or (
-        edges.get("left") in ("open", "front") and edges.get("right") in ("open", "front")
-    ) or "front" in (edges.get("left"), edges.get("right"))
+    ceiling or the floor), or a ``front`` at one side (``fronts.py``: a parallel surface, or
+    its own side face, a furniture depth behind). Open at both sides alone is no end: a wall
+    between two doorways is, seen whole."""
+    sides = (edges.get("left"), edges.get("right"))
+    return edges.get("top") == "open" or edges.get("bottom") == "open" or "front" in sides
 
 
 def view_bounded(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,

@@ -91,7 +91,6 @@ class BackgroundConfig:
     # a vertical plane seen up to the image's top and down to an occluder in front is as tall
     # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
     wall_view_bounded: bool = True
-    wall_tall_m: float = 2.2  # seen reaching this high: a wall, though its views saw both ends open
     # a furniture front stands before a wall (``fronts.py``): past a side edge the camera sees a
     # plane parallel to it this far behind; deeper than a door's recess in its wall (a wall's
     # thickness), no deeper than furniture (wardrobes, fridges, shelves: 0.3-0.8 m)

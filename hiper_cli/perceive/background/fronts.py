@@ -1,17 +1,22 @@
-"""Whether a vertical plane stands in front of a parallel surface: a furniture front.
+"""Whether a vertical plane is a furniture front: something a furniture depth stands behind it.
 
 A wardrobe, a fridge or a row of bookshelves stands against a wall: past the side edge of
 its front the camera sees the wall behind it, parallel to the front and a furniture depth
-(0.3-0.8 m) back. A wall ends at a corner (the next wall is nearer, or turns away), at a
-doorway (the room beyond, at any depth) or at a door recessed into it (parallel, but only
-the wall's thickness back). ``front_sides`` probes past the left and right edges of a plane
-(``bounds.edge_probes``) and names the sides where the samples seen beyond the plane (those
-on no plane of the image, or on one parallel to it) lie,
-at their median, between ``wall_front_min_m`` and ``wall_front_max_m`` behind it, and in
-most image lines with evidence most of them lie within the inlier distance (``inlier_m``
-times their depth) of that median: on a surface parallel to the plane. Past a wall's end
-the room beyond, its floor or a wall turning away spread over many depths along a line. A wardrobe in a
-room's corner shows this at one side only; the other is the corner.
+(0.3-0.8 m) back (``front_sides``). Standing free in a room, seen from beside its front, it
+shows its own side face running that depth back from the front's edge and ending there
+(``deep_sides``). A wall ends at a corner (the next wall is nearer, or turns away and goes
+on), at a doorway (the wall's thickness, then the room beyond, at any depth) or at a door
+recessed into it (parallel, but only the wall's thickness back): a wall seen whole between
+two doorways is open at both its sides, and still a wall.
+
+``front_sides`` probes past the left and right edges of a plane (``bounds.edge_probes``)
+and names the sides where the samples seen beyond the plane (those on no plane of the
+image, or on one parallel to it) lie, at their median, between ``wall_front_min_m`` and
+``wall_front_max_m`` behind it, and in most image lines with evidence most of them lie
+within the inlier distance (``inlier_m`` times their depth) of that median: on a surface
+parallel to the plane. Past a wall's end the room beyond, its floor or a wall turning away
+spread over many depths along a line. A wardrobe in a room's corner shows this at one side
+only; the other is the corner.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from hiper_cli.perceive.background.config import BackgroundConfig
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["front_sides", "segment_labels"]
+__all__ = ["deep_sides", "front_sides", "segment_labels"]
 
 
 def segment_labels(shape: tuple[int, int], segments: Sequence[PlaneSegment]) -> NDArray[np.int64]:
@@ -92,3 +97,58 @@ def _parallel(on_back: NDArray[np.bool_], behind_m: NDArray[np.float64], depth_m
     u = across_m - (np.bincount(lines, across_m, on_back.shape[0]) / safe)[lines]
     d = behind_m - (np.bincount(lines, behind_m, on_back.shape[0]) / safe)[lines]
     return bool(abs(float(u @ d)) < float(u @ u))
+
+
+def deep_sides(grid: SampleGrid, seg: PlaneSegment, height_m: NDArray[np.float64],
+               cfg: BackgroundConfig) -> list[str]:
+    """The side edges (``left``, ``right``) of ``seg`` (camera frame, on ``grid``) past which
+    the camera sees a side face a furniture depth long: along the image line out from the
+    edge the surface goes on without a depth jump, away from the plane, above the floor
+    (``height_m``: every sample's height in the map), and ends, with a jump to farther,
+    between ``wall_front_min_m`` and ``wall_front_max_m`` behind the plane, in most of the
+    edge's lines. A wall's end at a doorway is its thickness deep; round a room's outer
+    corner the next wall goes on (at a grazing angle near the range's end it breaks up: a few
+    lines only)."""
+    normal, offset = seg.plane_cam[:3], float(seg.plane_cam[3])
+    w = seg.mask.shape[1]
+    reach = max(round(2.0 * cfg.wall_probe_reach_px / grid.stride), 2)
+    out: list[str] = []
+    rows = np.flatnonzero(seg.mask.any(axis=1))
+    if len(rows) == 0:
+        return out
+    for side, step in (("left", -1), ("right", 1)):
+        if step < 0:
+            edge = np.argmax(seg.mask[rows], axis=1)
+        else:
+            edge = w - 1 - np.argmax(seg.mask[rows, ::-1], axis=1)
+        cols = edge[:, None] + step * np.arange(reach + 1)[None, :]
+        inside = (cols >= 0) & (cols < w)
+        cols = np.clip(cols, 0, w - 1)
+        r = np.broadcast_to(rows[:, None], cols.shape)
+        z = grid.points_cam[r, cols, 2]
+        valid = inside & grid.valid[r, cols]
+        usable = valid & (height_m[r, cols] > cfg.floor_max_height_m)
+        behind = -(grid.points_cam[r, cols] @ normal + offset)
+        dz = np.diff(z, axis=1)
+        smooth = np.abs(dz) <= cfg.join_jump_frac * z[:, :-1]
+        # beyond the side face: a furniture depth farther (a wall turning away at a grazing
+        # angle breaks into smaller steps), or no return where the face ended well within
+        # range (nothing there; at the range's end a wall turning away fades out instead)
+        no_return = inside[:, 1:] & ~valid[:, 1:] & (z[:, :-1] < cfg.wall_probe_max_depth_m)
+        farther = (valid[:, 1:] & (np.diff(behind, axis=1) >= cfg.wall_front_min_m)) | no_return
+        n_deep = n_other = 0
+        for k in range(len(rows)):
+            # the run: samples 0 .. end - 1 joined without a jump
+            joined = smooth[k] & usable[k, 1:] & usable[k, :-1]
+            end = int(np.argmin(joined)) + 1 if not joined.all() else reach + 1
+            if end < 2:
+                continue  # no side face seen past the edge
+            depth_m = float(behind[k, :end].max())
+            if depth_m > cfg.wall_front_max_m:
+                n_other += 1  # it goes on: round a room's corner, the next wall
+            elif end <= reach and farther[k, end - 1]:
+                n_deep += int(depth_m >= cfg.wall_front_min_m)  # it ends, with a jump back
+                n_other += int(depth_m < cfg.wall_front_min_m)  # a wall's thickness
+        if n_deep >= max(cfg.wall_probe_min_columns, cfg.wall_open_share * len(rows)) and n_deep > n_other:
+            out.append(side)
+    return out

@@ -20,7 +20,7 @@ from hiper_cli.perceive.background.contour import (
     transform_plane,
     transform_points,
 )
-from hiper_cli.perceive.background.fronts import front_sides, segment_labels
+from hiper_cli.perceive.background.fronts import deep_sides, front_sides, segment_labels
 from hiper_cli.perceive.background.merge import (
     MapObservation,
     match_instances,
@@ -72,6 +72,9 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
     if edges is not None and cfg.wall_fronts:
         for side in front_sides(grid, frame.camera, seg, segments, labels, cfg):
             edges[side] = "front"  # a furniture front before a wall
+        height_m = grid.points_cam @ frame.T_map_cam[2, :3] + frame.T_map_cam[2, 3]
+        for side in deep_sides(grid, seg, height_m, cfg):
+            edges[side] = "front"  # a furniture front with a side face of furniture depth
     rows, cols = np.nonzero(seg.mask)
     pick = np.linspace(0, len(rows) - 1, min(cfg.pixel_sample, len(rows))).astype(int)
     pixels_uv = np.stack([cols[pick], rows[pick]], axis=1) * grid.stride
@@ -200,10 +203,7 @@ class BackgroundStage:
             kept.append(mo)
         observations = [mo.obs for mo in kept]
         touched, deleted = merge_observations(kept, live, self.config)
-        for obs in observations:
-            if obs.class_name == "wall":
-                self._not_walls.note(obs.instance_uuid, obs.data.get("edges", {}))
-        deleted = vetoed + deleted + self._not_walls.settle(live) + self._table_votes.settle(live)
+        deleted = vetoed + deleted + self._table_votes.settle(live)
         touched = {uuid: inst for uuid, inst in touched.items() if uuid in live}
         timings = {
             "background_s": time.perf_counter() - start,
