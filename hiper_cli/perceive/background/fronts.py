@@ -136,19 +136,18 @@ def deep_sides(grid: SampleGrid, seg: PlaneSegment, height_m: NDArray[np.float64
         # range (nothing there; at the range's end a wall turning away fades out instead)
         no_return = inside[:, 1:] & ~valid[:, 1:] & (z[:, :-1] < cfg.wall_probe_max_depth_m)
         farther = (valid[:, 1:] & (np.diff(behind, axis=1) >= cfg.wall_front_min_m)) | no_return
-        n_deep = n_other = 0
-        for k in range(len(rows)):
-            # the run: samples 0 .. end - 1 joined without a jump
-            joined = smooth[k] & usable[k, 1:] & usable[k, :-1]
-            end = int(np.argmin(joined)) + 1 if not joined.all() else reach + 1
-            if end < 2:
-                continue  # no side face seen past the edge
-            depth_m = float(behind[k, :end].max())
-            if depth_m > cfg.wall_front_max_m:
-                n_other += 1  # it goes on: round a room's corner, the next wall
-            elif end <= reach and farther[k, end - 1]:
-                n_deep += int(depth_m >= cfg.wall_front_min_m)  # it ends, with a jump back
-                n_other += int(depth_m < cfg.wall_front_min_m)  # a wall's thickness
+        # the run: samples 0 .. end - 1 of a line, joined without a jump
+        joined = smooth & usable[:, 1:] & usable[:, :-1]
+        end = np.argmin(np.concatenate([joined, np.zeros((len(rows), 1), dtype=bool)], axis=1), axis=1) + 1
+        in_run = np.arange(reach + 1)[None, :] < end[:, None]
+        depth_m = np.where(in_run, behind, -np.inf).max(axis=1)
+        seen = end >= 2  # a side face seen past the edge
+        goes_on = seen & (depth_m > cfg.wall_front_max_m)  # round a room's corner, the next wall
+        ends = seen & ~goes_on & (end <= reach)
+        ends &= farther[np.arange(len(rows)), np.minimum(end, reach) - 1]  # with a jump back
+        n_deep = int(np.sum(ends & (depth_m >= cfg.wall_front_min_m)))
+        thin = ends & (depth_m < cfg.wall_front_min_m)  # a wall's thickness
+        n_other = int(np.sum(goes_on)) + int(np.sum(thin))
         if n_deep >= max(cfg.wall_probe_min_columns, cfg.wall_open_share * len(rows)) and n_deep > n_other:
             out.append(side)
     return out
