@@ -17,8 +17,10 @@ The definitions follow the worlds' reference scorer (``gt/README.md`` of each wo
   is put down to the class of the nearest true object it would match but for its class, or to
   ``nothing`` (``unmatched``; ``unknown_on_nothing`` is the share of unknown instances that lie
   on no real object); ``persons_per_person`` = person instances per true person observed;
-- localisation: centre error of matched static objects; person speed: the mean speed along
-  the trajectory of each person matched to a walker, against the walker's own speed.
+- localisation: centre error of matched static objects; person speed: of each person matched
+  to a walker, the median filtered speed at its stamps where the walker walked, against the
+  median true speed there (the worlds' walkers keep one speed; a simulated one stops for
+  others, and a filter cannot tell a stop from a slow walk by its median).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ MATCH_M = 0.5
 MATCH_IOU = 0.25
 GRID = np.linspace(-0.8, 0.8, 5)
 MIN_PIECE_M2 = 1.0
+WALKING_MPS = 0.1  # a walker this fast (truth) walks; slower, it stands
 
 FloatArray = NDArray[np.float64]
 
@@ -162,6 +165,23 @@ def _nearest_class(inst: Instance, gt: list[TruthInstance], truth: Truth) -> str
     return best[1] if best else "nothing"
 
 
+def _walking_speeds(truth: Truth, t: TruthInstance, rows: list[list[float]]) -> tuple[float, float] | None:
+    """(predicted, true) speed of a walker while it walked and the instance saw it: at the
+    instance's trajectory stamps where the truth walked (``WALKING_MPS``), the median of the
+    instance's filtered speed and of the true one (a simulated walker stops for others; the
+    worlds' keep walking). None where the truth has no velocities there."""
+    track = truth.tracks.get(t.id)
+    arr = np.asarray([r[:7] for r in rows], np.float64).reshape(-1, 7)
+    if track is None or len(track) < 2 or len(arr) == 0 or not np.any(arr[:, 4:7]):
+        return None
+    stamps = arr[:, 0]
+    true = np.hypot(np.interp(stamps, track[:, 0], track[:, 4]), np.interp(stamps, track[:, 0], track[:, 5]))
+    walking = (stamps >= track[0, 0]) & (stamps <= track[-1, 0]) & (true > WALKING_MPS)
+    if not walking.any():
+        return None
+    return float(np.median(np.linalg.norm(arr[walking, 4:7], axis=1))), float(np.median(true[walking]))
+
+
 def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, Any]:
     """Table III style figures of the foreground ``instances``."""
     preds = list(instances)
@@ -198,8 +218,12 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
     for pi, (tid, _) in matched.items():
         t = truth.instances[tid]
         if t.state == "dynamic" and t.speed_mps is not None:
-            speed = typical_speed_mps(preds[pi].data.get("trajectory") or [])
-            if speed is not None:
+            rows = preds[pi].data.get("trajectory") or []
+            walked = _walking_speeds(truth, t, rows)
+            speed = typical_speed_mps(rows)
+            if walked is not None:
+                speeds.append(walked)
+            elif speed is not None:
                 speeds.append((speed, t.speed_mps))
     return {
         "instances": len(preds),

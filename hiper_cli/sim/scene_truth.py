@@ -51,7 +51,9 @@ class StaticTruth:
 
 @dataclass(frozen=True)
 class DynamicTruth:
-    """One moving instance: its [t, x, y, z] box-centre rows, body extent and true speed."""
+    """One moving instance: its [t, x, y, z] box-centre rows, body extent and preferred speed
+    (people slow down and stop for each other and the robot: ``instances.json`` gives the
+    speed it walked at while seen, ``_seen_speed_mps``)."""
 
     id: int
     name: str
@@ -75,6 +77,7 @@ class SceneTruthRecorder:
         self.first_t = np.full(n_ids, np.inf)
         self.last_t = np.full(n_ids, -np.inf)
         self.n_frames = 0
+        self._seen_stamps: dict[int, list[float]] = {}  # moving instances: stamps they were seen
         self._static: list[tuple[NDArray[np.float32], NDArray[np.int8], NDArray[np.uint16]]] = []
         self._dynamic: list[tuple[NDArray[np.float32], NDArray[np.uint16], NDArray[np.float64]]] = []
         self._sampled = 0
@@ -104,8 +107,12 @@ class SceneTruthRecorder:
         self.max_in_range = np.maximum(self.max_in_range, ranged)
         self.first_t = np.where(seen > 0, np.minimum(self.first_t, stamp_s), self.first_t)
         self.last_t = np.where(seen > 0, np.maximum(self.last_t, stamp_s), self.last_t)
+        movers = frozenset(dynamic_ids)
+        for i in movers:
+            if 0 <= i < self.n_ids and ranged[i] > 0:
+                self._seen_stamps.setdefault(i, []).append(stamp_s)
         if self.n_frames % SAMPLE_EVERY == 0:
-            self._sample(stamp_s, hit_ids, true_z_m, normal_cam, T_map_cam, frozenset(dynamic_ids))
+            self._sample(stamp_s, hit_ids, true_z_m, normal_cam, T_map_cam, movers)
         self.n_frames += 1
 
     def _sample(
@@ -218,11 +225,24 @@ class SceneTruthRecorder:
         return {
             "id": d.id, "name": d.name, "model": d.name, "class": d.class_name, "alt_classes": [],
             "layer": "foreground", "static": False, **_box(lo, hi),
-            "speed_mps": d.speed_mps, "active_from_t": float(d.rows[0, 0]),
+            "speed_mps": self._seen_speed_mps(d), "preferred_speed_mps": d.speed_mps,
+            "active_from_t": float(d.rows[0, 0]),
             "body_size": [float(v) for v in d.extent_m],
             "trajectory": [[round(float(v), 5) for v in row] for row in d.rows],
             **self._visibility(d.id),
         }
+
+
+    def _seen_speed_mps(self, d: DynamicTruth) -> float:
+        """The median horizontal speed of ``d`` at the frames it was seen with depth: what a
+        perceiver can measure (the preferred speed where it was never seen)."""
+        seen = np.asarray(self._seen_stamps.get(d.id, []))
+        if len(d.rows) < 2 or len(seen) == 0:
+            return d.speed_mps
+        t = d.rows[:, 0]
+        v = np.gradient(d.rows[:, 1:3], t, axis=0)
+        at = np.clip(np.searchsorted(t, seen), 0, len(t) - 1)
+        return round(float(np.median(np.hypot(v[at, 0], v[at, 1]))), 4)
 
 
 def _box(lo: FloatArray, hi: FloatArray) -> dict[str, list[float]]:
