@@ -249,6 +249,13 @@ class MatchConfig(_Part):
     unknown_class: str = "unknown"
     keep_unknown: bool = True
     """Track blobs that matched no detection as class ``unknown`` (the paper does)."""
+    fixture_classes: tuple[str, ...] = ("sink", "toilet")
+    """Plumbing fixtures (``plausible.attached``): a blob named one of these classes is ``unknown``
+    unless it stands against a wall (within ``fixture_reach_m`` of a background wall) or is
+    built into a counter (its centre inside a background table top's footprint, its top within
+    ``fixture_reach_m`` of the top's height). Pipes come out of walls; a round stool seen from
+    above, standing free in the room, is no sink (empty: off)."""
+    fixture_reach_m: float = 0.3
     unknown_max_extent_m: float = 1.0
     """An unmatched blob is seen *whole* (``whole.py``: evidence for an ``unknown`` instance)
     only when inside the image (not within one ``pixel_step`` of its edge: a shelf, a wall or a
@@ -260,6 +267,8 @@ class MatchConfig(_Part):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        _as_tuples(self, ("fixture_classes",))
+        _nonnegative(self, ("fixture_reach_m",))
         if not 0.0 <= self.iou_threshold <= 1.0:
             raise ConfigError(f"iou_threshold must be in [0, 1], got {self.iou_threshold}")
 
@@ -297,6 +306,15 @@ class TrackerConfig(_Part):
     """... and when that class holds at least this share of the track's (score-weighted)
     known-class votes: a track whose detections keep swapping between two classes (a person
     half of the time taken for a teddy bear) stays ``unknown`` instead of guessing."""
+    class_sizes: bool = True
+    """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): an observation
+    whose blob is longer than the largest instance of the class it was named is ``unknown``,
+    and a track cannot take a class when every view that named it so, with the blob seen whole
+    (inside the image, not hidden in part by something nearer), showed an object shorter than
+    the smallest instance (a 1 m book display is no bed, a trash can no cup). A view can show
+    less of an object, never more."""
+    class_size_tolerance: float = 0.15
+    """The sizes' margin for measurement: the largest times 1 + this, the smallest times 1 - this."""
     class_mismatch_m: float = 0.5
     """Association cost added (inside the gate) when a track and an observation have
     different known classes: same-class pairs win, a confused detection still joins."""
@@ -432,7 +450,7 @@ class TrackerConfig(_Part):
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m"))
-        _in_unit_interval(self, ("stitch_min_overlap",))
+        _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance"))
 
 
 def _own(cls: type, base: type | None) -> frozenset[str]:
@@ -467,10 +485,17 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
     exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED
     """Detector classes dropped before matching (the paper excluded classes not present, such as
     boat and traffic light): outdoor COCO classes and ``dining table`` (tables are background)."""
+    carried_classes: tuple[str, ...] = ("backpack", "umbrella", "handbag", "tie", "suitcase", "cell phone")
+    """Things people carry (``carried.py``): a detection of one of these classes whose box lies
+    inside a walker detection's box (``carried_containment`` of its area) is part of that person
+    (a bag on a walker's arm, a phone at an ear) and is dropped before refinement, so the
+    person's box names the blob; empty: off."""
+    carried_containment: float = 0.8
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        _as_tuples(self, ("classes", "exclude_classes"))
+        _as_tuples(self, ("classes", "exclude_classes", "carried_classes"))
+        _in_unit_interval(self, ("carried_containment",))
 
     @classmethod
     def from_options(cls, **options: Any) -> ForegroundConfig:

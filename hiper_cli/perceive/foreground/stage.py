@@ -27,15 +27,17 @@ from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
+from hiper_cli.perceive.foreground.carried import drop_carried
 from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
+from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.tables import drop_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
-from hiper_cli.perceive.foreground.whole import seen_whole
+from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
 
@@ -221,6 +223,8 @@ class ForegroundStage:
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
+        walls = [inst.box for inst in world.background.values() if inst.class_name == "wall"]
+        tops = support_boxes(inst for inst in world.background.values() if inst.class_name == "table")
         self._floor_z_m = floor_height_m(world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
             for inst in world.background.values():
@@ -246,6 +250,8 @@ class ForegroundStage:
         else:
             dets, detect_s = self._detect_timed(frame)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
+        dets = drop_carried(dets, cfg.carried_classes, cfg.walker_classes, cfg.carried_containment,
+                            cfg.min_detection_score)
         t_det = time.perf_counter()
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
@@ -269,10 +275,22 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
+            longest = None
+            if match.detection_index is not None and cfg.class_sizes:
+                longest = longest_m(blob.points_map, float(blob.extent_map_m[2]))
             if match.detection_index is not None and not (
                 self._fits_priors(match.class_name, blob) and self._stands(match.class_name, blob)
+                and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
+                and (match.class_name not in cfg.fixture_classes
+                     or attached(blob.points_map, walls, tops, cfg.fixture_reach_m))
             ):
                 match = Match(cfg.unknown_class, 0.0, None, match.iou)
+                longest = None
+            if longest is not None and min_longest_m(match.class_name, cfg.class_size_tolerance) > 0 and (
+                not inside_image(blob, cfg.pixel_step, frame.camera)
+                or occluded(blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step)
+            ):
+                longest = None  # cut by the border or hidden in part: no view of its whole length
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
@@ -285,6 +303,7 @@ class ForegroundStage:
                     appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
                     standing=self._standing_box(blob),  # a walking track takes any blob as standing
                     bounds_map_m=_corners(blob),
+                    longest_m=longest,
                 )
             )
         t_match = time.perf_counter()

@@ -195,6 +195,8 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
         old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
     for cls, count in new.class_counts.items():
         old.class_counts[cls] = old.class_counts.get(cls, 0) + count
+    for cls, longest in new.class_longest_m.items():
+        old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
     old.score_sum += new.score_sum
     old._class_name = None
     old.standing_tops_m.extend(new.standing_tops_m)

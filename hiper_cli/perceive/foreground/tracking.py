@@ -53,6 +53,7 @@ from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, ne
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
+from hiper_cli.perceive.foreground.plausible import min_longest_m
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
@@ -102,6 +103,10 @@ class Measurement:
     bounds_map_m: tuple[FloatArray, FloatArray] | None = None
     """(lower, upper) corners of the blob's box, map frame (``SeenBox``); None: the box of
     ``center_map_m`` and ``extent_map_m``."""
+    longest_m: float | None = None
+    """The longest dimension of a named blob seen whole (``plausible.longest_m``): what the view
+    shows of the object's size; None: cut by the image's border, hidden in part by something
+    nearer (``whole.occluded``), of a class without a lower size bound, or not named."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -153,8 +158,11 @@ class Track:
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
     class_counts: dict[str, int] = field(default_factory=dict)
+    # per known class, the longest of its blobs seen inside the image (``Measurement.longest_m``)
+    class_longest_m: dict[str, float] = field(default_factory=dict)
     min_class_observations: int = 1
     min_class_share: float = 0.0
+    size_tolerance: float | None = None  # ``class_size_tolerance`` when ``class_sizes`` is on
     score_sum: float = 0.0
     observation_uuids: list[str] = field(default_factory=list)
     # one row per update: ``model.TRAJECTORY_COLUMNS`` (stamp, position, velocity; map frame)
@@ -177,15 +185,19 @@ class Track:
     @property
     def class_name(self) -> str:
         """The vote winner among the known classes seen at least ``min_class_observations``
-        times, when it holds at least ``min_class_share`` of all known-class votes (two
-        classes that keep swapping leave the track ``unknown``) and outweighs ``unknown``."""
+        times (and not too short for the class, ``_long_enough``), when it holds at least
+        ``min_class_share`` of all known-class votes (two classes that keep swapping leave the
+        track ``unknown``) and outweighs ``unknown``."""
         if self._class_name is None:
             self._class_name = self._vote_winner()
         return self._class_name
 
     def _vote_winner(self) -> str:
         known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
-        eligible = [k for k in sorted(known) if self.class_counts.get(k, 0) >= self.min_class_observations]
+        eligible = [
+            k for k in sorted(known)
+            if self.class_counts.get(k, 0) >= self.min_class_observations and self._long_enough(k)
+        ]
         if not eligible:
             return UNKNOWN
         best = max(eligible, key=lambda k: known[k])
@@ -194,6 +206,27 @@ class Track:
         if self.class_votes.get(UNKNOWN, 0.0) > known[best]:
             return UNKNOWN
         return best
+
+    @property
+    def search_class(self) -> str:
+        """The class that decides whether the track searches when lost (``search_classes``):
+        its class, or while ``unknown`` the known class detections named most when they named
+        it at least ``min_class_observations`` times (a class the vote turned down for its
+        share or its size still says what kind of thing it is: a book display taken for a bed
+        does not walk away)."""
+        name = self.class_name
+        if name != UNKNOWN:
+            return name
+        named = [k for k, n in self.class_counts.items() if k != UNKNOWN and n >= self.min_class_observations]
+        return max(sorted(named), key=lambda k: self.class_votes[k]) if named else UNKNOWN
+
+    def _long_enough(self, class_name: str) -> bool:
+        """False when every view that named the track ``class_name`` with its blob seen whole
+        showed an object shorter than the class's smallest instance (``class_sizes``)."""
+        seen = self.class_longest_m.get(class_name)
+        if self.size_tolerance is None or seen is None:
+            return True
+        return seen >= min_longest_m(class_name, self.size_tolerance)
 
     @property
     def confidence(self) -> float:
@@ -415,7 +448,7 @@ class Tracker:
         grace = max(self.config.velocity_decay_grace_s, DECAY_GRACE_FRAMES * dt)
         if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
-        relaxes = self.config.velocity_relax_static or track.class_name in self.config.search_classes
+        relaxes = self.config.velocity_relax_static or track.search_class in self.config.search_classes
         prior = self.config.velocity_prior_mps**2 if relaxes else 0.0
         factor, scale, relax = _decay_terms(
             dt, self.config.velocity_decay_s, prior, self.config.vertical_noise_ratio**2
@@ -478,6 +511,9 @@ class Tracker:
         weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
         track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
         track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
+        if m.longest_m is not None and m.class_name != UNKNOWN:
+            seen = track.class_longest_m.get(m.class_name, 0.0)
+            track.class_longest_m[m.class_name] = max(seen, m.longest_m)
         track._class_name = None
         track.score_sum += m.score
         if m.whole:
@@ -502,7 +538,7 @@ class Tracker:
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
             return learned, learned
-        searching = track.class_name in cfg.search_classes and _was_moving(track, cfg)
+        searching = track.search_class in cfg.search_classes and _was_moving(track, cfg)
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
@@ -695,6 +731,7 @@ class Tracker:
             first_center=np.asarray(center, dtype=np.float64).copy(),
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
+            size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
         )
         track.seen.add(*m.corners())
         if walks:

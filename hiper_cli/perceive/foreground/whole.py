@@ -5,17 +5,26 @@ image's edge is cut there (a shelf, a wall or a floor remnant seen through the b
 longer than ``unknown_max_extent_m`` is structure or several things, and a flat one (its
 points within a centimetre or two of one plane, beyond the depth noise) is a piece of a
 surface the background did not claim: a wall, a floor, a furniture side.
+
+A blob inside the image may still be cut by something nearer: a bed seen through a doorway, a
+couch behind a chair (``occluded``). Its outline then borders nearer surfaces; an object seen
+whole borders only farther ones, or what it stands on.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["seen_whole", "thickness_m"]
+__all__ = ["inside_image", "occluded", "seen_whole", "thickness_m"]
+
+OCCLUDER_MARGIN_M = 0.15  # a surface this much nearer than the blob beside it stands in front
+OCCLUDER_RING_CELLS = 2  # ... within this many samples of the blob's outline
+OCCLUDED_SHARE = 0.1  # a blob whose outline borders occluders for this share of it is cut
 
 
 def thickness_m(points: np.ndarray) -> float:
@@ -27,14 +36,58 @@ def thickness_m(points: np.ndarray) -> float:
     return float(np.sqrt(max(float(np.linalg.eigvalsh(cov)[0]), 0.0)))
 
 
+def inside_image(blob: Blob, pixel_step: int, camera: CameraIntrinsics) -> bool:
+    """Whether ``blob``'s image box keeps more than one ``pixel_step`` from the image's edges:
+    a blob reaching the border is cut there and shows only a part of its object."""
+    x0, y0, x1, y1 = (float(v) for v in blob.image_box_xyxy)
+    edge = pixel_step
+    return not (x0 <= edge or y0 <= edge or x1 >= camera.width - edge or y1 >= camera.height - edge)
+
+
 def seen_whole(blob: Blob, config: ForegroundConfig, camera: CameraIntrinsics) -> bool:
     """Whether ``blob`` lies inside the image, is compact and is not flat."""
-    x0, y0, x1, y1 = (float(v) for v in blob.image_box_xyxy)
-    edge = config.pixel_step
-    if x0 <= edge or y0 <= edge or x1 >= camera.width - edge or y1 >= camera.height - edge:
+    if not inside_image(blob, config.pixel_step, camera):
         return False
     if float(np.max(blob.extent_map_m)) > config.unknown_max_extent_m:
         return False
     depth = float(np.median(blob.points_cam[:, 2]))
     flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
     return thickness_m(blob.points_cam) >= flat_m
+
+
+def occluded(
+    blob: Blob, depth_m: NDArray[np.float32], camera: CameraIntrinsics, T_map_cam: NDArray[np.float64],
+    pixel_step: int,
+) -> bool:
+    """Whether something nearer hides a part of ``blob``: of the samples around its outline
+    (within ``OCCLUDER_RING_CELLS`` samples), at least ``OCCLUDED_SHARE`` are more than
+    ``OCCLUDER_MARGIN_M`` nearer than the blob beside them and lie above the blob's base (what
+    an object stands on lies below it and in front of it, and hides nothing)."""
+    from scipy.ndimage import binary_dilation, minimum_filter
+
+    step, off = pixel_step, pixel_step // 2
+    grid = blob.pixels_uv // step
+    reach = OCCLUDER_RING_CELLS
+    lo = np.maximum(grid.min(axis=0) - reach, 0)
+    n_u, n_v = (camera.width - off + step - 1) // step, (camera.height - off + step - 1) // step
+    hi = np.minimum(grid.max(axis=0) + reach + 1, [n_u, n_v])
+    shape = (int(hi[1] - lo[1]), int(hi[0] - lo[0]))
+    mask = np.zeros(shape, dtype=bool)
+    mask[grid[:, 1] - lo[1], grid[:, 0] - lo[0]] = True
+    vs = off + step * np.arange(lo[1], hi[1])
+    us = off + step * np.arange(lo[0], hi[0])
+    z = depth_m[np.ix_(vs, us)].astype(np.float64)
+    ring = binary_dilation(mask, iterations=reach) & ~mask
+    if not ring.any():
+        return False
+    beside = minimum_filter(np.where(mask, z, np.inf), size=2 * reach + 1)
+    nearer = ring & (z > 0) & (z < beside - OCCLUDER_MARGIN_M)
+    if nearer.any():
+        rows, cols = np.nonzero(nearer)
+        zz = z[rows, cols]
+        x = (us[cols] - camera.cx) / camera.fx * zz
+        y = (vs[rows] - camera.cy) / camera.fy * zz
+        height = T_map_cam[2, :3] @ np.stack([x, y, zz]) + T_map_cam[2, 3]
+        base = float(blob.bounds_map[0][2])
+        nearer[rows, cols] = height > base + OCCLUDER_MARGIN_M
+    return bool(nearer.sum() >= OCCLUDED_SHARE * ring.sum())
