@@ -10,7 +10,7 @@ from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.carried import drop_carried
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
-from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
+from hiper_cli.perceive.foreground.tracking import Measurement, Tracker, object_box
 from hiper_cli.perceive.stage import World
 from hiper_cli.types import Detections, Frame
 from tests.fg_scene import SceneBox, background_instances, make_frame, person, pose_looking_x, room
@@ -68,7 +68,8 @@ def test_one_whole_view_of_the_full_length_is_enough():
 
 def test_a_track_named_a_static_class_does_not_search_when_its_class_is_turned_down():
     """A book display taken for a bed, whose blob slid while the robot turned: ``unknown`` for
-    its size, but no walker; lost, it does not widen its gate to take other objects."""
+    its size, but no walker; lost, it does not widen its gate to take other objects, and its
+    box is the union of its blobs."""
     config = TrackerConfig()
     tracker = Tracker(config)
     for k in range(12):
@@ -79,6 +80,8 @@ def test_a_track_named_a_static_class_does_not_search_when_its_class_is_turned_d
     assert track.class_name == "unknown" and track.search_class == "bed"
     base, gate = tracker._gate(track, 12 / RATE_HZ + 3.0)
     assert gate == base
+    centre, _ = object_box(track, config)  # where its blobs were, not where the last one slid to
+    assert centre[0] == pytest.approx(3.0 + 0.05 * 11 / 2, abs=0.02)
     unnamed = Tracker(config)  # the same blobs never named: may be a person not named yet
     for k in range(12):
         centre = np.array([3.0 + 0.05 * k, 0.0, 0.5])

@@ -318,8 +318,13 @@ def is_static(track: Track, config: TrackerConfig) -> bool:
 def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatArray]:
     """(centre, extent), map frame, of the object a track is: a static one's seen box (the union
     of its blobs, ``SeenBox``); a walker's or a moving object's filtered box where it was last
-    updated (not extrapolated past its last observation)."""
-    if is_static(track, config):
+    updated (not extrapolated past its last observation). An ``unknown`` track detections named
+    a static class (``Track.search_class``) is judged as that class: a book display turned down
+    as a bed, whose blob slid while the robot turned past it, is where its blobs were."""
+    named = track.search_class
+    if is_static(track, config) or (
+        named != track.class_name and named not in config.walker_classes and not track.seen.moved()
+    ):
         found = track.seen.box()
         if found is not None:
             return found
