@@ -79,13 +79,13 @@ def test_walker_becomes_one_dynamic_person_with_its_speed():
 def test_observations_carry_the_low_level_data():
     stage = ForegroundStage(detector="log", pixel_step=2, confirm_hits=2)
     world = World(background=background_instances(room()))
-    frames = walker_frames(3)
+    frames = walker_frames(5)  # named 4 times: a person (a class never named is withdrawn)
     results = []
     for f in frames:
         r = stage.process(f, world)
         world.apply(r)
         results.append(r)
-    obs = results[-1].observations[0]
+    obs = results[2].observations[0]
     assert obs.class_name == "person" and obs.frame_id == "camera" and obs.pose_id == 2
     assert set(obs.data) >= {"image_box_xyxy", "points_cam", "pixels_uv", "detection", "center_map"}
     assert obs.data["detection"]["class"] == "person"

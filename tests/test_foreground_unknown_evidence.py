@@ -66,3 +66,107 @@ def test_without_the_rule_three_hits_make_an_unknown_instance():
 
 def test_a_detected_object_keeps_the_usual_evidence():
     assert _track(ForegroundConfig(), 5, whole=False, cls="chair")
+
+
+# --- the evidence holds for the class an instance carries, all its life (unknown_evidence_held)
+
+
+def _feed(tracker, views, start=0):
+    """One measurement per frame at one place: ``views`` a string of W (unknown, whole),
+    B (unknown, cut by the border: not whole), N (named ``bed``) and P (named ``person``).
+    Returns the uuids of the instances changed and withdrawn per frame."""
+    changed, withdrawn = [], []
+    for k, view in enumerate(views, start):
+        cls = {"N": "bed", "P": "person"}.get(view, "unknown")
+        m = Measurement(np.array([1.0, 2.0, 0.5]), np.array([0.3, 0.3, 0.3]), cls,
+                        0.0 if cls == "unknown" else 0.9, f"o{k}", whole=view != "B")
+        out, _ = tracker.step(k / RATE_HZ, [m])
+        changed.append([t.uuid for t in out])
+        withdrawn.append(list(tracker.withdrawn))
+    return changed, withdrawn
+
+
+def test_an_unknown_instance_that_then_takes_pieces_of_structure_is_withdrawn():
+    # seen whole for 0.67 s (an instance), then 15 views cut by the border: 10 of 25 whole
+    tracker = Tracker(ForegroundConfig())
+    changed, withdrawn = _feed(tracker, "W" * 10 + "B" * 15)
+    (uuid,) = {u for c in changed for u in c}
+    assert [k for k, w in enumerate(withdrawn) if w] == [20]  # 10 whole of 21: less than half
+    assert withdrawn[20] == [uuid]
+    assert tracker.close_all() == []
+    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    _feed(old, "W" * 10 + "B" * 15)
+    assert len(old.close_all()) == 1
+
+
+def test_a_withdrawn_track_seen_whole_again_comes_back():
+    tracker = Tracker(ForegroundConfig())
+    _feed(tracker, "W" * 10 + "B" * 15 + "W" * 20)  # 30 whole of 45
+    (track,) = tracker.close_all()
+    assert track.class_name == "unknown" and track.hits == 45
+
+
+def test_two_detections_do_not_make_an_unknown_instance_of_a_desk():
+    # a desk named `bed` twice (confirmed on its third view, most of them named), then cut by
+    # the border: the class never comes and it is never seen whole
+    tracker = Tracker(ForegroundConfig())
+    changed, withdrawn = _feed(tracker, "NNB" + "B" * 40)
+    assert changed[2] and not any(changed[4:])
+    assert withdrawn[3] == changed[2]
+    assert tracker.close_all() == []
+    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    _feed(old, "NNB" + "B" * 40)
+    assert [t.class_name for t in old.close_all()] == ["unknown"]
+
+
+def test_a_blip_named_in_two_frames_is_no_instance_when_it_ends():
+    tracker = Tracker(ForegroundConfig())
+    changed, _ = _feed(tracker, "NNB")
+    assert changed[2]  # confirmed while it lives: a class may still come
+    closed = []
+    for k in range(3, 40):  # unseen for 2.5 s: closed, and withdrawn
+        tracker.step(k / RATE_HZ, [])
+        closed += tracker.withdrawn
+    assert closed == changed[2]
+    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    _feed(old, "NNB")
+    assert [t.class_name for t in old.close_all()] == ["unknown"]
+
+
+def test_a_person_is_still_confirmed_on_its_third_named_view():
+    tracker = Tracker(ForegroundConfig())
+    changed, withdrawn = _feed(tracker, "PPP" + "P" * 10)
+    assert not changed[1] and changed[2]
+    assert not any(withdrawn)
+    (track,) = tracker.close_all()
+    assert track.class_name == "person"
+
+
+def test_the_stage_deletes_the_instance_of_a_withdrawn_track():
+    """A box no detector names, seen whole for 20 frames, then cut by the image's left border
+    for 30 (the camera moved aside): its instance goes from the world and the knowledge base."""
+    from hiper_cli.perceive.foreground import ForegroundStage
+    from hiper_cli.perceive.runner import run_stages
+    from hiper_cli.perceive.stage import World
+    from hiper_cli.types import Detections, Frame
+    from tests.fg_scene import CAMERA as SCENE_CAMERA
+    from tests.fg_scene import SceneBox, background_instances, pose_looking_x, render, room
+
+    thing = SceneBox(20, np.array([3.0, 0.0, 0.3]), np.array([0.3, 0.3, 0.3]), "other")
+    frames = []
+    for k in range(50):
+        T = pose_looking_x(y=0.0 if k < 20 else -2.4)  # then the box lies across the left border
+        depth, _ = render([*room(), thing], T)
+        rgb = np.zeros((SCENE_CAMERA.height, SCENE_CAMERA.width, 3), np.uint8)
+        frames.append(Frame(k / 30.0, rgb, depth, SCENE_CAMERA, T, k, detections=Detections.from_records([])))
+    deleted = []
+
+    def on_frame(frame, result):
+        deleted.extend(result.deleted_instances)
+
+    for held, expected in ((True, 0), (False, 1)):
+        deleted.clear()
+        stage = ForegroundStage(detector="log", pixel_step=2, unknown_evidence_held=held)
+        world, _ = run_stages(frames, [stage], World(background=background_instances(room())), on_frame)
+        assert len(world.foreground) == expected
+        assert len(deleted) == 1 - expected

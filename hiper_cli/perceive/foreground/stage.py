@@ -313,8 +313,10 @@ class ForegroundStage:
             if track_uuid in confirmed:
                 obs.instance_uuid = track_uuid
         instances = [self._instance(t) for t in changed]
-        # a track stitched into another after it became an instance: merged away
-        merged = [u for u in self.tracker.absorbed if self._instances.pop(u, None) is not None]
+        # a track stitched into another after it became an instance (merged away), or one whose
+        # evidence failed (``unknown_evidence_held``)
+        gone = [*self.tracker.absorbed, *self.tracker.withdrawn]
+        merged = [u for u in gone if self._instances.pop(u, None) is not None]
         t_end = time.perf_counter()
         timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}
         timings.update(
@@ -339,7 +341,8 @@ class ForegroundStage:
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None
-        return FrameResult(instances=[self._instance(t) for t in closed])
+        gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
+        return FrameResult(instances=[self._instance(t) for t in closed], deleted_instances=gone)
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:

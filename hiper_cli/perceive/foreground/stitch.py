@@ -198,6 +198,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     for cls, longest in new.class_longest_m.items():
         old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
     old.score_sum += new.score_sum
+    old.whole_stamps_s.extend(new.whole_stamps_s)
     old._class_name = None
     old.standing_tops_m.extend(new.standing_tops_m)
     old.floor_z_m = new.floor_z_m if new.floor_z_m is not None else old.floor_z_m
@@ -226,7 +227,6 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     old.extent_m = new.extent_m
     old.motion = new.motion
     old.hits += new.hits
-    old.whole_stamps_s.extend(new.whole_stamps_s)
     old.max_size_m = max(old.max_size_m, new.max_size_m)
     old.last_update_s = new.last_update_s
     old.last_time_s = new.last_time_s

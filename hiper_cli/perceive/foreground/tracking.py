@@ -31,7 +31,8 @@
   then uses all observations of the track, so the first rows are no longer noisy).
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
   after ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``) → closed after
-  ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances.
+  ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances;
+  one whose evidence fails later, or on closing, is withdrawn (``unknown_evidence_held``).
 - Stitching (``stitch``): a newly confirmed (or newly named) track that continues a known one
   (a walker picked up again, a second blob of it, a static object seen again) is absorbed by it
   (``stitch.py``); closed confirmed tracks wait for that: static ones for good, walkers
@@ -385,6 +386,7 @@ class Tracker:
         self.tracks: list[Track] = []  # live (tentative or confirmed)
         self.dormant: list[Track] = []  # closed confirmed tracks a new one may continue
         self.absorbed: list[str] = []  # uuids of the tracks stitched into others this step
+        self.withdrawn: list[str] = []  # uuids of the instances whose evidence failed this step
         self.last_stamp_s: float | None = None
         self._frame_dt_s = 0.0
 
@@ -489,26 +491,43 @@ class Tracker:
             _record_standing(track, m)
             self._hold_level(track)
         self._vote(track, m)
-        if not track.confirmed and self._evidence_enough(track):
-            track.confirmed = True
+        self._confirm(track)
 
-    def _evidence_enough(self, track: Track) -> bool:
-        """Whether a tentative track may become an instance: ``confirm_hits`` observations, and
-        for one detections named fewer than ``min_class_observations`` times and in less
-        than ``min_class_share`` of its observations ``unknown_confirm_whole`` whole ones over
-        ``unknown_min_span_s``, at least ``unknown_min_whole_share`` of its observations."""
+    def _confirm(self, track: Track, closing: bool = False) -> None:
+        """Confirm a tentative track whose evidence is enough; withdraw a confirmed one whose
+        evidence no longer holds (``unknown_evidence_held``: listed in ``withdrawn``)."""
+        if not track.confirmed:
+            track.confirmed = not closing and self._evidence_enough(track)
+        elif self.config.unknown_evidence_held and not self._evidence_enough(track, closing):
+            track.confirmed = False
+            self.withdrawn.append(track.uuid)
+
+    def _evidence_enough(self, track: Track, closing: bool = False) -> bool:
+        """Whether a track may be an instance: ``confirm_hits`` observations, and, unless
+        detections named it in ``min_class_share`` of its observations or gave it its class
+        (``unknown_evidence_held``; else: named it ``min_class_observations`` times),
+        ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``, at least
+        ``unknown_min_whole_share`` of all its observations. A track ``closing`` without a
+        class that detections named most of the time must have lasted ``unknown_min_span_s``
+        (while it lives, its class may still come: a person is named from its first view)."""
         cfg = self.config
         if track.hits < cfg.confirm_hits:
             return False
+        if cfg.unknown_confirm_whole <= 0:
+            return True
         named = sum(n for k, n in track.class_counts.items() if k != UNKNOWN)
-        if cfg.unknown_confirm_whole <= 0 or named >= cfg.min_class_observations or (
-            named >= cfg.min_class_share * track.hits
-        ):
-            return True  # detections name it (often, or most of the time): the usual evidence
+        if cfg.unknown_evidence_held:
+            if track.class_name != UNKNOWN:
+                return True  # detections gave it its class
+            lasted = track.last_update_s - track.first_seen_s >= cfg.unknown_min_span_s
+            if named >= cfg.min_class_share * track.hits and (lasted or not closing):
+                return True  # detections name it most of the time
+        elif named >= cfg.min_class_observations or named >= cfg.min_class_share * track.hits:
+            return True  # detections name it (often, or most of the time)
         stamps = track.whole_stamps_s
         return (
             len(stamps) >= cfg.unknown_confirm_whole
-            and stamps[-1] - stamps[0] >= cfg.unknown_min_span_s
+            and max(stamps) - min(stamps) >= cfg.unknown_min_span_s
             and len(stamps) >= cfg.unknown_min_whole_share * track.hits
         )
 
@@ -619,6 +638,7 @@ class Tracker:
         dt_frame = 0.0 if self.last_stamp_s is None else max(stamp_s - self.last_stamp_s, 0.0)
         self.last_stamp_s = stamp_s
         self._frame_dt_s = dt_frame
+        self.withdrawn = []
         for t in self.tracks:
             self._predict(t, stamp_s)
         pairs = self.associate(measurements, stamp_s)
@@ -651,6 +671,7 @@ class Tracker:
                 )
                 if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > lost:
                     track.closed = True
+                    self._confirm(track, closing=True)
                     if track.confirmed:
                         self._close(track)
                         self._retire(track)
@@ -747,10 +768,13 @@ class Tracker:
         return track
 
     def close_all(self) -> list[Track]:
-        """Close every live track (end of the log); returns the confirmed ones."""
+        """Close every live track (end of the log); returns the confirmed ones (``withdrawn``:
+        those whose evidence failed on closing)."""
         out = []
+        self.withdrawn = []
         for t in self.tracks:
             t.closed = True
+            self._confirm(t, closing=True)
             if t.confirmed:
                 self._close(t)
                 out.append(t)
