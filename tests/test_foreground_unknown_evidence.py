@@ -170,3 +170,16 @@ def test_the_stage_deletes_the_instance_of_a_withdrawn_track():
         world, _ = run_stages(frames, [stage], World(background=background_instances(room())), on_frame)
         assert len(world.foreground) == expected
         assert len(deleted) == 1 - expected
+
+
+def test_a_stitched_track_keeps_the_whole_views_of_both_in_time_order():
+    from hiper_cli.perceive.foreground.stitch import DUPLICATE, REVISIT, absorb
+
+    for kind in (DUPLICATE, REVISIT):
+        old, new = Tracker(ForegroundConfig()), Tracker(ForegroundConfig())
+        _feed(old, "W" * 4)
+        _feed(new, "WBW", start=2)
+        a, b = old.tracks[0], new.tracks[0]
+        absorb(a, b, kind)
+        assert a.hits == 7
+        assert a.whole_stamps_s == sorted(a.whole_stamps_s) and len(a.whole_stamps_s) == 6

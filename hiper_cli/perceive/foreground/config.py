@@ -293,12 +293,11 @@ class TrackerConfig(_Part):
     update and when the track closes): detections count once they give the track its class, or
     while they name most of its observations (a person is named from its first view; a track
     that ends so without a class must have lasted ``unknown_min_span_s``); otherwise the whole
-    evidence above, over all of its observations so far (a track confirmed on two ``bed``
-    boxes, then fed 120 blobs of a desk cut by the image border, stayed an ``unknown``
-    instance). A track that loses its evidence is withdrawn (``Tracker.withdrawn``): its
-    instance is deleted, and comes back with the evidence. False: evidence is checked once,
-    while the track is tentative, and ``min_class_observations`` detections count without a
-    class."""
+    evidence above, over all of its observations so far (a track confirmed on a few named
+    views that then takes pieces of structure cut by the image border is that structure). A
+    track that loses its evidence is withdrawn (``Tracker.withdrawn``): its instance is
+    deleted, and comes back with the evidence. False: evidence is checked once, while the
+    track is tentative, and ``min_class_observations`` detections count without a class."""
     motion_model: str = "constant_velocity"
     """How a track moves (``motion.MOTION_MODELS``): the paper's constant-velocity Kalman filter."""
     association: str = "hungarian"

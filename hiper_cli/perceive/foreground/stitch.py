@@ -198,7 +198,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     for cls, longest in new.class_longest_m.items():
         old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
     old.score_sum += new.score_sum
-    old.whole_stamps_s.extend(new.whole_stamps_s)
+    old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked
     old._class_name = None
     old.standing_tops_m.extend(new.standing_tops_m)
     old.floor_z_m = new.floor_z_m if new.floor_z_m is not None else old.floor_z_m

@@ -527,7 +527,7 @@ class Tracker:
         stamps = track.whole_stamps_s
         return (
             len(stamps) >= cfg.unknown_confirm_whole
-            and max(stamps) - min(stamps) >= cfg.unknown_min_span_s
+            and stamps[-1] - stamps[0] >= cfg.unknown_min_span_s
             and len(stamps) >= cfg.unknown_min_whole_share * track.hits
         )
 
