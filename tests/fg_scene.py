@@ -19,6 +19,9 @@ class SceneBox:
     extent: np.ndarray
     class_name: str
     background: bool = False
+    relief_m: float = 0.0
+    """The middle half of the box's width, as the camera sees it, is this much nearer than the
+    sides: a body (chest before the arms) rather than a flat panel."""
 
 
 def pose_looking_x(x: float = 0.0, y: float = 0.0, z: float = 1.0) -> np.ndarray:
@@ -37,7 +40,9 @@ def room() -> list[SceneBox]:
 
 
 def person(id_: int, x: float, y: float) -> SceneBox:
-    return SceneBox(id_, np.array([x, y, 0.85]), np.array([0.3, 0.5, 1.7]), "person")
+    """A standing person: a 0.3 x 0.5 x 1.7 m box whose middle (the chest) stands 0.1 m before
+    its sides (a person is no flat panel: ``solid.is_flat``)."""
+    return SceneBox(id_, np.array([x, y, 0.85]), np.array([0.3, 0.5, 1.7]), "person", relief_m=0.1)
 
 
 def render(boxes: list[SceneBox], T_map_cam: np.ndarray, camera: CameraIntrinsics = CAMERA):
@@ -57,6 +62,11 @@ def render(boxes: list[SceneBox], T_map_cam: np.ndarray, camera: CameraIntrinsic
             tmax = np.nanmin(np.maximum(t1, t2), axis=1)
             hit = (tmax >= tmax * 0 + np.maximum(tmin, 0)) & (tmax > 0)
             t = np.where(tmin > 0, tmin, tmax)
+            if b.relief_m > 0 and hit.any():
+                cols = u.reshape(-1)[hit]
+                half = (cols.max() - cols.min()) / 4.0
+                middle = np.abs(u.reshape(-1) - (cols.min() + cols.max()) / 2.0) <= half
+                t = np.where(hit & middle, t - b.relief_m, t)
             closer = hit & (t < best_t)
             best_t[closer] = t[closer]
             ids[closer] = b.id

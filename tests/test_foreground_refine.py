@@ -239,3 +239,24 @@ def test_a_piece_that_makes_the_blob_fit_its_detection_worse_is_not_joined():
     loose = replace(cfg, join_max_iou_loss=1.0)
     (joined,) = refine_blobs([chair, table_piece], np.asarray(detection), loose, 640, 480)
     assert len(joined.points_cam) == len(chair.points_cam) + len(table_piece.points_cam)
+
+
+def test_two_chairs_side_by_side_in_one_blob_come_apart_by_their_boxes():
+    """Office 42: two meeting-room chairs 0.26 m apart at 4-5 m made one blob (the clustering
+    tolerance grows with depth) and then one chair instance."""
+    boxes = [*room(), chair(11, 4.0, 0.0), chair(12, 4.0, 0.55)]
+    cfg = ForegroundConfig(pixel_step=2, cluster_tolerance_m=0.2)
+    frame, blobs = _segment(boxes, cfg)
+    assert len(blobs) == 1  # the clustering joined them
+    ids = frame.extras["ids"]
+    dets = frame.detections
+    names = list(dets.class_names)
+
+    def refined(cfg, xyxy, classes):
+        return refine_blobs(blobs, xyxy, cfg, CAMERA.width, CAMERA.height, classes=classes)
+
+    split = refined(cfg, dets.xyxy, names)
+    owners = sorted(int(np.bincount(ids[b.pixels_uv[:, 1], b.pixels_uv[:, 0]]).argmax()) for b in split)
+    assert owners == [11, 12]
+    assert len(refined(replace(cfg, split_twins=False), dets.xyxy, names)) == 1
+    assert len(refined(cfg, dets.xyxy, ["person", "chair"])) == 1  # a person and a chair: no twins

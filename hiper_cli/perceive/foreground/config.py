@@ -156,7 +156,17 @@ class SegmentConfig(BackgroundFilterConfig):
     unseen_table_max_height_m: float = 1.2
     unseen_table_skip_classes: tuple[str, ...] = ("couch", "bed", "bench", "dining table", "toilet")
     """... except in blobs matched to these detector classes: furniture with tops of its own (a
-    couch's arms and back are such a slab)."""
+    couch's arms and back are such a slab) ..."""
+    unseen_table_holding: float = 0.8
+    """... and also in a blob that no detection names but that holds a detected object: a
+    detection box (not of those classes) lies at least this share inside the blob's image box
+    (a bottle or a cup standing on a table the background has not mapped, a bedside table seen
+    only from a doorway, joins the table's blob, and no detection names that blob; 0: off)."""
+    unseen_table_instances: bool = True
+    """A table top found so (and its legs) is an observation of class ``table``, tracked as
+    any object (``unmapped_tables.py``): a bedside table or a desk the background layer never
+    maps is still a table. It is withdrawn once the background layer maps a table that it
+    touches at the height of its top (within ``table_leg_reach_m``)."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04
@@ -217,6 +227,12 @@ class RefineConfig(SegmentConfig):
     (jittered and missed boxes make the split flicker from frame to frame)."""
     split_attach_m: float = 0.15
     """A split blob's point outside every box joins the nearest labelled point within this."""
+    split_twins: bool = True
+    """Even with ``detection_split`` off, split a blob that holds two or more detection boxes of
+    one class side by side (each at least ``join_containment`` inside the blob's image box,
+    none half inside another): bottles, cups or chairs in a row that the clustering joined (its
+    tolerance grows with the depth: 0.26 m at 4 m). Boxes of one class side by side are two
+    objects whatever the jitter; a person beside a chair keeps to the rule above."""
     detection_join: bool = True
     """Join blobs inside one detection box that an occluder cut apart."""
     join_containment: float = 0.8
@@ -264,6 +280,14 @@ class MatchConfig(_Part):
     """... and not flat: the thinnest spread σ of its points at least this plus
     ``background_margin_per_m2`` · depth² (a flat blob is a piece of a wall, a floor or a
     furniture side the background did not claim)."""
+    walker_solid: bool = True
+    """A walker is a solid body (``solid.py``): a flat blob (as ``unknown_min_thickness_m``
+    says: a picture or a screen showing people, a wall piece) named a walker class stays
+    ``unknown``, and a walker's track does not take a flat blob."""
+    detection_nearest: bool = True
+    """A detection names the nearest of the blobs it matches (``solid.nearest_named``): one
+    whose depths lie more than ``join_depth_m`` beyond the nearest one's is hidden behind it
+    inside the box (a wall behind a person) and stays ``unknown``."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -352,7 +376,11 @@ class TrackerConfig(_Part):
     its own class: a lost person track otherwise took a chair or junk blob metres away."""
     search_min_size_ratio: float = 0.5
     """... or an ``unknown`` one at least this share of the track's largest blob (a person coming
-    back cut by the image border, unmatched; 0.75 split the fixture's person; above 1: never)."""
+    back cut by the image border, unmatched; 0.75 split the fixture's person; above 1: never) ..."""
+    search_unknown_max_s: float = 3.0
+    """... and that only within this long of its last update: a person comes back through the
+    border soon after leaving it, while after longer only a detection says a blob is the person
+    (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m away)."""
     moving_speed_mps: float = 0.3
     """Only a track that was moving faster than this when last seen (filtered velocity and
     displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
@@ -405,9 +433,12 @@ class TrackerConfig(_Part):
     quantile of their blobs' tops) and is never extrapolated (issue 17: person boxes below the
     floor, and 0.7 m low from the mean of partial blobs)."""
     settled_hits: int = 15
-    """A track not of a walker class, with at least this many observations and not moving
-    (``moving_speed_mps``), is settled: it only takes an observation whose box overlaps its
-    own grown by ``settled_overlap_m``. Something that stood still is where it stood: the 2 cm
+    """A track not of a walker class, with at least this many observations and not moving (a
+    named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its
+    filter, ``moving_speed_mps``), is settled: it only takes an observation whose box overlaps the
+    box of its blobs (``SeenBox``; the filter's centre drifts as partial views come and go: a
+    TV's track took a wall sliver 0.7 m away) grown by ``settled_overlap_m``. Something that
+    stood still is where it stood: the 2 cm
     sliver of a door frame must not take the person walking past it half a metre away, and
     turn its standing rows into the person's (0: off) ..."""
     settled_overlap_m: float = 0.05
@@ -432,6 +463,12 @@ class TrackerConfig(_Part):
     apart vertically (a chair's back over a table, its seat under it) ..."""
     stitch_min_overlap: float = 0.5
     """... by this share of the smaller footprint (of the larger when one is ``unknown``)."""
+    stitch_static_again: bool = True
+    """A confirmed track of any class is offered to stitching again each time its observations
+    double (not only walkers), either way round (the older track keeps its instance), and a
+    pair of static tracks is judged static on the boxes of their blobs together
+    (``same_object.py``): a track's box is young when it is confirmed, and a track that saw only
+    part of a large object seems to move on its own (false: offered once, at confirmation)."""
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15

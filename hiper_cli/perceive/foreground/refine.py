@@ -13,12 +13,15 @@ IoU matching of Algorithm 4:
    depth is within ``trim_depth_m`` of the median depth of the points inside: a box jittered
    smaller cut the head of a person or the top of a chair's back.
 1. **Split**: a blob whose pixels fall into two or more detection boxes (each holding at least
-   ``min_cluster_points`` of them) is divided. Every point goes to the smallest box it lies in
-   (the specific object in front of a larger one); a point inside several boxes then goes to
-   the box whose points' median depth is nearest its own (a chair seen through the bottle's
-   box keeps the chair's depth). Points outside every box join the group of their nearest
-   labelled point when it is within ``split_attach_m``; the rest form a group of their own.
-   Groups smaller than ``min_cluster_points`` join the group of their nearest point.
+   ``min_cluster_points`` of them) is divided (``detection_split``; without it, only a blob that
+   holds two or more boxes of one class side by side, ``split_twins``: each box at least
+   ``join_containment`` inside the blob's image box, none half inside another). Every point
+   goes to the smallest box it lies in (the specific object in front of a larger one); a
+   point inside several boxes then goes to the box whose points' median depth is nearest its
+   own (a chair seen through the bottle's box keeps the chair's depth). Points outside every
+   box join the group of their nearest labelled point when it is within ``split_attach_m``;
+   the rest form a group of their own. Groups smaller than ``min_cluster_points`` join the
+   group of their nearest point.
 2. **Join**: blobs that lie inside the same detection box (a share ``join_containment`` of
    their pixels, the box grown by ``detection_margin_frac`` of its size for detector jitter;
    the smallest such box owns them), whose median depths differ by at most ``join_depth_m``
@@ -109,6 +112,32 @@ def _split(
     return groups if len(groups) >= 2 else None
 
 
+def _twins(
+    blob_box: FloatArray, boxes: FloatArray, classes: Sequence[str], config: RefineConfig
+) -> NDArray[np.int64]:
+    """The detection boxes of the class with most boxes side by side in ``blob_box`` (each at
+    least ``join_containment`` inside it, none half inside another: duplicate boxes of one
+    object, a chair and its back, are no twins); empty when fewer than two."""
+    lo = np.maximum(blob_box[None, :2], boxes[:, :2])
+    hi = np.minimum(blob_box[None, 2:], boxes[:, 2:])
+    area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
+    inside = np.prod(np.clip(hi - lo, 0.0, None), axis=1) >= config.join_containment * area
+    best = np.zeros(0, dtype=np.int64)
+    for name in sorted({c for c, ok in zip(classes, inside, strict=True) if ok}):
+        idx = np.flatnonzero(inside & (np.array(classes, dtype=object) == name))
+        if len(idx) < 2:
+            continue
+        b = boxes[idx]
+        p_lo = np.maximum(b[:, None, :2], b[None, :, :2])
+        p_hi = np.minimum(b[:, None, 2:], b[None, :, 2:])
+        common = np.prod(np.clip(p_hi - p_lo, 0.0, None), axis=2)
+        smaller = np.minimum(area[idx][:, None], area[idx][None, :])
+        np.fill_diagonal(common, 0.0)
+        if np.all(common < 0.5 * smaller) and len(idx) > len(best):
+            best = idx
+    return best
+
+
 def _trim(
     blob: Blob, iou: FloatArray, boxes: FloatArray, grown: FloatArray, step_pad: FloatArray,
     config: RefineConfig,
@@ -190,14 +219,16 @@ def refine_blobs(
     width: int,
     height: int,
     support_boxes_map: Sequence[Box3D] = (),
+    classes: Sequence[str] = (),
 ) -> list[Blob]:
     """Split and join ``blobs`` with this frame's detection boxes (see the module docstring).
 
     Fragments (``Blob.fragment``, fewer than ``min_cluster_points`` points) may join an object
     in their detection box; those that do not are dropped.
 
-    ``detection_boxes_xyxy`` (K, 4) pixels: the detections the matching will use. Blobs that
-    are neither split nor joined are returned as they are.
+    ``detection_boxes_xyxy`` (K, 4) pixels: the detections the matching will use; ``classes``
+    their class names (``split_twins``; empty: no twins). Blobs that are neither split nor
+    joined are returned as they are.
     """
     boxes = np.asarray(detection_boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0 or not blobs:
@@ -209,6 +240,19 @@ def refine_blobs(
     if config.detection_split:
         for blob in blobs:
             groups = None if blob.fragment else _split(blob, boxes, areas, config)
+            if groups is None:
+                out.append(blob)
+                changed.append(False)
+            else:
+                out.extend(sub_blob(blob, g, step, width, height) for g in groups)
+                changed.extend([True] * len(groups))
+    elif config.split_twins and len(classes) == len(boxes):
+        for blob in blobs:
+            twins = (
+                np.zeros(0, dtype=np.int64) if blob.fragment
+                else _twins(blob.image_box_xyxy, boxes, classes, config)
+            )
+            groups = _split(blob, boxes[twins], areas[twins], config) if len(twins) >= 2 else None
             if groups is None:
                 out.append(blob)
                 changed.append(False)

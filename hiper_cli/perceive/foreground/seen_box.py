@@ -7,6 +7,12 @@ after the last update. The box of every blob, in the map frame, does not drift; 
 covers what all the views saw together. The union takes the ``SEEN_BOX_QUANTILE`` of the blobs' lower
 corners and the 1 - ``SEEN_BOX_QUANTILE`` of their upper ones, so that a few blobs of something else
 (a wrong association, depth noise at an edge) do not stretch it.
+
+The detector tells which blobs show the object: a track also takes blobs no detection named,
+and some of those are something else (floor strips beside a bed seen through a doorway, a table
+leg, the table a bottle stood on before the background mapped it). When at least
+``MIN_NAMED_BOXES`` of the blobs were named (by any class: a bed taken for a couch is still the
+bed), the union is of the named ones only.
 """
 
 from __future__ import annotations
@@ -23,6 +29,8 @@ SEEN_BOX_QUANTILE = 0.2  # of the blobs' corners; 1 in 5 blobs may reach past th
 MAX_SEEN_BOXES = 600  # the latest blob boxes kept (40 s of a static object at 15 Hz)
 MIN_MOVED_BOXES = 8  # blobs before the first and last quarters can tell a move
 MOVED_MARGIN_M = 0.1  # the quarters' boxes lie this far apart horizontally: it moved
+MIN_NAMED_BOXES = 5  # named blobs enough to make the box of them alone
+MIN_BRIDGING_BOXES = 2  # views reaching both where a track was first and last: it did not move
 
 
 @dataclass
@@ -31,38 +39,63 @@ class SeenBox:
 
     lower_m: list[FloatArray] = field(default_factory=list)
     upper_m: list[FloatArray] = field(default_factory=list)
+    named: list[bool] = field(default_factory=list)  # per blob: a detection named it
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
+    _moved: tuple[int, bool] | None = field(default=None, repr=False)
 
-    def add(self, lower_m: FloatArray, upper_m: FloatArray) -> None:
+    def add(self, lower_m: FloatArray, upper_m: FloatArray, named: bool = False) -> None:
         self.lower_m.append(np.asarray(lower_m, dtype=np.float64))
         self.upper_m.append(np.asarray(upper_m, dtype=np.float64))
+        self.named.append(bool(named))
         if len(self.lower_m) > 2 * MAX_SEEN_BOXES:  # trimmed in batches: amortised O(1)
             del self.lower_m[:-MAX_SEEN_BOXES]
             del self.upper_m[:-MAX_SEEN_BOXES]
+            del self.named[:-MAX_SEEN_BOXES]
         self._cache = None
+        self._moved = None
 
     def extend(self, other: SeenBox) -> None:
         """Add the blobs of ``other`` (a track this one absorbed)."""
-        for lo, hi in zip(other.lower_m, other.upper_m, strict=True):
-            self.add(lo, hi)
+        for lo, hi, named in zip(other.lower_m, other.upper_m, other.named, strict=True):
+            self.add(lo, hi, named)
 
     def __len__(self) -> int:
         return len(self.lower_m)
 
+    def _boxes(self) -> tuple[FloatArray, FloatArray]:
+        """(lower, upper) corners (K, 3) of the latest ``MAX_SEEN_BOXES`` blobs, of the named
+        ones alone when there are ``MIN_NAMED_BOXES`` of them."""
+        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
+        lower, upper = np.array(self.lower_m[start:]), np.array(self.upper_m[start:])
+        named = np.array(self.named[start:], dtype=bool)
+        if int(named.sum()) >= MIN_NAMED_BOXES:
+            return lower[named], upper[named]
+        return lower, upper
+
     def moved(self) -> bool:
         """Whether the object moved: the (median) box of its first quarter of blobs and that of
-        its last quarter lie apart horizontally. Views of one static object from different sides
-        overlap (each shows some of it); a cart that drove more than its length does not."""
+        its last quarter lie apart horizontally, and no view (``MIN_BRIDGING_BOXES`` of them)
+        reached both. Views of one static object from different sides overlap (each shows some
+        of it), and a large one seen in parts as the view pans (a TV's right end, then its left
+        end) was also seen whole in between; a cart that drove more than its length was not."""
         n = len(self.lower_m)
         if n < MIN_MOVED_BOXES:
             return False
-        start = max(n - MAX_SEEN_BOXES, 0)
-        k = max((n - start) // 4, 1)
-        lower, upper = np.array(self.lower_m[start:]), np.array(self.upper_m[start:])
+        if self._moved is None or self._moved[0] != n:
+            self._moved = (n, self._moved_now())
+        return self._moved[1]
+
+    def _moved_now(self) -> bool:
+        lower, upper = self._boxes()
+        k = max(len(lower) // 4, 1)
         first_lo, first_hi = np.median(lower[:k, :2], axis=0), np.median(upper[:k, :2], axis=0)
         last_lo, last_hi = np.median(lower[-k:, :2], axis=0), np.median(upper[-k:, :2], axis=0)
         gap = np.maximum(last_lo - first_hi, first_lo - last_hi)
-        return bool(np.any(gap > MOVED_MARGIN_M))
+        if not np.any(gap > MOVED_MARGIN_M):
+            return False
+        reach_first = np.all((lower[:, :2] <= first_hi) & (upper[:, :2] >= first_lo), axis=1)
+        reach_last = np.all((lower[:, :2] <= last_hi) & (upper[:, :2] >= last_lo), axis=1)
+        return int(np.count_nonzero(reach_first & reach_last)) < MIN_BRIDGING_BOXES
 
     def corners(self) -> tuple[FloatArray, FloatArray] | None:
         """(lower, upper) corners of the union; None before any blob."""
@@ -71,9 +104,9 @@ class SeenBox:
             return None
         if self._cache is not None and self._cache[0] == n:
             return self._cache[1], self._cache[2]
-        start = max(n - MAX_SEEN_BOXES, 0)
-        lo = np.quantile(np.array(self.lower_m[start:]), SEEN_BOX_QUANTILE, axis=0)
-        hi = np.quantile(np.array(self.upper_m[start:]), 1.0 - SEEN_BOX_QUANTILE, axis=0)
+        lower, upper = self._boxes()
+        lo = np.quantile(lower, SEEN_BOX_QUANTILE, axis=0)
+        hi = np.quantile(upper, 1.0 - SEEN_BOX_QUANTILE, axis=0)
         hi = np.maximum(hi, lo)
         self._cache = (n, lo, hi)
         return lo, hi

@@ -35,8 +35,15 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.tables import drop_unseen_tables
+from hiper_cli.perceive.foreground.solid import is_flat, nearest_named
+from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
+from hiper_cli.perceive.foreground.unmapped_tables import (
+    TABLE_CLASS,
+    TABLE_SCORE,
+    table_match,
+    withdraw_mapped,
+)
 from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
@@ -173,9 +180,15 @@ class ForegroundStage:
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
         above the floor: people stand on it, and even behind a counter their visible part
-        reaches below that (a person detection on a poster, a shelf's top or a reflection)."""
+        reaches below that (a person detection on a poster, a shelf's top or a reflection);
+        and for a flat one (``walker_solid``, ``solid.is_flat``: a picture or a screen showing
+        people, a wall piece)."""
         cfg = self.config
-        if cfg.walker_max_base_m <= 0 or class_name not in cfg.walker_classes:
+        if class_name not in cfg.walker_classes:
+            return True
+        if cfg.walker_solid and is_flat(blob.points_cam, cfg):
+            return False
+        if cfg.walker_max_base_m <= 0:
             return True
         return float(blob.bounds_map[0][2]) - self._floor_z_m <= cfg.walker_max_base_m
 
@@ -235,8 +248,8 @@ class ForegroundStage:
             frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports,
             keep_fragments=cfg.detection_join,
         )
+        tables = [inst.box for inst in world.background.values() if inst.class_name == "table"]
         if cfg.background_filter:
-            tables = [inst.box for inst in world.background.values() if inst.class_name == "table"]
             blobs = drop_table_legs(
                 blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
             )
@@ -255,15 +268,19 @@ class ForegroundStage:
         t_det = time.perf_counter()
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
+        found_tables: list[Blob] = []
         if cfg.background_filter:
             names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
-            blobs = drop_unseen_tables(blobs, usable, names, cfg, frame.camera.width, frame.camera.height)
+            blobs, found_tables = split_unseen_tables(
+                blobs, usable, names, cfg, frame.camera.width, frame.camera.height
+            )
             if cfg.table_rim_depth_m > 0:
                 blobs = drop_table_legs(
                     blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height, rims=True
                 )
         if refine:
-            blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports)
+            blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports,
+                                 classes=[n for n, keep in zip(dets.class_names, ok, strict=True) if keep])
         t_refine = time.perf_counter()
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
@@ -272,6 +289,8 @@ class ForegroundStage:
             min_score=cfg.min_detection_score,
             unknown=cfg.unknown_class,
         )
+        if cfg.detection_nearest:
+            matches = nearest_named(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
@@ -304,18 +323,30 @@ class ForegroundStage:
                     standing=self._standing_box(blob),  # a walking track takes any blob as standing
                     bounds_map_m=_corners(blob),
                     longest_m=longest,
+                    solid=not (cfg.walker_solid and is_flat(blob.points_cam, cfg)),
+                    detection_index=match.detection_index,
                 )
             )
+        for blob in found_tables if cfg.unseen_table_instances else []:
+            obs = self._observation(frame, blob, table_match(), dets)
+            observations.append(obs)
+            measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
+                                            obs.uuid, bounds_map_m=_corners(blob)))
         t_match = time.perf_counter()
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
+        tables_withdrawn = (
+            withdraw_mapped(self.tracker, tables, cfg.table_leg_reach_m) if cfg.unseen_table_instances else []
+        )
+        if tables_withdrawn:  # the background layer mapped them: its instance is the table
+            changed = [t for t in changed if t.uuid not in tables_withdrawn]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
         for obs, track_uuid in zip(observations, joined, strict=True):
             if track_uuid in confirmed:
                 obs.instance_uuid = track_uuid
         instances = [self._instance(t) for t in changed]
-        # a track stitched into another after it became an instance (merged away), or one whose
-        # evidence failed (``unknown_evidence_held``)
-        gone = [*self.tracker.absorbed, *self.tracker.withdrawn]
+        # a track stitched into another after it became an instance (merged away), one whose
+        # evidence failed (``unknown_evidence_held``), or a table the background mapped
+        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn]
         merged = [u for u in gone if self._instances.pop(u, None) is not None]
         t_end = time.perf_counter()
         timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}

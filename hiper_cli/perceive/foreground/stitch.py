@@ -47,10 +47,16 @@ MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at
 
 
 def find_target(
-    new: Track, candidates: Iterable[Track], config: TrackerConfig, moving: Callable[[Track], bool]
+    new: Track,
+    candidates: Iterable[Track],
+    config: TrackerConfig,
+    moving: Callable[[Track], bool],
+    together: Callable[[Track, Track], bool] | None = None,
 ) -> tuple[Track, str] | None:
     """The older confirmed track ``new`` continues, and how (``RESUME``, ``DUPLICATE``,
-    ``REVISIT``), or None. ``moving(track)``: whether it is no static object (``tracking.is_static``)."""
+    ``REVISIT``), or None. ``moving(track)``: whether it is no static object (``tracking.is_static``);
+    ``together(new, old)``, when given, decides instead whether the two are one static object
+    (``same_object.static_together``: a pair of partial views may look moving one by one)."""
     walkers = config.walker_classes
     name = provisional_class(new)
     best: tuple[float, Track, str] | None = None
@@ -62,10 +68,12 @@ def find_target(
             found = _walker_match(new, old, config)
         elif (
             name not in walkers and old_name not in walkers
-            and not moving(new) and not moving(old)
+            and (together is not None or (not moving(new) and not moving(old)))
             and (name == old_name or UNKNOWN in (name, old_name))
         ):
             found = _static_match(new, old, config)
+            if found is not None and together is not None and not together(new, old):
+                found = None
         else:
             found = None
         if found is not None and (best is None or found[0] < best[0]):

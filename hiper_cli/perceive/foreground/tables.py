@@ -30,7 +30,7 @@ from hiper_cli.perceive.foreground.legs import leg_points, standing_on
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
-__all__ = ["drop_unseen_tables", "table_points", "unseen_table_top"]
+__all__ = ["drop_unseen_tables", "one_board", "split_unseen_tables", "table_points", "unseen_table_top"]
 
 FloatArray = NDArray[np.float64]
 SLAB_BIN_M = 0.02  # height bins of the search for a table top
@@ -88,19 +88,38 @@ def _minor_extent_m(points_xy: FloatArray) -> float:
     return float(p95 - p5)
 
 
-def table_points(points_map: FloatArray, top: Box3D, config: SegmentConfig) -> NDArray[np.bool_]:
-    """Which points (N, 3) are the table's top (within its footprint grown by
-    ``table_leg_reach_m``, two slab bins of its top height, in columns that end there) or its
-    legs (``leg_points``)."""
+def _top_points(points_map: FloatArray, top: Box3D, config: SegmentConfig) -> NDArray[np.bool_]:
+    """Which points (N, 3) are the table's top: within its footprint grown by
+    ``table_leg_reach_m``, two slab bins of its top height, in columns that end there."""
     lo, hi = top.aabb()
     reach = 2 * SLAB_BIN_M + config.table_leg_above_m
     ending = _column_tops(points_map, config.table_leg_cell_m) <= hi[2] + reach
-    on_top = (
+    return np.asarray(
         np.all(points_map[:, :2] >= lo[:2] - config.table_leg_reach_m, axis=1)
         & np.all(points_map[:, :2] <= hi[:2] + config.table_leg_reach_m, axis=1)
         & (np.abs(points_map[:, 2] - hi[2]) <= 2 * SLAB_BIN_M) & ending
     )
-    return np.asarray(on_top | leg_points(points_map, [top], config))
+
+
+def table_points(points_map: FloatArray, top: Box3D, config: SegmentConfig) -> NDArray[np.bool_]:
+    """Which points (N, 3) are the table's top (``_top_points``) or its legs (``leg_points``)."""
+    return np.asarray(_top_points(points_map, top, config) | leg_points(points_map, [top], config))
+
+
+def one_board(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
+    """Whether the top found in ``blob`` is one board: the largest connected part of its points
+    (linked as the segmentation links points, on the image grid) still spans
+    ``unseen_table_min_side_m`` along its minor axis. The top of a chair's back and the bottles
+    on a desk behind it end at one height, and the depth noise at 4 m spreads the back's 4 cm
+    into a band as deep as a table: their slab is wide, but in pieces."""
+    on_top = np.flatnonzero(_top_points(blob.points_map, top, config))
+    parts = grid_components(blob, on_top, config.pixel_step, config)
+    if not parts:
+        return False
+    largest = on_top[max(parts, key=len)]
+    if len(largest) < config.min_cluster_points:
+        return False
+    return _minor_extent_m(blob.points_map[largest, :2]) >= config.unseen_table_min_side_m
 
 
 def drop_unseen_tables(
@@ -109,27 +128,61 @@ def drop_unseen_tables(
 ) -> list[Blob]:
     """``blobs`` without the tops and legs of tables found in them (see the module docstring);
     ``boxes_xyxy`` (K, 4) and ``classes`` are this frame's detections."""
+    return split_unseen_tables(blobs, boxes_xyxy, classes, config, width, height)[0]
+
+
+def split_unseen_tables(
+    blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
+    width: int, height: int,
+) -> tuple[list[Blob], list[Blob]]:
+    """(``blobs`` without the tops and legs of tables found in them, one blob per table found:
+    its top and legs); ``boxes_xyxy`` (K, 4) and ``classes`` are this frame's detections."""
+    tables: list[Blob] = []
     if config.unseen_table_min_side_m <= 0 or not blobs:
-        return blobs
+        return blobs, tables
     boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0:
-        return blobs
+        return blobs, tables
     out: list[Blob] = []
-    ious = iou_matrix(np.array([blob.image_box_xyxy for blob in blobs]), boxes)
-    for blob, iou in zip(blobs, ious, strict=True):
+    blob_boxes = np.array([blob.image_box_xyxy for blob in blobs])
+    ious = iou_matrix(blob_boxes, boxes)
+    held = _held(blob_boxes, boxes, classes, config)
+    for blob, iou, holds in zip(blobs, ious, held, strict=True):
         top = None
         if not blob.fragment:
             k = int(np.argmax(iou))
-            if iou[k] >= config.trim_iou and classes[k] not in config.unseen_table_skip_classes:
+            named = iou[k] >= config.trim_iou
+            if (named and classes[k] not in config.unseen_table_skip_classes) or (not named and holds):
                 top = unseen_table_top(blob.points_map, config)
+                if top is not None and not one_board(blob, top, config):
+                    top = None
         if top is None:
             out.append(blob)
             continue
-        rest = np.flatnonzero(~table_points(blob.points_map, top, config))
+        on_table = table_points(blob.points_map, top, config)
+        if np.count_nonzero(on_table) >= config.min_cluster_points:
+            tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
+        rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
                 out.append(_part(blob, rest[part], top, config, width, height))
-    return out
+    return out, tables
+
+
+def _held(
+    blob_boxes: FloatArray, boxes: FloatArray, classes: Sequence[str], config: RefineConfig
+) -> NDArray[np.bool_]:
+    """Per blob, whether a detection box (not of ``unseen_table_skip_classes``) lies at least
+    ``unseen_table_holding`` inside its image box: an object in or on it (0: never)."""
+    if config.unseen_table_holding <= 0:
+        return np.zeros(len(blob_boxes), dtype=bool)
+    usable = np.array([c not in config.unseen_table_skip_classes for c in classes], dtype=bool)
+    lo = np.maximum(blob_boxes[:, None, :2], boxes[None, :, :2])
+    hi = np.minimum(blob_boxes[:, None, 2:], boxes[None, :, 2:])
+    inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
+    area = np.prod(np.clip(boxes[:, 2:] - boxes[:, :2], 0.0, None), axis=1)
+    inside = inter >= config.unseen_table_holding * np.maximum(area, 1e-9)[None, :]
+    return np.asarray((inside & usable[None, :]).any(axis=1))
 
 
 def _part(

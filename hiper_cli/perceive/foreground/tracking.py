@@ -55,10 +55,12 @@ from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
 from hiper_cli.perceive.foreground.plausible import min_longest_m
+from hiper_cli.perceive.foreground.same_object import STAMP_DECIMALS, due, fold, newer_match, static_together
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
+    REVISIT,
     absorb,
     find_target,
     gap_ok,
@@ -108,6 +110,11 @@ class Measurement:
     """The longest dimension of a named blob seen whole (``plausible.longest_m``): what the view
     shows of the object's size; None: cut by the image's border, hidden in part by something
     nearer (``whole.occluded``), of a class without a lower size bound, or not named."""
+    solid: bool = True
+    """Not flat (``solid.is_flat``): a walker's track takes only solid blobs (``walker_solid``)."""
+    detection_index: int | None = None
+    """Which detection of its frame named the blob (None: none): two tracks named by different
+    detections in one frame are two objects (``same_object.seen_apart``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -155,6 +162,8 @@ class Track:
     floor_z_m: float | None = None
     # the boxes of its blobs: a static object's box (``object_box``)
     seen: SeenBox = field(default_factory=SeenBox)
+    # stamp (rounded, ``same_object.STAMP_DECIMALS``) -> the detection that named its blob then
+    named_at: dict[float, int] = field(default_factory=dict)
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -486,7 +495,7 @@ class Tracker:
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
-        track.seen.add(*m.corners())
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -540,6 +549,8 @@ class Tracker:
             track.class_longest_m[m.class_name] = max(seen, m.longest_m)
         track._class_name = None
         track.score_sum += m.score
+        if m.detection_index is not None:
+            track.named_at[round(track.last_update_s, STAMP_DECIMALS)] = m.detection_index
         if m.whole:
             track.whole_stamps_s.append(track.last_update_s)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
@@ -577,6 +588,8 @@ class Tracker:
         cfg = self.config
         if cfg.settled_hits <= 0 or track.hits < cfg.settled_hits or track.class_name in cfg.walker_classes:
             return False
+        if track.class_name != UNKNOWN:  # where its blobs were, not where partial views move its filter
+            return is_static(track, cfg)
         return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
@@ -604,20 +617,24 @@ class Tracker:
         classes = np.array([m.class_name for m in measurements], dtype=object)
         unknown = classes == UNKNOWN
         sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
+        solid = np.array([m.solid for m in measurements], dtype=bool)
         half_extents = np.array([m.extent_map_m for m in measurements]) / 2.0
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             if self._settled(t):
-                reach = t.extent_m / 2.0 + cfg.settled_overlap_m
-                allowed[i] &= np.all(np.abs(obs - t.position) <= reach + half_extents, axis=1)
+                # where its blobs were (``SeenBox``), not where a drifting filter puts it
+                lo, hi = t.seen.corners() or (t.position - t.extent_m / 2.0, t.position + t.extent_m / 2.0)
+                near = np.all(obs - half_extents <= hi + cfg.settled_overlap_m, axis=1)
+                allowed[i] &= near & np.all(obs + half_extents >= lo - cfg.settled_overlap_m, axis=1)
             if cls != UNKNOWN:  # two different known classes cost more; unknown is neutral
                 cost[i, ~unknown & (classes != cls)] += cfg.class_mismatch_m
             if cls in cfg.walker_classes:
-                allowed[i] &= sizes >= cfg.walker_min_size_ratio * t.max_size_m
+                allowed[i] &= (sizes >= cfg.walker_min_size_ratio * t.max_size_m) & solid
             if cls in cfg.search_same_class and stamp_s - t.last_update_s > grace:
                 # Lost and searching: another class only when it is an unmatched blob as big as
                 # the person (the person cut by the border).
                 person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
+                person_sized &= stamp_s - t.last_update_s <= cfg.search_unknown_max_s
                 allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
         return self._assign(cost, allowed)
 
@@ -693,27 +710,46 @@ class Tracker:
         whose hits doubled to ``stitch.find_target``; absorbed ones leave the live tracks (a
         revived closed one takes their place) and are listed in ``absorbed``. Returns new uuid -> target."""
         self.absorbed = []
-        walkers = self.config.walker_classes
+        cfg = self.config
         fresh = [
-            t for t in self.tracks
-            if t.confirmed and (
-                provisional_class(t) != t.stitch_class
-                or (t.stitch_class in walkers and t.hits >= 2 * t.stitch_hits)
-            )
+            t for t in self.tracks if t.confirmed and due(t, cfg.walker_classes, cfg.stitch_static_again)
         ]
         if not fresh:
             return {}
-        self.dormant = [t for t in self.dormant if gap_ok(t, stamp_s, self.config)]
+        self.dormant = [t for t in self.dormant if gap_ok(t, stamp_s, cfg)]
         aliases: dict[str, Track] = {}
+
+        def moving(track: Track) -> bool:
+            return not is_static(track, cfg)
+
+        def together(a: Track, b: Track) -> bool:
+            return static_together(a, b, cfg.walker_classes, lambda t: _was_moving(t, cfg))
+
+        pair = together if cfg.stitch_static_again else None
         for new in fresh:
+            if new.uuid in aliases:  # folded into an older track earlier in this loop
+                continue
             new.stitch_class, new.stitch_hits = provisional_class(new), new.hits
             live = [t for t in self.tracks if t.uuid not in aliases]
-            found = find_target(new, [*live, *self.dormant], self.config,
-                                lambda t: not is_static(t, self.config))
+            found = find_target(new, [*live, *self.dormant], cfg, moving, pair)
+            if found is None and pair is not None:
+                newer = newer_match(new, [*live, *self.dormant], cfg, moving, pair)
+                if newer is not None:  # the older one asked: the newer folds into it
+                    fold(new, newer)
+                    self.absorbed.append(newer.uuid)
+                    aliases[newer.uuid] = new
+                    for uuid, target in aliases.items():
+                        if target is newer:
+                            aliases[uuid] = new
+                    (self.dormant if newer in self.dormant else self.tracks).remove(newer)
+                continue
             if found is None:
                 continue
             old, kind = found
-            absorb(old, new, kind, stale_rows(new, old, self.config) if kind == RESUME else 0)
+            if kind == REVISIT and pair is not None:
+                fold(old, new)
+            else:
+                absorb(old, new, kind, stale_rows(new, old, cfg) if kind == RESUME else 0)
             self.absorbed.append(new.uuid)
             aliases[new.uuid] = old
             for uuid, target in aliases.items():  # a track absorbed earlier into ``new``
@@ -732,7 +768,9 @@ class Tracker:
         a walker (``stitch.gap_ok`` drops it later)."""
         if not self.config.stitch:
             return
-        if track.class_name in self.config.walker_classes or is_static(track, self.config):
+        if self.config.stitch_static_again or track.class_name in self.config.walker_classes or is_static(
+            track, self.config
+        ):
             self.dormant.append(track)
 
     def _close(self, track: Track) -> None:
@@ -759,7 +797,7 @@ class Tracker:
             min_class_share=self.config.min_class_share,
             size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
         )
-        track.seen.add(*m.corners())
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

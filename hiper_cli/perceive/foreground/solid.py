@@ -1,0 +1,73 @@
+"""What a detection of a walker can name: a solid body, the nearest thing in its box.
+
+Two kinds of blobs became people, and their tracks then lived on after the person left (a
+"person last seen" seconds or minutes late, and a second person instance):
+
+- **flat** ones: a picture, a poster or a screen that shows people (a detector names them
+  ``person``; the simulator's truth detector does so 30 % of the time, as the paper's
+  false-positive trap), and wall pieces the background has not claimed, which a lost person
+  track took while it searched. A person is a solid body at least a hand deep, whose surface
+  seen from any side spreads along the viewing ray; a flat blob, whose points lie within the
+  depth noise of one plane (``whole.thickness_m``, the same test that keeps flat pieces from
+  being ``unknown`` objects), is not one (``is_flat``). A blob named a walker class that is
+  flat stays ``unknown``, and a walker's track does not take a flat blob
+  (``Measurement.solid``).
+- blobs **behind** the one the detection saw: a detection box of a person in front of a wall
+  also names the wall's blob when that blob's image box fits the person's box (the
+  refinement trims a blob to the box it overlaps). Inside the box the nearer object hides the
+  farther one, so the detector saw the nearer; of the blobs one detection names, those whose
+  depths lie more than ``join_depth_m`` (the refinement's "same object" depth gap) beyond the
+  nearest one's are not what it saw and stay ``unknown`` (``nearest_named``). Two parts of one
+  person split by a table lie at the same depth and both keep the name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.match import Match
+from hiper_cli.perceive.foreground.whole import thickness_m
+
+__all__ = ["is_flat", "nearest_named"]
+
+DEPTH_RANGE_PERCENTILES = (5.0, 95.0)  # a blob's depth range, robust to a few stray points
+
+
+def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
+    """Whether the points (N, 3, camera frame) of a blob lie on one plane within the depth
+    noise: their thinnest spread is below ``unknown_min_thickness_m`` plus
+    ``background_margin_per_m2`` · depth² (depth: their median distance)."""
+    if len(points_cam) < 4:
+        return False
+    depth = float(np.median(points_cam[:, 2]))
+    flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
+    return thickness_m(points_cam) < flat_m
+
+
+def nearest_named(
+    matches: Sequence[Match], depths_m: Sequence[NDArray[np.float64]], config: ForegroundConfig
+) -> list[Match]:
+    """``matches`` with the blobs that lie behind another blob their detection names made
+    ``unknown``: per detection, the blob with the nearest median depth is what it saw, and a
+    blob whose near end (``DEPTH_RANGE_PERCENTILES``) lies more than ``join_depth_m`` beyond
+    that blob's far end is not. ``depths_m``: each blob's point depths (camera z, m)."""
+    out = list(matches)
+    by_detection: dict[int, list[int]] = {}
+    for i, m in enumerate(matches):
+        if m.detection_index is not None:
+            by_detection.setdefault(m.detection_index, []).append(i)
+    lo_q, hi_q = DEPTH_RANGE_PERCENTILES
+    for named in by_detection.values():
+        if len(named) < 2:
+            continue
+        ranges = {i: np.percentile(depths_m[i], [lo_q, 50.0, hi_q]) for i in named}
+        nearest = min(named, key=lambda i: float(ranges[i][1]))
+        far_end = float(ranges[nearest][2])
+        for i in named:
+            if float(ranges[i][0]) > far_end + config.join_depth_m:
+                out[i] = Match(config.unknown_class, 0.0, None, matches[i].iou)
+    return out
