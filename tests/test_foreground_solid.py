@@ -38,6 +38,8 @@ def test_flat_means_within_the_depth_noise_of_one_plane():
     wall = np.column_stack([uv, 3.0 + rng.normal(0.0, 0.01, n)])  # 1 cm of noise at 3 m
     body = np.column_stack([uv, 3.0 - 0.15 * (1.0 - (uv[:, 0] / 0.3) ** 2) + rng.normal(0.0, 0.01, n)])
     assert is_flat(wall, cfg) and not is_flat(body, cfg)
+    chest = np.column_stack([uv[:, 0] * 0.15, uv[:, 1] * 0.5, 0.4 + rng.normal(0.0, 0.001, n)])
+    assert not is_flat(chest, cfg)  # a person 0.4 m away: a flat patch 9 x 30 cm, no panel
 
 
 def test_a_lost_persons_track_does_not_take_a_wall_piece():

@@ -7,9 +7,10 @@ Two kinds of blobs became people, and their tracks then lived on after the perso
   ``person``; the simulator's truth detector does so 30 % of the time, as the paper's
   false-positive trap), and wall pieces the background has not claimed, which a lost person
   track took while it searched. A person is a solid body at least a hand deep, whose surface
-  seen from any side spreads along the viewing ray; a flat blob, whose points lie within the
-  depth noise of one plane (``whole.thickness_m``, the same test that keeps flat pieces from
-  being ``unknown`` objects), is not one (``is_flat``). A blob named a walker class that is
+  seen from any side spreads along the viewing ray; a flat blob half a metre across or more,
+  whose points lie within the depth noise of one plane (``whole.thickness_m``, the same test
+  that keeps flat pieces from being ``unknown`` objects), is not one (``is_flat``; a smaller
+  flat patch may be a piece of a chest seen from 0.4 m). A blob named a walker class that is
   flat stays ``unknown``, and a walker's track does not take a flat blob
   (``Measurement.solid``).
 - blobs **behind** the one the detection saw: a detection box of a person in front of a wall
@@ -35,13 +36,18 @@ from hiper_cli.perceive.foreground.whole import thickness_m
 __all__ = ["is_flat", "nearest_named"]
 
 DEPTH_RANGE_PERCENTILES = (5.0, 95.0)  # a blob's depth range, robust to a few stray points
+PANEL_MIN_SPAN_M = 0.5  # a flat blob this large would show a body's relief (a torso's width)
 
 
 def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
-    """Whether the points (N, 3, camera frame) of a blob lie on one plane within the depth
-    noise: their thinnest spread is below ``unknown_min_thickness_m`` plus
-    ``background_margin_per_m2`` · depth² (depth: their median distance)."""
+    """Whether the points (N, 3, camera frame) of a blob are a flat panel: at least
+    ``PANEL_MIN_SPAN_M`` across and on one plane within the depth noise (their thinnest spread
+    below ``unknown_min_thickness_m`` plus ``background_margin_per_m2`` · depth², depth: their
+    median distance). A smaller patch is no evidence: a person 0.4 m from the camera shows a
+    piece of the chest, as flat as a wall."""
     if len(points_cam) < 4:
+        return False
+    if float(np.max(np.ptp(points_cam, axis=0))) < PANEL_MIN_SPAN_M:
         return False
     depth = float(np.median(points_cam[:, 2]))
     flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
