@@ -167,7 +167,7 @@ def simulate(
     (gt / "instance_ids").mkdir(parents=True, exist_ok=True)
     for folder in ("rgb", "depth", "gt/instance_ids"):  # with overwrite: drop images of an older log
         for stale in (root / folder).glob("*.png"):
-            stale.unlink()
+            stale.unlink(missing_ok=True)  # another run may have removed it
     first_box: dict[int, Box3D] = {}
     tracks_rows: list[list[Any]] = []
     centres: dict[int, list[list[float]]] = {}  # id: [t, x, y, z] rows of the moving instances
