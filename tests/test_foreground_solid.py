@@ -16,8 +16,9 @@ RATE_HZ = 15.0
 
 
 def _poster(id_, y):
-    """A poster of a person 1 cm thick on a stand (its class: what a detector names it)."""
-    return SceneBox(id_, np.array([4.5, y, 1.2]), np.array([0.01, 0.6, 1.2]), "person")
+    """A poster of a person 1 cm thick on a stand (its class: what a detector names it), 3.4 m
+    away: within the range where the depth noise cannot hide a body's relief."""
+    return SceneBox(id_, np.array([3.4, y, 1.2]), np.array([0.01, 0.6, 1.2]), "person")
 
 
 def test_a_poster_of_a_person_is_no_person_and_a_person_is():
@@ -40,6 +41,18 @@ def test_flat_means_within_the_depth_noise_of_one_plane():
     assert is_flat(wall, cfg) and not is_flat(body, cfg)
     chest = np.column_stack([uv[:, 0] * 0.15, uv[:, 1] * 0.5, 0.4 + rng.normal(0.0, 0.001, n)])
     assert not is_flat(chest, cfg)  # a person 0.4 m away: a flat patch 9 x 30 cm, no panel
+    close = np.column_stack([uv[:, 0] * 0.9, uv[:, 1], 0.45 + rng.normal(0.0, 0.001, n)])
+    assert not is_flat(close, cfg)  # 0.45 m away the chest fills the view, 0.54 m across
+
+
+def test_flatness_is_no_evidence_where_the_noise_reaches_a_bodys_relief():
+    """At 5 m the noise margin (0.0475 m) exceeds a torso's relief: a walker's upper body read
+    as flat as a wall (bookstore), and its track lost it."""
+    cfg = ForegroundConfig()
+    rng = np.random.default_rng(2)
+    uv = rng.uniform(-0.3, 0.3, (400, 2))
+    torso = np.column_stack([uv, 5.0 - 0.05 * (1.0 - (uv[:, 0] / 0.3) ** 2) + rng.normal(0.0, 0.01, 400)])
+    assert not is_flat(torso, cfg)
 
 
 def test_a_lost_persons_track_does_not_take_a_wall_piece():

@@ -37,6 +37,8 @@ __all__ = ["is_flat", "nearest_named"]
 
 DEPTH_RANGE_PERCENTILES = (5.0, 95.0)  # a blob's depth range, robust to a few stray points
 PANEL_MIN_SPAN_M = 0.5  # a flat blob this large would show a body's relief (a torso's width)
+PANEL_MIN_DEPTH_M = 1.0  # nearer, a patch of one body fills the view (0.5 m across at 0.4 m)
+BODY_RELIEF_M = 0.03  # a body's surface spreads at least this much along the view (thinnest σ)
 
 
 def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
@@ -44,13 +46,18 @@ def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
     ``PANEL_MIN_SPAN_M`` across and on one plane within the depth noise (their thinnest spread
     below ``unknown_min_thickness_m`` plus ``background_margin_per_m2`` · depth², depth: their
     median distance). A smaller patch is no evidence: a person 0.4 m from the camera shows a
-    piece of the chest, as flat as a wall."""
+    piece of the chest, as flat as a wall. Nor is a flat reading where the depth noise reaches a
+    body's relief (``BODY_RELIEF_M``, beyond about 3.6 m): a walker's upper body at 5 m reads as
+    flat as a wall there; nor nearer than ``PANEL_MIN_DEPTH_M``, where a person's chest fills
+    the whole image, 0.5 m across and flat."""
     if len(points_cam) < 4:
         return False
     if float(np.max(np.ptp(points_cam, axis=0))) < PANEL_MIN_SPAN_M:
         return False
     depth = float(np.median(points_cam[:, 2]))
     flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
+    if depth < PANEL_MIN_DEPTH_M or flat_m >= BODY_RELIEF_M:
+        return False
     return thickness_m(points_cam) < flat_m
 
 
