@@ -115,6 +115,21 @@ def test_foreground_scores(tiny):
     assert fg["walkers_matched"] == 1 and fg["walker_speed_error_mps"] == pytest.approx(0.0, abs=0.01)
 
 
+def test_a_table_the_foreground_found_is_right_and_one_it_left_to_the_background_no_miss(tiny):
+    doc = json.loads((tiny / "gt" / "instances.json").read_text())
+    doc["instances"].append({"id": 7, "name": "desk_0", "class": "table", "layer": "foreground",
+                             "static": True, "aabb_min": [-2, -1, 0], "aabb_max": [-1, 0, 0.75],
+                             "observed": True, "alt_classes": []})
+    (tiny / "gt" / "instances.json").write_text(json.dumps(doc))
+    truth, surfaces = load_truth(tiny), load_surfaces(tiny)
+    without = score_scene(truth, surfaces, _instances())["foreground"]
+    assert (without["tp"], without["fp"], without["fn_observed"]) == (2, 2, 1)  # no table missed
+    found = _thing("table", [-1.5, -0.5, 0.38], [1.0, 1.0, 0.76])
+    stray = _thing("table", [2.0, -2.5, 0.38], [1.0, 1.0, 0.76])
+    fg = score_scene(truth, surfaces, [*_instances(), found, stray])["foreground"]
+    assert fg["per_class"]["table"] == {"tp": 1, "fp": 1, "fn": 0}
+
+
 def test_cli_names_a_missing_gt(tmp_path):
     result = CliRunner().invoke(app, ["eval", "scene", str(tmp_path), "--kb", str(tmp_path / "kb")])
     assert result.exit_code != 0
