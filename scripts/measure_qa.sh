@@ -2,7 +2,7 @@
 # Issue 20's measurements: hiper eval qa on fresh hiper sim logs (and the realistic worlds when
 # QA_WORLDS=1), one line per log with the figures the issue sets targets for.
 # Usage: scripts/measure_qa.sh OUTDIR [DETECTOR]
-# QA_SEEDS (default "house:41 office:42 hospital:43 house:44 office:45"), QA_SECONDS (60),
+# QA_SEEDS (default "house:41 office:42 hospital:43 house:44 office:45"; "" for none), QA_SECONDS (60),
 # QA_LOGS (OUTDIR/logs; existing logs are reused).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,7 +12,7 @@ mkdir -p "$out"
 export HIPER_MODELS="${HIPER_MODELS:-../shared/models}"
 logs="${QA_LOGS:-$out/logs}"
 targets=()
-for spec in ${QA_SEEDS:-house:41 office:42 hospital:43 house:44 office:45}; do
+for spec in ${QA_SEEDS-house:41 office:42 hospital:43 house:44 office:45}; do
   world="${spec%%:*}"; seed="${spec##*:}"; name="${world}_${seed}"
   [ -f "$logs/$name/groundtruth.txt" ] || \
     .venv/bin/hiper sim --world "$world" --seconds "${QA_SECONDS:-60}" --seed "$seed" -o "$logs/$name" \
