@@ -151,7 +151,7 @@ def test_map_layer_from_the_background_is_stored_in_the_environment(hospital):
         assert inside.all()
         assert grid.cells[iy[0], ix[0]] == FREE  # corridor floor
         assert grid.cells[iy[1], ix[1]] == OCCUPIED  # the east wall
-        generate_heatmap(kb, "person", out_dir=path.parent / "o", store=False)
+        generate_heatmap(kb, "person", out_dir=path.parent / "o")  # stores the map it drew on
         stored = load_map(kb.environment("hospital"))
         assert stored is not None and np.array_equal(stored.cells, grid.cells)
         assert env.name == "hospital"
