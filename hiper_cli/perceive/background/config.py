@@ -102,6 +102,12 @@ class BackgroundConfig:
     merge_offset_m: float = 0.1
     merge_box_margin_m: float = 0.3
     merge_contour_margin_m: float = 0.15
+    # seeing a known instance again (``sighting.py``): its last_seen follows the camera when
+    # this many pixels (of 640x480, scaled) lie on it, tested every stride-th pixel, at most
+    # every refresh_s (0 pixels: off)
+    sighting_min_pixels: int = 400
+    sighting_stride_px: int = 8
+    sighting_refresh_s: float = 1.0
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:

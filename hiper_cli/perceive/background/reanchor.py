@@ -77,6 +77,7 @@ def reanchor(
         new = fold(moved, cfg, base=inst)
         new.observation_uuids = list(inst.observation_uuids)
         new.confidence = inst.confidence
+        new.last_seen_s = max(new.last_seen_s, inst.last_seen_s)  # a sighting (``sighting.py``)
         rebuilt.append(new)
         result.observations += len(obs)
     # instances that the new poses bring together are one (oldest survives)

@@ -30,6 +30,7 @@ from hiper_cli.perceive.background.merge import (
 )
 from hiper_cli.perceive.background.not_walls import NotWalls
 from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extract_planes
+from hiper_cli.perceive.background.sighting import sighted
 from hiper_cli.perceive.background.table_votes import TableVotes
 from hiper_cli.perceive.background.under import under_evidence
 from hiper_cli.perceive.stage import FrameResult, World
@@ -205,6 +206,8 @@ class BackgroundStage:
         touched, deleted = merge_observations(kept, live, self.config)
         deleted = vetoed + deleted + self._table_votes.settle(live)
         touched = {uuid: inst for uuid, inst in touched.items() if uuid in live}
+        for inst in sighted(frame, [i for u, i in live.items() if u not in touched], self.config):
+            touched[inst.uuid] = live[inst.uuid] = inst
         timings = {
             "background_s": time.perf_counter() - start,
             # CPU time of the process (all its threads): what the keyframe costs, whatever else runs
