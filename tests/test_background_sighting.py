@@ -2,8 +2,10 @@
 or not a plane segment forms: a table seen across a room answers "a table in the last 15 s"."""
 
 import numpy as np
+import pytest
 from _bg_scenes import SceneBox, box_room, look_at, make_frame
 
+from hiper_cli.errors import ConfigError
 from hiper_cli.model import Box3D, Instance
 from hiper_cli.perceive.background import BackgroundConfig
 from hiper_cli.perceive.background.sighting import sighted
@@ -40,3 +42,8 @@ def test_a_few_pixels_are_no_sighting():
     frame = make_frame(scene, look_at((0.5, 0.5, 1.2), (3.2, 2.4, 0.75)), stamp_s=30.0)
     many = BackgroundConfig(sighting_min_pixels=640 * 480)  # all the image on the table: never
     assert sighted(frame, [_table_instance(10.0)], many) == []
+
+
+def test_a_stride_below_one_is_a_config_error():
+    with pytest.raises(ConfigError, match="sighting_stride_px must be >= 1"):
+        BackgroundConfig(sighting_stride_px=0)

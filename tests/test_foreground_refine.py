@@ -260,3 +260,27 @@ def test_two_chairs_side_by_side_in_one_blob_come_apart_by_their_boxes():
     assert owners == [11, 12]
     assert len(refined(replace(cfg, split_twins=False), dets.xyxy, names)) == 1
     assert len(refined(cfg, dets.xyxy, ["person", "chair"])) == 1  # a person and a chair: no twins
+
+
+def _one_blob(*parts):
+    uv = np.concatenate([p.pixels_uv for p in parts])
+    cam = np.concatenate([p.points_cam for p in parts])
+    return Blob(cam, cam.copy(), uv, image_box(uv, 4, 640, 480))
+
+
+def test_two_chairs_one_behind_the_other_come_apart_and_one_chairs_two_boxes_do_not():
+    """Office 45: two chairs at a table's far end, seen along the row, made one blob whose
+    boxes overlapped by 0.6 (the nearer hides most of the farther): one chair instance."""
+    near = _flat_blob(100, 200, 160, 400, 3.9)
+    far = _flat_blob(160, 190, 185, 380, 4.6)  # the part of the farther chair the nearer leaves
+    boxes = np.array([[100.0, 200.0, 160.0, 400.0], [115.0, 190.0, 185.0, 380.0]])  # 0.61 shared
+    cfg = ForegroundConfig()
+
+    def split(blob, cfg):
+        return refine_blobs([blob], boxes, cfg, 640, 480, classes=["chair", "chair"])
+
+    parts = split(_one_blob(near, far), cfg)
+    assert sorted(len(b.points_cam) for b in parts) == sorted([len(near.points_cam), len(far.points_cam)])
+    assert len(split(_one_blob(near, far), replace(cfg, twin_depth_gap_m=0.0))) == 1
+    back = _flat_blob(160, 190, 185, 380, 4.2)  # 0.3 m behind: a chair's back, its second box
+    assert len(split(_one_blob(near, back), cfg)) == 1

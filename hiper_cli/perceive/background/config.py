@@ -116,6 +116,11 @@ class BackgroundConfig:
             raise ConfigError(f"background keyframe_hz must be positive, got {self.keyframe_hz}")
         if self.stride_px < 1 or self.cell_px < 2 or self.ransac_stride_px < 1:
             raise ConfigError("background stride_px, ransac_stride_px must be >= 1 and cell_px >= 2")
+        if self.sighting_stride_px < 1 or self.sighting_refresh_s < 0:
+            raise ConfigError(
+                f"background sighting_stride_px must be >= 1 (got {self.sighting_stride_px}) and "
+                f"sighting_refresh_s >= 0 (got {self.sighting_refresh_s})"
+            )
         if not 0 < self.min_depth_m < self.max_depth_m:
             raise ConfigError(
                 f"background depth range {self.min_depth_m}..{self.max_depth_m} m is empty; "

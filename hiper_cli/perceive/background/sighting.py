@@ -50,7 +50,7 @@ def sighted(frame: Frame, instances: Iterable[Instance], cfg: BackgroundConfig) 
     todo = [i for i in instances if frame.stamp_s - i.last_seen_s >= cfg.sighting_refresh_s]
     if not todo or cfg.sighting_min_pixels <= 0:
         return []
-    stride = max(1, cfg.sighting_stride_px)
+    stride = cfg.sighting_stride_px
     points, z = _map_samples(frame, stride, cfg)
     if len(points) == 0:
         return []

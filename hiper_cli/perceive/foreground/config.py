@@ -233,6 +233,11 @@ class RefineConfig(SegmentConfig):
     none half inside another): bottles, cups or chairs in a row that the clustering joined (its
     tolerance grows with the depth: 0.26 m at 4 m). Boxes of one class side by side are two
     objects whatever the jitter; a person beside a chair keeps to the rule above."""
+    twin_depth_gap_m: float = 0.5
+    """Two boxes of one class that overlap by half or more are still twins when the points only
+    one holds lie this much farther than the other's in median depth (two chairs one behind the
+    other at a table's far end, two cups at the image's border); nearer, they are duplicate boxes
+    of one object (a chair's back is 0.2-0.45 m behind its seat's front; 0: never)."""
     detection_join: bool = True
     """Join blobs inside one detection box that an occluder cut apart."""
     join_containment: float = 0.8
@@ -251,7 +256,7 @@ class RefineConfig(SegmentConfig):
     def __post_init__(self) -> None:
         super().__post_init__()
         _nonnegative(self, ("split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac",
-                            "trim_margin_frac", "trim_depth_m"))
+                            "twin_depth_gap_m", "trim_margin_frac", "trim_depth_m"))
         if not 0.0 < self.join_containment <= 1.0:
             raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
 

@@ -15,7 +15,8 @@ IoU matching of Algorithm 4:
 1. **Split**: a blob whose pixels fall into two or more detection boxes (each holding at least
    ``min_cluster_points`` of them) is divided (``detection_split``; without it, only a blob that
    holds two or more boxes of one class side by side, ``split_twins``: each box at least
-   ``join_containment`` inside the blob's image box, none half inside another). Every point
+   ``join_containment`` inside the blob's image box, none half inside another unless their
+   own points lie ``twin_depth_gap_m`` apart in depth: one chair behind the other). Every point
    goes to the smallest box it lies in (the specific object in front of a larger one); a
    point inside several boxes then goes to the box whose points' median depth is nearest its
    own (a chair seen through the bottle's box keeps the chair's depth). Points outside every
@@ -112,12 +113,34 @@ def _split(
     return groups if len(groups) >= 2 else None
 
 
+def _apart_in_depth(blob: Blob, a: FloatArray, b: FloatArray, config: RefineConfig) -> bool:
+    """Whether the points of ``blob`` that only box ``a`` holds and those that only ``b`` holds
+    (or, for a box inside the other, those the inner one holds) lie more than
+    ``twin_depth_gap_m`` apart in median depth: one object behind the other, not one object's
+    duplicate boxes. False when either side has fewer than ``min_cluster_points``."""
+    if config.twin_depth_gap_m <= 0:
+        return False
+    inside = _inside(blob.pixels_uv, np.stack([a, b]))
+    only_a, only_b = inside[:, 0] & ~inside[:, 1], inside[:, 1] & ~inside[:, 0]
+    both = inside[:, 0] & inside[:, 1]
+    if np.count_nonzero(only_a) < config.min_cluster_points:
+        only_a = both
+    elif np.count_nonzero(only_b) < config.min_cluster_points:
+        only_b = both
+    if min(np.count_nonzero(only_a), np.count_nonzero(only_b)) < config.min_cluster_points:
+        return False
+    z = blob.points_cam[:, 2]
+    return bool(abs(float(np.median(z[only_a])) - float(np.median(z[only_b]))) > config.twin_depth_gap_m)
+
+
 def _twins(
-    blob_box: FloatArray, boxes: FloatArray, classes: Sequence[str], config: RefineConfig
+    blob: Blob, boxes: FloatArray, classes: Sequence[str], config: RefineConfig
 ) -> NDArray[np.int64]:
-    """The detection boxes of the class with most boxes side by side in ``blob_box`` (each at
-    least ``join_containment`` inside it, none half inside another: duplicate boxes of one
-    object, a chair and its back, are no twins); empty when fewer than two."""
+    """The detection boxes of the class with most boxes side by side in the blob's image box
+    (each at least ``join_containment`` inside it, none half inside another unless the two lie
+    at different depths, ``_apart_in_depth``: duplicate boxes of one object, a chair and its
+    back, are no twins; two chairs one behind the other are); empty when fewer than two."""
+    blob_box = blob.image_box_xyxy
     lo = np.maximum(blob_box[None, :2], boxes[:, :2])
     hi = np.minimum(blob_box[None, 2:], boxes[:, 2:])
     area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
@@ -133,7 +156,8 @@ def _twins(
         common = np.prod(np.clip(p_hi - p_lo, 0.0, None), axis=2)
         smaller = np.minimum(area[idx][:, None], area[idx][None, :])
         np.fill_diagonal(common, 0.0)
-        if np.all(common < 0.5 * smaller) and len(idx) > len(best):
+        overlapping = np.argwhere(np.triu(common >= 0.5 * smaller, k=1))
+        if all(_apart_in_depth(blob, b[i], b[j], config) for i, j in overlapping) and len(idx) > len(best):
             best = idx
     return best
 
@@ -250,7 +274,7 @@ def refine_blobs(
         for blob in blobs:
             twins = (
                 np.zeros(0, dtype=np.int64) if blob.fragment
-                else _twins(blob.image_box_xyxy, boxes, classes, config)
+                else _twins(blob, boxes, classes, config)
             )
             groups = _split(blob, boxes[twins], areas[twins], config) if len(twins) >= 2 else None
             if groups is None:

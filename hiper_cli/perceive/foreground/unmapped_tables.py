@@ -6,7 +6,7 @@ hospital room, 0.6 m wide) gives too thin a band of pixels for its plane cells, 
 is never mapped. The foreground finds such a top in a blob (``tables.py``: a horizontal slab
 at table height, of columns that end there, wide both ways, in a blob a detection names or
 that holds a detected object) and takes it and its legs out of the blob. That slab is a table:
-``table_observations`` makes it an observation of class ``table`` (``TABLE_CLASS``, the
+the stage makes it an observation of class ``table`` (``table_match``: ``TABLE_CLASS``, the
 background's name for it), tracked as any object, so it needs ``min_class_observations``
 frames, as a detector's class would, before it is an instance.
 
