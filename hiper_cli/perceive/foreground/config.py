@@ -236,8 +236,8 @@ class RefineConfig(SegmentConfig):
     twin_depth_gap_m: float = 0.5
     """Two boxes of one class that overlap by half or more are still twins when the points only
     one holds lie this much farther than the other's in median depth (two chairs one behind the
-    other at a table's far end, two cups at the image's border); nearer, they are duplicate boxes
-    of one object (a chair's back is 0.2-0.45 m behind its seat's front; 0: never)."""
+    other at a table's far end); nearer, they are duplicate boxes of one object (a chair's back
+    is 0.2-0.45 m behind its seat's front; 0: never)."""
     detection_join: bool = True
     """Join blobs inside one detection box that an occluder cut apart."""
     join_containment: float = 0.8
