@@ -259,32 +259,28 @@ def refine_blobs(
         return [b for b in blobs if not b.fragment]
     step = config.pixel_step
     areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+    twins_on = config.split_twins and len(classes) == len(boxes)
+
+    def groups_of(blob: Blob) -> list[NDArray[np.int64]] | None:
+        if blob.fragment:
+            return None
+        if config.detection_split:
+            return _split(blob, boxes, areas, config)
+        if twins_on:
+            twins = _twins(blob, boxes, classes, config)
+            return _split(blob, boxes[twins], areas[twins], config) if len(twins) >= 2 else None
+        return None
+
     out: list[Blob] = []
     changed: list[bool] = []
-    if config.detection_split:
-        for blob in blobs:
-            groups = None if blob.fragment else _split(blob, boxes, areas, config)
-            if groups is None:
-                out.append(blob)
-                changed.append(False)
-            else:
-                out.extend(sub_blob(blob, g, step, width, height) for g in groups)
-                changed.extend([True] * len(groups))
-    elif config.split_twins and len(classes) == len(boxes):
-        for blob in blobs:
-            twins = (
-                np.zeros(0, dtype=np.int64) if blob.fragment
-                else _twins(blob, boxes, classes, config)
-            )
-            groups = _split(blob, boxes[twins], areas[twins], config) if len(twins) >= 2 else None
-            if groups is None:
-                out.append(blob)
-                changed.append(False)
-            else:
-                out.extend(sub_blob(blob, g, step, width, height) for g in groups)
-                changed.extend([True] * len(groups))
-    else:
-        out, changed = list(blobs), [False] * len(blobs)
+    for blob in blobs:
+        groups = groups_of(blob)
+        if groups is None:
+            out.append(blob)
+            changed.append(False)
+        else:
+            out.extend(sub_blob(blob, g, step, width, height) for g in groups)
+            changed.extend([True] * len(groups))
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
     pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
     grown = boxes + pad

@@ -177,16 +177,16 @@ class ForegroundStage:
                 return False
         return True
 
-    def _stands(self, class_name: str, blob: Blob) -> bool:
+    def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
         above the floor: people stand on it, and even behind a counter their visible part
         reaches below that (a person detection on a poster, a shelf's top or a reflection);
-        and for a flat one (``walker_solid``, ``solid.is_flat``: a picture or a screen showing
+        and for a ``flat`` one (``walker_solid``, ``solid.is_flat``: a picture or a screen showing
         people, a wall piece)."""
         cfg = self.config
         if class_name not in cfg.walker_classes:
             return True
-        if cfg.walker_solid and is_flat(blob.points_cam, cfg):
+        if flat:
             return False
         if cfg.walker_max_base_m <= 0:
             return True
@@ -269,8 +269,8 @@ class ForegroundStage:
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
         found_tables: list[Blob] = []
+        names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
         if cfg.background_filter:
-            names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
             blobs, found_tables = split_unseen_tables(
                 blobs, usable, names, cfg, frame.camera.width, frame.camera.height
             )
@@ -280,7 +280,7 @@ class ForegroundStage:
                 )
         if refine:
             blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports,
-                                 classes=[n for n, keep in zip(dets.class_names, ok, strict=True) if keep])
+                                 classes=names)
         t_refine = time.perf_counter()
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
@@ -294,11 +294,12 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
+            flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
             longest = None
             if match.detection_index is not None and cfg.class_sizes:
                 longest = longest_m(blob.points_map, float(blob.extent_map_m[2]))
             if match.detection_index is not None and not (
-                self._fits_priors(match.class_name, blob) and self._stands(match.class_name, blob)
+                self._fits_priors(match.class_name, blob) and self._stands(match.class_name, blob, flat)
                 and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
                 and (match.class_name not in cfg.fixture_classes
                      or attached(blob.points_map, walls, tops, cfg.fixture_reach_m))
@@ -323,7 +324,7 @@ class ForegroundStage:
                     standing=self._standing_box(blob),  # a walking track takes any blob as standing
                     bounds_map_m=_corners(blob),
                     longest_m=longest,
-                    solid=not (cfg.walker_solid and is_flat(blob.points_cam, cfg)),
+                    solid=not flat,
                     detection_index=match.detection_index,
                 )
             )

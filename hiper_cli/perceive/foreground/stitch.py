@@ -54,7 +54,7 @@ def find_target(
     together: Callable[[Track, Track], bool] | None = None,
 ) -> tuple[Track, str] | None:
     """The older confirmed track ``new`` continues, and how (``RESUME``, ``DUPLICATE``,
-    ``REVISIT``), or None. ``moving(track)``: whether it is no static object (``tracking.is_static``);
+    ``REVISIT``), or None. ``moving(track)``: whether it is no static object (``moving.is_static``);
     ``together(new, old)``, when given, decides instead whether the two are one static object
     (``same_object.static_together``: a pair of partial views may look moving one by one)."""
     walkers = config.walker_classes

@@ -27,8 +27,8 @@
   detection does not bias a moving track. A track only ages while its predicted centre is
   visible to the camera (in the image, not hidden behind nearer depth): a person who walks out
   of view keeps the identity for ``lost_max_s``.
-- Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother (every row
-  then uses all observations of the track, so the first rows are no longer noisy).
+- Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother
+  (``smoother.py``: every row then uses all observations of the track).
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
   after ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``) → closed after
   ``max_age_s`` unseen in view (or ``lost_max_s`` anywhere). Only confirmed tracks are instances;
@@ -50,13 +50,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_STATE, ROW_VELOCITY, new_uuid
+from hiper_cli.model import ROW_POSITION, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
-from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model, process_noise
+from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model
+from hiper_cli.perceive.foreground.moving import is_static, was_moving
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 from hiper_cli.perceive.foreground.same_object import STAMP_DECIMALS, due, fold, newer_match, static_together
 from hiper_cli.perceive.foreground.seen_box import SeenBox
+from hiper_cli.perceive.foreground.smoother import smooth_trajectory
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
@@ -68,7 +70,7 @@ from hiper_cli.perceive.foreground.stitch import (
     stale_rows,
 )
 
-__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "object_box", "smooth_trajectory"]
+__all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "object_box"]
 
 FloatArray = NDArray[np.float64]
 UNKNOWN = "unknown"
@@ -181,7 +183,7 @@ class Track:
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
     _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
-    # ``_was_moving`` for the trajectory of this many rows (rows change only by being added)
+    # ``moving.was_moving`` for the trajectory of this many rows (rows change only by being added)
     _moving: tuple[int, bool] | None = field(default=None, repr=False)
 
     @property
@@ -279,52 +281,6 @@ def standing_level(track: Track) -> tuple[float, float] | None:
     return track.floor_z_m + height / 2.0, height
 
 
-def smooth_trajectory(track: Track) -> None:
-    """Rauch-Tung-Striebel smoothing of a closed track's trajectory rows (in place), for the
-    constant-velocity model.
-
-    The filter's estimates at the start of a track rest on few observations; once the track is
-    closed every row can use all of them. Rows keep their stamps; positions and velocities
-    become the smoothed ones.
-    """
-    rows = track.trajectory
-    n = len(rows)
-    if n < 3 or len(track.covariances) != n:
-        return
-    xs = [np.asarray(r[ROW_STATE], dtype=np.float64) for r in rows]
-    Ps = [np.asarray(P, dtype=np.float64) for P in track.covariances]
-    for k in range(n - 2, -1, -1):
-        dt = rows[k + 1][ROW_STAMP] - rows[k][ROW_STAMP]
-        if dt <= 0:
-            continue
-        F = np.eye(6)
-        F[:3, 3:] = np.eye(3) * dt
-        x_k, P_k = np.asarray(rows[k][ROW_STATE], dtype=np.float64), track.covariances[k]
-        x_pred = F @ x_k
-        P_pred = F @ P_k @ F.T + process_noise(dt, *track.noises[k + 1])
-        try:
-            C = P_k @ F.T @ np.linalg.inv(P_pred)
-        except np.linalg.LinAlgError:
-            continue
-        xs[k] = x_k + C @ (xs[k + 1] - x_pred)
-        Ps[k] = P_k + C @ (Ps[k + 1] - P_pred) @ C.T
-    for row, x in zip(rows, xs, strict=True):
-        row[ROW_STATE] = x.tolist()
-
-
-def is_static(track: Track, config: TrackerConfig) -> bool:
-    """Whether a track is a static object: not of a walking class, and its blobs stayed where
-    they were (``SeenBox.moved``; for ``unknown``, which may be a person not named yet: the
-    filter, ``_was_moving``). A static object's filtered velocity is no evidence: partial
-    views move a blob's centroid, and beds that never moved read 2 m/s."""
-    name = track.class_name
-    if name in config.walker_classes:
-        return False
-    if name == UNKNOWN:
-        return not _was_moving(track, config)
-    return not track.seen.moved()
-
-
 def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatArray]:
     """(centre, extent), map frame, of the object a track is: a static one's seen box (the union
     of its blobs, ``SeenBox``); a walker's or a moving object's filtered box where it was last
@@ -340,37 +296,6 @@ def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatAr
             return found
     centre = np.asarray(track.trajectory[-1][ROW_POSITION]) if track.trajectory else track.position
     return np.asarray(centre, dtype=np.float64), track.extent_m
-
-
-def _was_moving(track: Track, config: TrackerConfig) -> bool:
-    """Whether the track was moving when last updated: its filtered velocity then and its
-    filtered displacement over the last ``moving_window_s`` (at least ``min_moving_span_s`` of
-    history) both exceed ``moving_speed_mps``. Either alone is fooled: the velocity by noise,
-    the displacement by a blob that grew or lost a part; a track seen too briefly is not
-    known to move. Computed once per trajectory length (an update adds a row)."""
-    rows = track.trajectory
-    if track._moving is not None and track._moving[0] == len(rows):
-        return track._moving[1]
-    moving = _moving_rows(rows, config)
-    track._moving = (len(rows), moving)
-    return moving
-
-
-def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:
-    if not rows or math.hypot(*rows[-1][ROW_VELOCITY][:2]) <= config.moving_speed_mps:
-        return False
-    t_end = rows[-1][ROW_STAMP]
-    start = rows[0]
-    for row in reversed(rows):
-        if t_end - row[ROW_STAMP] >= config.moving_window_s:
-            start = row
-            break
-    span = t_end - start[ROW_STAMP]
-    if span < config.min_moving_span_s:
-        return False
-    (x_end, y_end), (x_start, y_start) = rows[-1][ROW_POSITION][:2], start[ROW_POSITION][:2]
-    dx, dy = x_end - x_start, y_end - y_start
-    return math.hypot(dx, dy) / span > config.moving_speed_mps
 
 
 def _size_m(extent_m: FloatArray) -> float:
@@ -573,7 +498,7 @@ class Tracker:
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
             return learned, learned
-        searching = track.search_class in cfg.search_classes and _was_moving(track, cfg)
+        searching = track.search_class in cfg.search_classes and was_moving(track, cfg)
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
@@ -590,7 +515,7 @@ class Tracker:
             return False
         if track.class_name != UNKNOWN:  # where its blobs were, not where partial views move its filter
             return is_static(track, cfg)
-        return not _was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
+        return not was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated assignment (``association``)."""
@@ -723,7 +648,7 @@ class Tracker:
             return not is_static(track, cfg)
 
         def together(a: Track, b: Track) -> bool:
-            return static_together(a, b, cfg.walker_classes, lambda t: _was_moving(t, cfg))
+            return static_together(a, b, cfg.walker_classes, lambda t: was_moving(t, cfg))
 
         pair = together if cfg.stitch_static_again else None
         for new in fresh:
