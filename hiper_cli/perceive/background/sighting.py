@@ -17,30 +17,15 @@ import dataclasses
 from collections.abc import Iterable
 
 import numpy as np
-from numpy.typing import NDArray
 
 from hiper_cli.model import Instance
 from hiper_cli.perceive.background.config import BackgroundConfig
+from hiper_cli.perceive.background.planes import sample_grid
 from hiper_cli.types import Frame
 
 __all__ = ["sighted"]
 
-FloatArray = NDArray[np.float64]
 REFERENCE_PIXELS = 640 * 480  # ``sighting_min_pixels`` is given for this image size
-
-
-def _map_samples(frame: Frame, stride: int, cfg: BackgroundConfig) -> tuple[FloatArray, FloatArray]:
-    """(points (N, 3) map frame, depth (N,) m) of the valid samples of every ``stride``-th pixel."""
-    depth = np.asarray(frame.depth_m[::stride, ::stride], dtype=np.float64)
-    v, u = np.mgrid[0:frame.depth_m.shape[0]:stride, 0:frame.depth_m.shape[1]:stride]
-    valid = np.isfinite(depth) & (depth >= cfg.min_depth_m) & (depth <= cfg.max_depth_m)
-    z = depth[valid]
-    cam = frame.camera
-    x = (u[valid] - cam.cx) / cam.fx * z
-    y = (v[valid] - cam.cy) / cam.fy * z
-    T = np.asarray(frame.T_map_cam, dtype=np.float64)
-    points = np.column_stack([x, y, z]) @ T[:3, :3].T + T[:3, 3]
-    return points, z
 
 
 def sighted(frame: Frame, instances: Iterable[Instance], cfg: BackgroundConfig) -> list[Instance]:
@@ -51,9 +36,12 @@ def sighted(frame: Frame, instances: Iterable[Instance], cfg: BackgroundConfig) 
     if not todo or cfg.sighting_min_pixels <= 0:
         return []
     stride = cfg.sighting_stride_px
-    points, z = _map_samples(frame, stride, cfg)
-    if len(points) == 0:
+    grid = sample_grid(frame.depth_m, frame.camera, stride, cfg.min_depth_m, cfg.max_depth_m)
+    cam = grid.points_cam[grid.valid]
+    if len(cam) == 0:
         return []
+    T = np.asarray(frame.T_map_cam, dtype=np.float64)
+    points, z = cam @ T[:3, :3].T + T[:3, 3], cam[:, 2]
     h, w = frame.depth_m.shape[:2]
     min_samples = max(1, round(cfg.sighting_min_pixels * (h * w) / REFERENCE_PIXELS / (stride * stride)))
     margin = cfg.inlier_m * np.maximum(z, 1.0)
