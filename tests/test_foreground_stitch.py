@@ -80,6 +80,26 @@ def test_the_switch_and_a_walker_too_far_away_keep_two():
     assert len(run.uuids()) == 2
 
 
+@pytest.mark.parametrize(("pace_factor", "instances"), [(1.5, 2), (0.0, 1)])
+def test_the_next_person_in_a_corridor_is_not_the_slow_walker_lost_there(pace_factor, instances):
+    """A walker at 0.6 m/s lost, and 2 s later a person in other clothes 4.6 m back the way it
+    came: a walk of 2.3 m/s (1.5 m/s from its rows 3 s before), not at its pace."""
+    run = _Run(stitch_pace_factor=pace_factor)
+    end = run.walk([0, 0, 0.85], [-0.6, 0, 0], 4.0, colours=_colours(0))
+    run.idle(2.0)
+    run.walk(end + np.array([4.6, 0.2, 0.0]), [-0.6, 0, 0], 3.0, colours=_colours(20))
+    assert len(run.uuids()) == instances
+
+
+def test_a_walker_keeps_its_pace_and_turns_back_unseen():
+    """Lost for 2 s, it turned and came back past where it was: within its pace, one person."""
+    run = _Run()
+    end = run.walk([0, 0, 0.85], [0.6, 0, 0], 4.0, colours=_colours(0))
+    run.idle(2.0)
+    run.walk(end + np.array([-0.8, 0.1, 0.0]), [-0.6, 0, 0], 3.0, colours=_colours(20))
+    assert len(run.uuids()) == 1
+
+
 @pytest.mark.parametrize(("colours_after", "instances"), [(0, 1), (20, 2)])
 def test_after_a_long_gap_the_clothes_tell(colours_after, instances):
     run = _Run()

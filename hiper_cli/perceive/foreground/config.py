@@ -456,6 +456,12 @@ class TrackerConfig(_Part):
     stitch_speed_mps: float = 1.5
     stitch_margin_m: float = 0.5
     """... within ``stitch_margin_m`` plus this speed times the gap of that row's position ..."""
+    stitch_pace_factor: float = 1.5
+    stitch_min_pace_mps: float = 0.6
+    """... where the speed is the old walker's own pace, at most this factor times its median
+    speed (at least ``stitch_min_pace_mps``, at most ``stitch_speed_mps``): a person who walked
+    at 0.6 m/s did not cover 5 m in 3 s, another person came into view (0: any walker may go
+    ``stitch_speed_mps``) ..."""
     stitch_appearance_gap_s: float = 60.0
     stitch_min_similarity: float = 0.8
     """... or after a longer gap, up to ``stitch_appearance_gap_s``, with colour histograms
@@ -501,7 +507,8 @@ class TrackerConfig(_Part):
             raise ConfigError(f"confirm_hits must be >= 1, got {self.confirm_hits}")
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
-                            "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m"))
+                            "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m",
+                            "stitch_pace_factor", "stitch_min_pace_mps"))
         _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance"))
 
 

@@ -4,10 +4,11 @@ The frame-to-frame association misses in three ways that leave one object as sev
 
 - **resume**: a walker's track closed or lost it (an occluder, a turn, the image border, a blob
   too small for ``walker_min_size_ratio``) and a new track picked the walker up; the new track
-  starts where the old one, walking at most ``stitch_speed_mps``, could be after the gap
-  (at most ``stitch_max_gap_s``) from any of its rows of that long before; lost for longer (at
-  most ``stitch_appearance_gap_s``), the walker's clothes tell: the colour histograms of the
-  two tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
+  starts where the old one, keeping its pace (``stitch_pace_factor`` times its median speed, at
+  most ``stitch_speed_mps``), could be after the gap (at most ``stitch_max_gap_s``) from any of
+  its rows of that long before; lost for longer or farther (a gap up to
+  ``stitch_appearance_gap_s``), the walker's clothes tell: the colour histograms of the two
+  tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
 - **duplicate**: two blobs of one walker (the head above a shelf, the legs below it) fed two
   tracks at once, or two tracks took it in turns; the new one stays within
   ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``);
@@ -28,7 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import ROW_POSITION, ROW_STAMP
+from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_VELOCITY
 from hiper_cli.perceive.foreground.appearance import similarity
 
 if TYPE_CHECKING:
@@ -99,7 +100,8 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
         # was last: a lost track's last rows are often junk blobs it took while searching.
         gap_s, dist, reach, _ = _resume_geometry(new, old, config)
         near = gap_s <= config.stitch_max_gap_s
-        if near.any() and (ratio := float((dist[near] / reach[near]).min())) <= 1.0:
+        paced = config.stitch_margin_m + _pace_mps(old, config) * np.maximum(gap_s, 0.0)
+        if near.any() and (ratio := float((dist[near] / paced[near]).min())) <= 1.0:
             return ratio, RESUME
         # Lost for longer: the same clothes, and reachable walking from where it was.
         similar = _similarity(new, old)
@@ -129,6 +131,18 @@ def _resume_geometry(
     dist = np.hypot(*(rows[:, 1:3] - start).T)
     reach = config.stitch_margin_m + config.stitch_speed_mps * np.maximum(gap_s, 0.0)
     return gap_s, dist, reach, first
+
+
+def _pace_mps(old: Track, config: TrackerConfig) -> float:
+    """How fast the old walker may have gone while unseen: ``stitch_pace_factor`` times its
+    median speed over the rows a resume looks back on, within [``stitch_min_pace_mps``,
+    ``stitch_speed_mps``]; ``stitch_speed_mps`` when the factor is 0."""
+    if config.stitch_pace_factor <= 0:
+        return config.stitch_speed_mps
+    rows = np.asarray(old.trajectory[-MAX_RESUME_ROWS:], dtype=np.float64)
+    speed = float(np.median(np.hypot(*rows[:, ROW_VELOCITY][:, :2].T)))
+    pace = config.stitch_pace_factor * speed
+    return float(min(max(pace, config.stitch_min_pace_mps), config.stitch_speed_mps))
 
 
 def stale_rows(new: Track, old: Track, config: TrackerConfig) -> int:
