@@ -7,7 +7,8 @@ import pytest
 
 from hiper_cli.perceive.foreground.appearance import HISTOGRAM_BINS, histogram, similarity
 from hiper_cli.perceive.foreground.config import TrackerConfig
-from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
+from hiper_cli.perceive.foreground.stitch import RESUME, find_target
+from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker
 
 RATE_HZ = 15.0
 PERSON = np.array([0.5, 0.4, 1.7])
@@ -187,3 +188,27 @@ def test_a_walker_stands_on_the_floor_whatever_part_of_it_a_blob_shows():
     assert track.velocity[2] == 0.0
     (closed,) = tracker.close_all()
     assert [row[3] for row in closed.trajectory] == pytest.approx([0.85] * 60, abs=1e-6)
+
+
+def _walker_track(name, stamps, x_of_t, first_seen):
+    """A confirmed person track with one row per stamp, walking along x."""
+    rows = [[t, x_of_t(t), 0.0, 0.85, 0.6, 0.0, 0.0] for t in stamps]
+    return Track(uuid=name, motion=None, first_seen_s=first_seen, last_update_s=stamps[-1],
+                 last_time_s=stamps[-1], extent_m=PERSON, confirmed=True, hits=len(stamps),
+                 class_votes={"person": float(len(stamps))}, class_counts={"person": len(stamps)},
+                 trajectory=rows)
+
+
+@pytest.mark.parametrize(("old_last_s", "apart_m", "joined"), [(3.7, 0.05, True), (3.7, 1.0, False),
+                                                               (4.4, 0.05, False)])
+def test_a_handover_between_two_tracks_of_one_walker_is_a_resume(old_last_s, apart_m, joined):
+    """The old track lost the walker at 3.0 s, a new one took it from 3.03 s, and the old one
+    took it once more at ``old_last_s``: one stamp in common, too few for a duplicate."""
+    walk = lambda t: 0.6 * t  # noqa: E731
+    old_stamps = [k / RATE_HZ for k in range(46)] + [old_last_s]
+    old = _walker_track("old", old_stamps, lambda t: walk(t) + (apart_m if t > 3.5 else 0.0), 0.0)
+    new_stamps = [3.03 + k / RATE_HZ for k in range(30)]
+    new_stamps = sorted({round(t, 4) for t in new_stamps} | {old_last_s})
+    new = _walker_track("new", new_stamps, walk, 3.03)
+    found = find_target(new, [old], TrackerConfig(), moving=lambda t: True)
+    assert (found == (old, RESUME)) is joined

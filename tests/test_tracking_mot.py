@@ -319,6 +319,17 @@ def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate():
     assert joined == [track.uuid]
 
 
+@pytest.mark.parametrize(("max_footprint_m", "couch_joins"), [(1.2, False), (5.0, True)])
+def test_a_lost_person_track_does_not_take_a_couch(max_footprint_m, couch_joins):
+    """An unmatched blob beyond the normal gate, as tall as half the person but 1.0 by 1.7 m
+    seen from above: a couch, not the person coming back."""
+    tracker, track = _lost_person_track(ForegroundConfig(search_max_footprint_m=max_footprint_m))
+    couch = Measurement(track.position + np.array([1.2, 0.5, -0.45]), np.array([1.0, 1.7, 0.85]),
+                        "unknown", 0.0, "couch")
+    _, joined = tracker.step(2.0, [couch])
+    assert (joined == [track.uuid]) is couch_joins
+
+
 def test_one_missed_frame_at_4_hz_is_not_lost_yet():
     rate = 4.0
     tracker = Tracker(ForegroundConfig())

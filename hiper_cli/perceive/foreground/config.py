@@ -385,7 +385,11 @@ class TrackerConfig(_Part):
     search_unknown_max_s: float = 3.0
     """... and that only within this long of its last update: a person comes back through the
     border soon after leaving it, while after longer only a detection says a blob is the person
-    (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m away)."""
+    (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m away) ..."""
+    search_max_footprint_m: float = 1.2
+    """... and no wider than this seen from above (the diagonal of its box's footprint): a
+    person is about a metre across at most; a lost person's track took a couch's blob, 1.0 by
+    1.7 m, and kept it while the person went on as a new track."""
     moving_speed_mps: float = 0.3
     """Only a track that was moving faster than this when last seen (filtered velocity and
     displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
@@ -508,7 +512,7 @@ class TrackerConfig(_Part):
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m",
-                            "stitch_pace_factor", "stitch_min_pace_mps"))
+                            "stitch_pace_factor", "stitch_min_pace_mps", "search_max_footprint_m"))
         _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance"))
 
 

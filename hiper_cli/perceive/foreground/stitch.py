@@ -11,7 +11,9 @@ The frame-to-frame association misses in three ways that leave one object as sev
   tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
 - **duplicate**: two blobs of one walker (the head above a shelf, the legs below it) fed two
   tracks at once, or two tracks took it in turns; the new one stays within
-  ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``);
+  ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``); when
+  the old one took the walker only once or twice after the new one started (at most
+  ``HANDOVER_MAX_S`` later) and was within ``stitch_duplicate_m`` then, the new one resumes it;
 - **revisit**: a static object (a chair, a shelf's junk) seen again after its track closed, or
   a part of it (a chair's back) tracked beside the whole: the footprints of the boxes the two
   tracks' blobs fill overlap by ``stitch_min_overlap``, at most ``stitch_overlap_m`` apart
@@ -45,6 +47,7 @@ UNKNOWN = "unknown"
 STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
 INTERPOLATE_MAX_S = 0.5  # a track's position between two of its rows at most this far apart
 MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at 30 Hz)
+HANDOVER_MAX_S = 1.0  # a new walker track this much older than the old one's last row
 
 
 def find_target(
@@ -115,6 +118,12 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     apart_m = _common_distance_m(new, old, config.confirm_hits)
     if apart_m is not None and apart_m <= config.stitch_duplicate_m:
         return apart_m / config.stitch_duplicate_m, DUPLICATE
+    if old.last_update_s - new.first_seen_s <= HANDOVER_MAX_S:
+        # A handover: the old track took the walker once or twice more after the new one
+        # started, too few common stamps for a duplicate; the new one goes on as the walker.
+        apart_m = _common_distance_m(new, old, 1)
+        if apart_m is not None and apart_m <= config.stitch_duplicate_m:
+            return apart_m / config.stitch_duplicate_m, RESUME
     return None
 
 

@@ -544,6 +544,7 @@ class Tracker:
         sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
         solid = np.array([m.solid for m in measurements], dtype=bool)
         half_extents = np.array([m.extent_map_m for m in measurements]) / 2.0
+        footprints = 2.0 * np.hypot(half_extents[:, 0], half_extents[:, 1])
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             if self._settled(t):
@@ -559,6 +560,7 @@ class Tracker:
                 # Lost and searching: another class only when it is an unmatched blob as big as
                 # the person (the person cut by the border).
                 person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
+                person_sized &= footprints <= cfg.search_max_footprint_m
                 person_sized &= stamp_s - t.last_update_s <= cfg.search_unknown_max_s
                 allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
         return self._assign(cost, allowed)
