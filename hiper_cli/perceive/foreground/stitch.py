@@ -47,7 +47,7 @@ UNKNOWN = "unknown"
 STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
 INTERPOLATE_MAX_S = 0.5  # a track's position between two of its rows at most this far apart
 MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at 30 Hz)
-HANDOVER_MAX_S = 1.0  # a new walker track this much older than the old one's last row
+HANDOVER_MAX_S = 1.0  # the old walker track's last row at most this long after the new one began
 
 
 def find_target(

@@ -543,8 +543,9 @@ class Tracker:
         unknown = classes == UNKNOWN
         sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
         solid = np.array([m.solid for m in measurements], dtype=bool)
-        half_extents = np.array([m.extent_map_m for m in measurements]) / 2.0
-        footprints = 2.0 * np.hypot(half_extents[:, 0], half_extents[:, 1])
+        extents = np.array([m.extent_map_m for m in measurements])
+        half_extents = extents / 2.0
+        footprints = np.hypot(extents[:, 0], extents[:, 1])  # diagonal seen from above
         for i, t in enumerate(self.tracks):
             cls = t.class_name
             if self._settled(t):
