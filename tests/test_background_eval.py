@@ -95,3 +95,28 @@ def test_cli_errors_name_the_file(tmp_path):
     assert "world.json" in result.output
     result = CliRunner().invoke(app, ["eval", "background", str(tmp_path), "--method", "magic"])
     assert result.exit_code != 0
+
+
+def test_json_export_gives_each_plane_its_equation(sim_log, tmp_path):
+    """A reader that ignores the box's axes still learns which way a wall faces: each
+    background instance carries its plane, and the walls' planes are the room's inner faces."""
+    kb = tmp_path / "kb"
+    runner = CliRunner()
+    result = runner.invoke(app, ["perceive", str(sim_log), "--kb", str(kb), "--stages", "background"])
+    assert result.exit_code == 0, result.output
+    out = tmp_path / "scene.json"
+    assert runner.invoke(app, ["export", str(out), "--kb", str(kb)]).exit_code == 0
+    instances = json.loads(out.read_text())["instances"]
+    walls = [i for i in instances if i["class"] == "wall"]
+    assert walls and all(i["plane"] is None for i in instances if i["layer"] == "foreground")
+    inner_faces = {(0, 0.0), (0, 6.0), (1, 0.0), (1, 5.0)}  # (axis, coordinate) of box_room's walls
+    for wall in walls:
+        a, b, c, d = wall["plane"]
+        n = np.array([a, b, c])
+        assert np.linalg.norm(n) == pytest.approx(1.0, abs=1e-6) and abs(c) < 0.05
+        axis = int(np.argmax(np.abs(n)))
+        coordinate = -d / n[axis]
+        assert min(abs(coordinate - x) for ax, x in inner_faces if ax == axis) < 0.03, wall
+        assert abs(n @ np.array(wall["box"]["center_m"]) + d) < 0.03  # the box lies on its plane
+    floor = next(i for i in instances if i["class"] == "floor")
+    assert floor["plane"][2] == pytest.approx(1.0, abs=0.01) and abs(floor["plane"][3]) < 0.03

@@ -18,6 +18,7 @@ data, and their boxes are zero unless the graph held them (``observation_detail=
 from __future__ import annotations
 
 import json
+import math
 import re
 import time
 import warnings
@@ -196,6 +197,17 @@ def _xml_text(text: str) -> str:
     return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
 
 
+def _plane(doc: dict[str, Any]) -> list[float] | None:
+    """A background instance's plane ``[a, b, c, d]`` (unit normal, map frame, ``a x + b y +
+    c z + d = 0``) from its low-level data; None for the others. A plane piece's box is thin
+    along the normal, but a reader that ignores ``R`` cannot tell which way: the plane says it."""
+    plane = (doc.get("data") or {}).get("plane_map")
+    if doc.get("layer") != "background" or plane is None or len(plane) != 4:
+        return None
+    values = [float(v) for v in plane]
+    return values if all(math.isfinite(v) for v in values) else None
+
+
 def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, Any]:
     """The documented JSON form of a knowledge base (see docs/kb.md)."""
     docs = kb.docs
@@ -205,6 +217,7 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
         instances.append({
             "uuid": d["uuid"], "layer": d["layer"], "class": d["class"],
             "box": {"center_m": box["center_m"], "extent_m": box["extent_m"], "R": box.get("R")},
+            "plane": _plane(d),
             "frame": d.get("frame_id", "map"),
             "first_seen_s": d["first_seen_s"], "last_seen_s": d["last_seen_s"], "state": d.get("state"),
             "confidence": d.get("confidence"),
