@@ -171,3 +171,31 @@ def test_hits_carry_evidence_and_times(house):
         data = hit.to_dict(answer.now_s)
         assert data["last_seen"]["iso"].startswith("1970-01-01T00:00:")
         assert data["last_seen"]["ago"].endswith("ago") or data["last_seen"]["ago"] == "just now"
+
+
+@pytest.mark.parametrize("far_first", [True, False])
+def test_a_tie_goes_to_the_nearer_in_any_write_order(tmp_path, far_first):
+    """Two cups last seen in one frame: "where was the cup last seen" names the nearer one,
+    whichever was written (and given its uuid) first; the same question, the same answer."""
+    from hiper_cli.model import Box3D, Instance, Observation
+    from hiper_cli.model import FrameResult
+
+    def cup(x_m: float) -> Instance:
+        return Instance("foreground", "cup", Box3D(np.array([x_m, 0.0, 0.8]), np.full(3, 0.1)), 1.0, 2.0)
+
+    cups = [cup(3.0), cup(1.0)] if far_first else [cup(1.0), cup(3.0)]
+    with open_kb(tmp_path / "kb") as kb:
+        session = kb.start_session(kb.environment("lab"), "probe", ["probe"])
+        for pose_id, stamp in enumerate((1.0, 2.0)):
+            result = FrameResult()
+            for inst in cups:
+                obs = Observation("foreground", "cup", 0.9, stamp, pose_id, inst.box, instance_uuid=inst.uuid)
+                inst.observation_uuids.append(obs.uuid)
+                result.observations.append(obs)
+                result.instances.append(inst)
+            kb.write_frame(session, result, pose_id=pose_id, stamp_s=stamp, T_map_cam=np.eye(4))
+        kb.end_session(session)
+        kb.sync_graph()
+        answer = ask(kb, "where was the cup last seen", pose=(0.0, 0.0, 1.2, 0.0))
+    assert answer.hits, answer.text
+    assert answer.hits[0].center_map_m[0] == pytest.approx(1.0)

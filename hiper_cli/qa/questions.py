@@ -120,7 +120,8 @@ class _Builder:
             nearest = min(insts, key=s.distance_m)
             self.add("position", "long", f"where is the closest {cls}",
                      s.last_position(nearest).tolist(), cls)
-            last = max(insts, key=lambda i: float(s.seen[i.id][-1]))
+            # several last seen in one frame: the nearest of them (the query layer's rule)
+            last = max(insts, key=lambda i: (float(s.seen[i.id][-1]), -s.distance_m(i)))
             self.add("position", "long", f"where was the {cls} last seen",
                      s.last_position(last).tolist(), cls)
             recent = [i for i in insts if i.id in self.seen_in(cls, self.since, s.now_s)]

@@ -194,14 +194,17 @@ def select(ctx: Context, spec: QuerySpec) -> Candidates:
     cands = prefilter(ctx, spec)
     cands = cands.take(_spatial_mask(ctx, spec, cands))
     idx = ctx.index
+    # Ties (two cups last seen in one frame) go to the nearer, then the later seen, never to
+    # the index's order (uuids): the same question gets the same answer in every run.
+    distance_m = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
     if spec.sort in (None, "distance"):
-        order = np.argsort(geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents), kind="stable")
+        order = np.lexsort((-cands.last_s, distance_m))
     elif spec.sort == "last_seen":
-        order = np.argsort(-cands.last_s, kind="stable")
+        order = np.lexsort((distance_m, -cands.last_s))
     elif spec.sort == "first_seen":
-        order = np.argsort(idx.first_s[cands.rows], kind="stable")
+        order = np.lexsort((distance_m, idx.first_s[cands.rows]))
     else:
-        order = np.argsort(-idx.confidence[cands.rows], kind="stable")
+        order = np.lexsort((distance_m, -idx.confidence[cands.rows]))
     cands = cands.take(order)
     if spec.limit is not None:
         cands = cands.take(np.arange(min(spec.limit, len(cands))))
