@@ -177,8 +177,7 @@ def test_hits_carry_evidence_and_times(house):
 def test_a_tie_goes_to_the_nearer_in_any_write_order(tmp_path, far_first):
     """Two cups last seen in one frame: "where was the cup last seen" names the nearer one,
     whichever was written (and given its uuid) first; the same question, the same answer."""
-    from hiper_cli.model import Box3D, Instance, Observation
-    from hiper_cli.model import FrameResult
+    from hiper_cli.model import Box3D, FrameResult, Instance, Observation
 
     def cup(x_m: float) -> Instance:
         return Instance("foreground", "cup", Box3D(np.array([x_m, 0.0, 0.8]), np.full(3, 0.1)), 1.0, 2.0)
