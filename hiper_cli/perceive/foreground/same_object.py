@@ -38,19 +38,33 @@ if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["APART_SHARE", "due", "fold", "newer_match", "seen_apart", "static_together"]
+__all__ = ["APART_SHARE", "GROWN_FACTOR", "due", "fold", "footprint_m2", "newer_match", "seen_apart",
+           "static_together"]
 
 APART_SHARE = 0.5  # of the shorter track's frames, taken apart at once: two objects
 STAMP_DECIMALS = 4  # stamps of one frame agree to well within this (0.1 ms)
+GROWN_FACTOR = 1.5  # a static track's footprint this many times what it was when last offered
+
+
+def footprint_m2(track: Track) -> float:
+    """The area (m²) of the footprint of the boxes its blobs fill (``SeenBox``)."""
+    found = track.seen.box()
+    return 0.0 if found is None else float(found[1][0] * found[1][1])
 
 
 def due(track: Track, walkers: tuple[str, ...], every_class: bool) -> bool:
     """Whether a confirmed track is to be offered to stitching now: its (provisional) class
-    changed since it was last offered, or its observations doubled (a walker's always, any
-    other track's when ``every_class``: ``stitch_static_again``)."""
+    changed since it was last offered, its observations doubled (a walker's always, any
+    other track's when ``every_class``: ``stitch_static_again``), or, for a static one, its
+    footprint grew by ``GROWN_FACTOR`` (a table seen in two pieces past a chair in front of
+    it: as the robot moves, each piece's box grows over the hidden middle into the other's)."""
     if provisional_class(track) != track.stitch_class:
         return True
-    return track.hits >= 2 * track.stitch_hits and (every_class or track.stitch_class in walkers)
+    if not (every_class or track.stitch_class in walkers):
+        return False
+    if track.hits >= 2 * track.stitch_hits:
+        return True
+    return track.stitch_class not in walkers and footprint_m2(track) >= GROWN_FACTOR * track.stitch_area_m2
 
 
 def seen_apart(a: Track, b: Track) -> bool:

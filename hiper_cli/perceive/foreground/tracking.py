@@ -56,7 +56,14 @@ from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model
 from hiper_cli.perceive.foreground.moving import is_static, was_moving
 from hiper_cli.perceive.foreground.plausible import min_longest_m
-from hiper_cli.perceive.foreground.same_object import STAMP_DECIMALS, due, fold, newer_match, static_together
+from hiper_cli.perceive.foreground.same_object import (
+    STAMP_DECIMALS,
+    due,
+    fold,
+    footprint_m2,
+    newer_match,
+    static_together,
+)
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.smoother import smooth_trajectory
 from hiper_cli.perceive.foreground.stitch import (
@@ -155,10 +162,12 @@ class Track:
     closed: bool = False
     # summed colour histograms of the observations a detection named a walker (``stitch``)
     appearance: FloatArray | None = None
-    # its ``provisional_class`` and hits when last offered to ``find_target``; a walker's is
-    # offered again each time its hits double (two tracks that take one walker in turns)
+    # its ``provisional_class``, hits and seen footprint (m²) when last offered to
+    # ``find_target``; offered again when its hits double or its footprint grows
+    # (``same_object.due``)
     stitch_class: str | None = None
     stitch_hits: int = 0
+    stitch_area_m2: float = 0.0
     # a walker's standing boxes seen (``Measurement.standing``): tops and floor, map z
     standing_tops_m: list[float] = field(default_factory=list)
     floor_z_m: float | None = None
@@ -657,7 +666,10 @@ class Tracker:
         for new in fresh:
             if new.uuid in aliases:  # folded into an older track earlier in this loop
                 continue
-            new.stitch_class, new.stitch_hits = provisional_class(new), new.hits
+            name = provisional_class(new)
+            if name != new.stitch_class or new.hits >= 2 * new.stitch_hits:
+                new.stitch_hits = new.hits  # an offer on growth keeps the doubling schedule
+            new.stitch_class, new.stitch_area_m2 = name, footprint_m2(new)
             live = [t for t in self.tracks if t.uuid not in aliases]
             found = find_target(new, [*live, *self.dormant], cfg, moving, pair)
             if found is None and pair is not None:
