@@ -167,6 +167,14 @@ class SegmentConfig(BackgroundFilterConfig):
     any object (``unmapped_tables.py``): a bedside table or a desk the background layer never
     maps is still a table. It is withdrawn once the background layer maps a table that it
     touches at the height of its top (within ``table_leg_reach_m``)."""
+    table_pieces_max_gap_m: float = 0.8
+    """Two such tables of one frame facing each other across at most this gap, their tops at
+    one height and the band between them at that height hidden from the camera by something
+    nearer (a chair in front of the table), are one table cut in two (``table_pieces.py``;
+    0: off) ..."""
+    table_pieces_max_length_m: float = 3.5
+    """... unless joined they would be longer than this (two desks in a row, a chair before
+    the gap between them)."""
     cluster_tolerance_m: float = 0.1
     """Euclidean clustering: neighbouring points closer than this join one cluster ..."""
     cluster_tolerance_per_m: float = 0.04

@@ -36,6 +36,7 @@ from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_lon
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import is_flat, nearest_named
+from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
@@ -57,6 +58,7 @@ HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this span
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
+HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -274,6 +276,9 @@ class ForegroundStage:
             blobs, found_tables = split_unseen_tables(
                 blobs, usable, names, cfg, frame.camera.width, frame.camera.height
             )
+            found_tables = join_hidden_pieces(
+                found_tables, self._hidden(frame), cfg, frame.camera.width, frame.camera.height
+            )
             if cfg.table_rim_depth_m > 0:
                 blobs = drop_table_legs(
                     blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height, rims=True
@@ -432,6 +437,25 @@ class ForegroundStage:
         inst.confidence = track.confidence
         inst.data["closed"] = track.closed
         return inst
+
+    def _hidden(self, frame: Frame) -> Any:
+        """A function telling, per map point, whether it is in the camera's view (image and
+        depth range) and whether something measured nearer (``HIDDEN_MARGIN_M``) hides it."""
+        T_cam_map = np.linalg.inv(frame.T_map_cam)
+        cam, depth, cfg = frame.camera, frame.depth_m, self.config
+
+        def hidden(points_map: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+            p = points_map @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+            z = p[:, 2]
+            ok = (z > cfg.min_depth_m) & (z < cfg.max_depth_m)
+            u = np.where(ok, cam.fx * p[:, 0] / np.where(ok, z, 1.0) + cam.cx, -1.0)
+            v = np.where(ok, cam.fy * p[:, 1] / np.where(ok, z, 1.0) + cam.cy, -1.0)
+            ok &= (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+            ui = np.clip(u.astype(int), 0, cam.width - 1)
+            measured = depth[np.clip(v.astype(int), 0, cam.height - 1), ui]
+            return ok, np.asarray(ok & (measured > 0) & (measured < z - HIDDEN_MARGIN_M))
+
+        return hidden
 
     def _visibility(self, frame: Frame) -> Any:
         """A function telling which map points the camera sees now (in image, not occluded)."""
