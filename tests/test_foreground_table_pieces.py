@@ -61,3 +61,38 @@ def test_pieces_apart_in_height_length_or_line_stay_apart():
     off = RefineConfig(table_pieces_max_gap_m=0.0)
     right = _piece(8.6, 9.2, 1.7, 2.2, u0=300)
     assert len(join_hidden_pieces([left, right], _hidden_everywhere, off, W, H)) == 2
+
+
+def _table_tracker(config):
+    """A tracker that saw one piece of a table for 2 s, then only the other piece for 2 s."""
+    from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
+
+    tracker, t_s = Tracker(config), 0.0
+    for lower, upper in (([8.6, 1.0, 0.0], [9.2, 1.3, 0.75]), ([8.6, 1.7, 0.0], [9.2, 2.2, 0.75])):
+        lower, upper = np.asarray(lower), np.asarray(upper)
+        for _ in range(30):
+            m = Measurement((lower + upper) / 2, upper - lower, "table", 1.0, f"o{t_s}",
+                            bounds_map_m=(lower, upper))
+            tracker.step(t_s, [m])
+            t_s += 1.0 / 15
+    return tracker
+
+
+def test_tracks_of_two_pieces_seen_in_turn_are_one_table_when_the_band_is_hidden():
+    """House 41: a chair hid the middle of the study table, and the two pieces were found in
+    different frames (each one table), so no frame held both."""
+    from hiper_cli.perceive.foreground.config import ForegroundConfig
+    from hiper_cli.perceive.foreground.table_pieces import join_hidden_tracks
+
+    config = ForegroundConfig()
+    tracker = _table_tracker(config)
+    tables = [t for t in [*tracker.tracks, *tracker.dormant] if t.confirmed]
+    assert len(tables) == 2
+    older = min(tables, key=lambda t: t.first_seen_s)
+    aliases = join_hidden_tracks(tracker, _hidden_everywhere, config)
+    assert list(aliases.values()) == [older]
+    (table,) = [t for t in [*tracker.tracks, *tracker.dormant] if t.confirmed]
+    lo, hi = table.seen.corners()
+    assert table is older and hi[1] - lo[1] > 1.1
+    tracker = _table_tracker(config)
+    assert join_hidden_tracks(tracker, _seen_through, config) == {}  # floor between two tables

@@ -36,7 +36,7 @@ from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_lon
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import is_flat, nearest_named
-from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces
+from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
@@ -271,13 +271,14 @@ class ForegroundStage:
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
         found_tables: list[Blob] = []
+        hidden = self._hidden(frame)
         names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
         if cfg.background_filter:
             blobs, found_tables = split_unseen_tables(
                 blobs, usable, names, cfg, frame.camera.width, frame.camera.height
             )
             found_tables = join_hidden_pieces(
-                found_tables, self._hidden(frame), cfg, frame.camera.width, frame.camera.height
+                found_tables, hidden, cfg, frame.camera.width, frame.camera.height
             )
             if cfg.table_rim_depth_m > 0:
                 blobs = drop_table_legs(
@@ -345,6 +346,11 @@ class ForegroundStage:
         )
         if tables_withdrawn:  # the background layer mapped them: its instance is the table
             changed = [t for t in changed if t.uuid not in tables_withdrawn]
+        pieces = join_hidden_tracks(self.tracker, hidden, cfg) if cfg.unseen_table_instances else {}
+        if pieces:  # two tracks of one table a chair cut in two: the newer folded into the older
+            joined = [pieces[u].uuid if u in pieces else u for u in joined]
+            changed = [t for t in changed if t.uuid not in pieces]
+            changed += [t for t in {id(t): t for t in pieces.values()}.values() if t not in changed]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
         for obs, track_uuid in zip(observations, joined, strict=True):
             if track_uuid in confirmed:
@@ -352,7 +358,7 @@ class ForegroundStage:
         instances = [self._instance(t) for t in changed]
         # a track stitched into another after it became an instance (merged away), one whose
         # evidence failed (``unknown_evidence_held``), or a table the background mapped
-        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn]
+        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn, *pieces]
         merged = [u for u in gone if self._instances.pop(u, None) is not None]
         t_end = time.perf_counter()
         timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}

@@ -13,20 +13,29 @@ Two pieces of one frame are joined (``join_hidden_pieces``) when their tops lie 
 the narrower one), the joined table is at most ``table_pieces_max_length_m`` long (two desks
 side by side with a chair before the gap stay two when together they would be longer than a
 table), and most of the samples of the band at the top's height (``HIDDEN_SHARE``) that the
-camera's view holds are hidden.
+camera's view holds are hidden. When the frames show one piece at a time, each piece is a
+table track of its own; ``join_hidden_tracks`` applies the same test to the boxes of a table
+track updated in this frame and another one, against this frame's depth.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.perceive.foreground.config import RefineConfig
+from hiper_cli.perceive.foreground.same_object import fold
 from hiper_cli.perceive.foreground.segment import Blob, sub_blob
+from hiper_cli.perceive.foreground.stitch import provisional_class
+from hiper_cli.perceive.foreground.unmapped_tables import TABLE_CLASS
 
-__all__ = ["HIDDEN_SHARE", "TOP_HEIGHT_TOLERANCE_M", "join_hidden_pieces"]
+if TYPE_CHECKING:
+    from hiper_cli.perceive.foreground.tracking import Track, Tracker
+
+__all__ = ["HIDDEN_SHARE", "TOP_HEIGHT_TOLERANCE_M", "join_hidden_pieces", "join_hidden_tracks"]
 
 FloatArray = NDArray[np.float64]
 Hidden = Callable[[FloatArray], tuple[NDArray[np.bool_], NDArray[np.bool_]]]
@@ -42,16 +51,17 @@ def _footprint(blob: Blob) -> tuple[FloatArray, FloatArray]:
     return lo, hi
 
 
-def _band(a: Blob, b: Blob, config: RefineConfig) -> FloatArray | None:
-    """Samples (K, 3) of the band at the top's height between the two pieces' footprints (none
-    when the footprints touch or overlap: nothing lies between them), or None when they do not
-    face each other across a gap of at most ``table_pieces_max_gap_m`` or would be longer than
+def _band(
+    lo_a: FloatArray, hi_a: FloatArray, top_a: float, lo_b: FloatArray, hi_b: FloatArray, top_b: float,
+    config: RefineConfig,
+) -> FloatArray | None:
+    """Samples (K, 3) of the band at the top's height between two footprints (``lo``, ``hi``:
+    their horizontal corners; none when they touch or overlap: nothing lies between them), or
+    None when the tops are not at one height, the footprints do not face each other across a
+    gap of at most ``table_pieces_max_gap_m``, or would be longer than
     ``table_pieces_max_length_m`` joined."""
-    top_a = float(np.percentile(a.points_map[:, 2], TOP_QUANTILE))
-    top_b = float(np.percentile(b.points_map[:, 2], TOP_QUANTILE))
     if abs(top_a - top_b) > TOP_HEIGHT_TOLERANCE_M:
         return None
-    (lo_a, hi_a), (lo_b, hi_b) = _footprint(a), _footprint(b)
     gap = np.maximum(lo_b - hi_a, lo_a - hi_b)  # per axis; negative: they overlap along it
     axis = int(np.argmax(gap))
     other = 1 - axis
@@ -75,15 +85,23 @@ def _band(a: Blob, b: Blob, config: RefineConfig) -> FloatArray | None:
     return grid
 
 
-def _hidden_between(a: Blob, b: Blob, hidden: Hidden, config: RefineConfig) -> bool:
-    band = _band(a, b, config)
+def _band_hidden(band: FloatArray | None, hidden: Hidden) -> bool:
+    """Whether the camera cannot see the band: most of its samples in view lie behind something
+    nearer (an empty band: the pieces touch)."""
     if band is None:
         return False
     if len(band) == 0:
-        return True  # the footprints touch at one height: one top
+        return True
     in_view, behind = hidden(band)
     n_view = int(np.count_nonzero(in_view))
     return n_view >= BAND_SAMPLES and int(np.count_nonzero(behind & in_view)) >= HIDDEN_SHARE * n_view
+
+
+def _hidden_between(a: Blob, b: Blob, hidden: Hidden, config: RefineConfig) -> bool:
+    (lo_a, hi_a), (lo_b, hi_b) = _footprint(a), _footprint(b)
+    top_a = float(np.percentile(a.points_map[:, 2], TOP_QUANTILE))
+    top_b = float(np.percentile(b.points_map[:, 2], TOP_QUANTILE))
+    return _band_hidden(_band(lo_a, hi_a, top_a, lo_b, hi_b, top_b, config), hidden)
 
 
 def join_hidden_pieces(
@@ -119,3 +137,42 @@ def _concat(a: Blob, b: Blob, step: int, width: int, height: int) -> Blob:
         a.support_z_m,
     )
     return sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
+
+
+def join_hidden_tracks(tracker: Tracker, hidden: Hidden, config: RefineConfig) -> dict[str, Track]:
+    """Tracks of one table cut in two (see the module docstring), when its pieces were found in
+    different frames: a confirmed table track updated in this frame and another confirmed,
+    unmoved table track (live or closed) whose boxes (``SeenBox``) have their tops at one
+    height, lie in line and have the band between them hidden from the camera now are one
+    table. The newer folds into the older (``same_object.fold``). Returns gone uuid -> keeper."""
+    if config.table_pieces_max_gap_m <= 0:
+        return {}
+
+    def is_table(track: Track) -> bool:
+        return track.confirmed and provisional_class(track) == TABLE_CLASS and not track.seen.moved()
+
+    aliases: dict[str, Track] = {}
+    now = [t for t in tracker.tracks if is_table(t) and t.last_update_s == tracker.last_stamp_s]
+    for a in now:
+        if a.uuid in aliases:
+            continue
+        for b in [*tracker.tracks, *tracker.dormant]:
+            if b is a or b.uuid in aliases or not is_table(b):
+                continue
+            box_a, box_b = a.seen.corners(), b.seen.corners()
+            if box_a is None or box_b is None:
+                continue
+            band = _band(box_a[0][:2], box_a[1][:2], float(box_a[1][2]),
+                         box_b[0][:2], box_b[1][:2], float(box_b[1][2]), config)
+            if not _band_hidden(band, hidden):
+                continue
+            keep, gone = (a, b) if a.first_seen_s <= b.first_seen_s else (b, a)
+            fold(keep, gone)
+            if gone in tracker.tracks and keep in tracker.dormant:  # the older goes on live
+                tracker.dormant.remove(keep)
+                tracker.tracks[tracker.tracks.index(gone)] = keep
+            else:
+                (tracker.tracks if gone in tracker.tracks else tracker.dormant).remove(gone)
+            aliases[gone.uuid] = keep
+            break
+    return aliases
