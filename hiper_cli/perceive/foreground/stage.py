@@ -350,7 +350,8 @@ class ForegroundStage:
         if pieces:  # two tracks of one table a chair cut in two: the newer folded into the older
             joined = [pieces[u].uuid if u in pieces else u for u in joined]
             changed = [t for t in changed if t.uuid not in pieces]
-            changed += [t for t in {id(t): t for t in pieces.values()}.values() if t not in changed]
+            listed = {id(t) for t in changed}
+            changed += [t for t in {id(t): t for t in pieces.values()}.values() if id(t) not in listed]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
         for obs, track_uuid in zip(observations, joined, strict=True):
             if track_uuid in confirmed:
