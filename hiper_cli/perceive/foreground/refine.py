@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.match import iou_matrix
-from hiper_cli.perceive.foreground.segment import Blob, sub_blob, support_below
+from hiper_cli.perceive.foreground.segment import Blob, concat_blobs, sub_blob, support_below
 
 __all__ = ["refine_blobs"]
 
@@ -226,16 +226,6 @@ def _fits_better(group: Sequence[Blob], blob: Blob, box_xyxy: FloatArray, config
     return bool(iou[1] >= iou[0] - config.join_max_iou_loss)
 
 
-def _concat(blobs: Sequence[Blob], step: int, width: int, height: int) -> Blob:
-    whole = Blob(
-        np.concatenate([b.points_cam for b in blobs]),
-        np.concatenate([b.points_map for b in blobs]),
-        np.concatenate([b.pixels_uv for b in blobs]),
-        np.zeros(4),
-    )
-    return sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
-
-
 def refine_blobs(
     blobs: Sequence[Blob],
     detection_boxes_xyxy: FloatArray,
@@ -321,7 +311,7 @@ def refine_blobs(
             for group in merged:
                 if len(group) > 1:
                     drop.update(group)
-                    whole = _concat([out[j] for j in group], step, width, height)
+                    whole = concat_blobs([out[j] for j in group], step, width, height)
                     whole.fragment = len(whole.points_cam) < config.min_cluster_points
                     extra.append(whole)
         if drop:

@@ -34,7 +34,8 @@ from hiper_cli.perceive.foreground.config import SegmentConfig
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
-    "Blob", "SegmentStats", "cell_inverse", "grid_components", "image_box", "segment", "sub_blob",
+    "Blob", "SegmentStats", "cell_inverse", "concat_blobs", "grid_components", "image_box", "segment",
+    "sub_blob",
     "support_below",
 ]
 
@@ -113,6 +114,20 @@ def sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: 
     uv = blob.pixels_uv[sel]
     box = image_box(uv, step, width, height)
     return Blob(blob.points_cam[sel], blob.points_map[sel], uv, box, blob.support_z_m, blob.fragment)
+
+
+def concat_blobs(
+    blobs: Sequence[Blob], step: int, width: int, height: int, support_z_m: float | None = None
+) -> Blob:
+    """The points of ``blobs`` as one blob, standing on ``support_z_m``."""
+    whole = Blob(
+        np.concatenate([b.points_cam for b in blobs]),
+        np.concatenate([b.points_map for b in blobs]),
+        np.concatenate([b.pixels_uv for b in blobs]),
+        np.zeros(4),
+        support_z_m,
+    )
+    return sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
 
 
 @dataclass

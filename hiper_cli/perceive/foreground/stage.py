@@ -445,33 +445,13 @@ class ForegroundStage:
         inst.data["closed"] = track.closed
         return inst
 
-    def _hidden(self, frame: Frame) -> Any:
-        """A function telling, per map point, whether it is in the camera's view (image and
-        depth range) and whether something measured nearer (``HIDDEN_MARGIN_M``) hides it."""
+    def _projector(self, frame: Frame) -> Any:
+        """A function taking map points (N, 3) to (in the camera's view: image and depth range,
+        their depth z (m), the depth measured at their pixel (m, 0: no return))."""
         T_cam_map = np.linalg.inv(frame.T_map_cam)
         cam, depth, cfg = frame.camera, frame.depth_m, self.config
 
-        def hidden(points_map: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-            p = points_map @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
-            z = p[:, 2]
-            ok = (z > cfg.min_depth_m) & (z < cfg.max_depth_m)
-            u = np.where(ok, cam.fx * p[:, 0] / np.where(ok, z, 1.0) + cam.cx, -1.0)
-            v = np.where(ok, cam.fy * p[:, 1] / np.where(ok, z, 1.0) + cam.cy, -1.0)
-            ok &= (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
-            ui = np.clip(u.astype(int), 0, cam.width - 1)
-            measured = depth[np.clip(v.astype(int), 0, cam.height - 1), ui]
-            return ok, np.asarray(ok & (measured > 0) & (measured < z - HIDDEN_MARGIN_M))
-
-        return hidden
-
-    def _visibility(self, frame: Frame) -> Any:
-        """A function telling which map points the camera sees now (in image, not occluded)."""
-        T_cam_map = np.linalg.inv(frame.T_map_cam)
-        cam = frame.camera
-        depth = frame.depth_m
-        cfg = self.config
-
-        def visible(points_map: FloatArray) -> NDArray[np.bool_]:
+        def project(points_map: FloatArray) -> tuple[NDArray[np.bool_], FloatArray, FloatArray]:
             p = points_map @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
             z = p[:, 2]
             ok = (z > cfg.min_depth_m) & (z < cfg.max_depth_m)
@@ -480,7 +460,27 @@ class ForegroundStage:
             ok &= (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
             ui = np.clip(u.astype(int), 0, cam.width - 1)
             vi = np.clip(v.astype(int), 0, cam.height - 1)
-            measured = depth[vi, ui]
+            return ok, z, depth[vi, ui]
+
+        return project
+
+    def _hidden(self, frame: Frame) -> Any:
+        """A function telling, per map point, whether it is in the camera's view and whether
+        something measured nearer (``HIDDEN_MARGIN_M``) hides it."""
+        project = self._projector(frame)
+
+        def hidden(points_map: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+            ok, z, measured = project(points_map)
+            return ok, np.asarray(ok & (measured > 0) & (measured < z - HIDDEN_MARGIN_M))
+
+        return hidden
+
+    def _visibility(self, frame: Frame) -> Any:
+        """A function telling which map points the camera sees now (in image, not occluded)."""
+        project = self._projector(frame)
+
+        def visible(points_map: FloatArray) -> NDArray[np.bool_]:
+            ok, z, measured = project(points_map)
             occluded = (measured > 0) & (measured < z - OCCLUSION_MARGIN_M)
             return np.asarray(ok & ~occluded)
 

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.same_object import fold
-from hiper_cli.perceive.foreground.segment import Blob, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, concat_blobs
 from hiper_cli.perceive.foreground.stitch import provisional_class
 from hiper_cli.perceive.foreground.unmapped_tables import TABLE_CLASS
 
@@ -119,24 +119,14 @@ def join_hidden_pieces(
         for i in range(len(pieces)):
             for j in range(i + 1, len(pieces)):
                 if _hidden_between(pieces[i], pieces[j], hidden, config):
-                    pieces[i] = _concat(pieces[i], pieces[j], config.pixel_step, width, height)
+                    pieces[i] = concat_blobs([pieces[i], pieces[j]], config.pixel_step, width, height,
+                                             pieces[i].support_z_m)
                     del pieces[j]
                     joined = True
                     break
             if joined:
                 break
     return pieces
-
-
-def _concat(a: Blob, b: Blob, step: int, width: int, height: int) -> Blob:
-    whole = Blob(
-        np.concatenate([a.points_cam, b.points_cam]),
-        np.concatenate([a.points_map, b.points_map]),
-        np.concatenate([a.pixels_uv, b.pixels_uv]),
-        np.zeros(4),
-        a.support_z_m,
-    )
-    return sub_blob(whole, np.arange(len(whole.points_cam)), step, width, height)
 
 
 def join_hidden_tracks(tracker: Tracker, hidden: Hidden, config: RefineConfig) -> dict[str, Track]:
