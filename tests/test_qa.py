@@ -5,9 +5,11 @@ fault); the worlds' gt/ format yields questions too; the CLI prints --json and o
 from __future__ import annotations
 
 import json
+import re
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -81,3 +83,24 @@ def test_without_a_kb_the_log_is_perceived_with_the_truth_detector(tmp_path):
     report = evaluate_qa(log, out_dir=tmp_path)
     assert report.detector == "truth" and (tmp_path / "kb.hiper").is_dir()
     assert report.figures["questions"] > 50 and "perceive" in report.seconds
+
+
+def test_after_and_before_answers_hold_for_the_time_the_question_names():
+    """The words say whole seconds ("after 00:00:36"); the true answer must be taken at that
+    second. A bottle seen at 36.03 s was there after 00:00:36, whatever fraction was drawn."""
+    scene = load_scene_truth(house_truth_kb().path.parent / "log")
+    asked = 0
+    for seed in range(8):
+        for q in generate_questions(scene, seed=seed):
+            found = re.fullmatch(r"was there an? (.+) (after|before) (\d\d):(\d\d):(\d\d)", q.text)
+            if found is None:
+                continue
+            cls, word = found.group(1), found.group(2)
+            at_s = int(found.group(3)) * 3600 + int(found.group(4)) * 60 + int(found.group(5))
+            seen = [scene.seen[i.id] for i in scene.instances(cls)]
+            after = [np.any(s >= at_s - 1e-6) for s in seen]
+            before = [np.any(s <= at_s + 1e-6) for s in seen]
+            truth = any(after if word == "after" else before)
+            assert q.answer == truth, q.text
+            asked += 1
+    assert asked > 50

@@ -59,6 +59,13 @@ def _clock(stamp_s: float) -> str:
     return iso_time(stamp_s)[11:19]  # HH:MM:SS, the grammar's time of day
 
 
+def _whole_second(stamp_s: float) -> float:
+    """The stamp ``_clock`` writes: the question's words hold whole seconds, so its true answer
+    must be taken at that second, not at the drawn stamp (a bottle seen at 36.03 s was there
+    "after 00:00:36", whatever fraction was drawn)."""
+    return float(np.floor(stamp_s))
+
+
 def _in_view_s(stamps: np.ndarray, gap_s: float) -> float:
     dt = np.diff(stamps)
     return float(dt[dt <= gap_s].sum())
@@ -97,11 +104,11 @@ class _Builder:
                      bool(self.seen_in(cls, self.since, s.now_s)), cls)
             near = any(s.distance_m(i) <= NEAR_RADIUS_M for i in s.instances(cls))
             self.add("yes_no", "long", f"is there a {cls} within {NEAR_RADIUS_M:g} m of me", near, cls)
-            t = float(self.rng.uniform(s.start_s, s.now_s))
+            t = _whole_second(self.rng.uniform(s.start_s, s.now_s))
             horizon = "short" if s.now_s - t <= self.short_s else "long"
             self.add("yes_no", horizon, f"was there a {cls} after {_clock(t)}",
                      bool(self.seen_in(cls, t, s.now_s)), cls)
-            t = float(self.rng.uniform(s.start_s, s.now_s))
+            t = _whole_second(self.rng.uniform(s.start_s, s.now_s))
             self.add("yes_no", "long", f"was there a {cls} before {_clock(t)}",
                      bool(self.seen_in(cls, s.start_s, t)), cls)
 
