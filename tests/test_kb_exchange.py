@@ -99,6 +99,9 @@ def test_cli_export_and_import(tmp_path):
         assert result.exit_code == 0, result.output
         counts = json.loads(result.output)["counts"]
         assert counts["instance"] == 3 and counts["environment"] == 1
+    result = runner.invoke(app, ["import", str(out), "--kb", str(tmp_path / "copy-text")])
+    assert result.exit_code == 0, result.output
+    assert "imported 1 environment, 3 instances, 1 analysis into" in result.output
     result = runner.invoke(app, ["export", str(tmp_path / "x.csv"), "--kb", str(tmp_path / "kb")])
     assert result.exit_code == 1 and "cannot tell the format" in " ".join(result.output.split())
 

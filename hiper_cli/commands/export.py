@@ -63,8 +63,15 @@ def import_command(
     if as_json:
         print_json(summary)
     else:
-        counts = ", ".join(f"{n} {k}s" for k, n in summary["counts"].items())
+        counts = ", ".join(f"{n} {_plural(k, n)}" for k, n in summary["counts"].items())
         console().print(f"imported {counts} into {summary['kb']}")
+
+
+def _plural(kind: str, n: int) -> str:
+    """"1 environment", "13 instances", "2 analyses"."""
+    if n == 1:
+        return kind
+    return kind[:-2] + "es" if kind.endswith("is") else kind + ("es" if kind.endswith("ss") else "s")
 
 
 def register(app: typer.Typer) -> None:
