@@ -88,3 +88,18 @@ def test_a_detection_names_the_nearest_of_its_blobs():
     out = nearest_named([named, named, named, other], depths, cfg)
     assert [m.class_name for m in out] == ["person", "unknown", "person", "chair"]
     assert out[1].detection_index is None
+
+
+def test_a_detection_of_furniture_names_the_blob_that_fits_its_box():
+    """A desk's end 1.2 m in front of a chair fills part of the chair's box (office 72): the
+    chair's blob fits the box best and keeps the name, the desk is not a chair. A walker's
+    detection still names the nearest: the person in front of a wall trimmed to its box."""
+    cfg = ForegroundConfig()
+    desk_end, chair = Match("chair", 0.8, 0, 0.69), Match("chair", 0.8, 0, 0.86)
+    chair_seat = Match("chair", 0.8, 0, 0.3)  # a piece of the same chair at its depth
+    depths = [np.linspace(1.8, 2.3, 50), np.linspace(3.2, 3.6, 50), np.linspace(3.3, 3.5, 50)]
+    out = nearest_named([desk_end, chair, chair_seat], depths, cfg)
+    assert [m.class_name for m in out] == ["unknown", "chair", "chair"]
+    person, wall = Match("person", 0.8, 0, 0.8), Match("person", 0.8, 0, 0.95)
+    out = nearest_named([person, wall], [np.linspace(2.0, 2.3, 50), np.linspace(4.8, 4.9, 50)], cfg)
+    assert [m.class_name for m in out] == ["person", "unknown"]

@@ -298,9 +298,11 @@ class MatchConfig(_Part):
     says: a picture or a screen showing people, a wall piece) named a walker class stays
     ``unknown``, and a walker's track does not take a flat blob."""
     detection_nearest: bool = True
-    """A detection names the nearest of the blobs it matches (``solid.nearest_named``): one
-    whose depths lie more than ``join_depth_m`` beyond the nearest one's is hidden behind it
-    inside the box (a wall behind a person) and stays ``unknown``."""
+    """A detection names one of the blobs it matches and those at its depth
+    (``solid.nearest_named``): for a walker class the nearest (a wall behind a person stays
+    ``unknown``), for other classes the one that fits its box best (a desk's end in front of
+    a chair stays ``unknown``); blobs more than ``join_depth_m`` behind or in front of it do not
+    keep the name."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
