@@ -7,7 +7,7 @@ import numpy as np
 from hiper_cli.perceive.foreground import ForegroundConfig, ForegroundStage
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.match import Match
-from hiper_cli.perceive.foreground.solid import is_flat, nearest_named
+from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
 from hiper_cli.perceive.stage import World
 from tests.fg_scene import SceneBox, background_instances, make_frame, person, pose_looking_x, room
@@ -85,7 +85,7 @@ def test_a_detection_names_the_nearest_of_its_blobs():
     legs_depths = np.linspace(2.05, 2.35, 50)  # the person's legs under a table: same depth
     chair_depths = np.linspace(4.8, 5.0, 50)  # another detection's blob, far away
     depths = [person_depths, wall_depths, legs_depths, chair_depths]
-    out = nearest_named([named, named, named, other], depths, cfg)
+    out = detected_blobs([named, named, named, other], depths, cfg)
     assert [m.class_name for m in out] == ["person", "unknown", "person", "chair"]
     assert out[1].detection_index is None
 
@@ -98,8 +98,8 @@ def test_a_detection_of_furniture_names_the_blob_that_fits_its_box():
     desk_end, chair = Match("chair", 0.8, 0, 0.69), Match("chair", 0.8, 0, 0.86)
     chair_seat = Match("chair", 0.8, 0, 0.3)  # a piece of the same chair at its depth
     depths = [np.linspace(1.8, 2.3, 50), np.linspace(3.2, 3.6, 50), np.linspace(3.3, 3.5, 50)]
-    out = nearest_named([desk_end, chair, chair_seat], depths, cfg)
+    out = detected_blobs([desk_end, chair, chair_seat], depths, cfg)
     assert [m.class_name for m in out] == ["unknown", "chair", "chair"]
     person, wall = Match("person", 0.8, 0, 0.8), Match("person", 0.8, 0, 0.95)
-    out = nearest_named([person, wall], [np.linspace(2.0, 2.3, 50), np.linspace(4.8, 4.9, 50)], cfg)
+    out = detected_blobs([person, wall], [np.linspace(2.0, 2.3, 50), np.linspace(4.8, 4.9, 50)], cfg)
     assert [m.class_name for m in out] == ["person", "unknown"]

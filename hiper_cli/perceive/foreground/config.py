@@ -299,7 +299,7 @@ class MatchConfig(_Part):
     ``unknown``, and a walker's track does not take a flat blob."""
     detection_nearest: bool = True
     """A detection names one of the blobs it matches and those at its depth
-    (``solid.nearest_named``): for a walker class the nearest (a wall behind a person stays
+    (``solid.detected_blobs``): for a walker class the nearest (a wall behind a person stays
     ``unknown``), for other classes the one that fits its box best (a desk's end in front of
     a chair stays ``unknown``); blobs more than ``join_depth_m`` behind or in front of it do not
     keep the name."""

@@ -19,13 +19,11 @@ Two kinds of blobs became people, and their tracks then lived on after the perso
   refinement trims a blob to the box it overlaps). Inside the box the nearer object hides the
   farther one, so the detector saw the nearer; of the blobs one detection names, those whose
   depths lie more than ``join_depth_m`` (the refinement's "same object" depth gap) beyond the
-  nearest one's are not what it saw and stay ``unknown`` (``nearest_named``). Two parts of one
+  nearest one's are not what it saw and stay ``unknown`` (``detected_blobs``). Two parts of one
   person split by a table lie at the same depth and both keep the name. For the other
   classes the blob that fits the box best is what the detection saw, and blobs in front of it
   are not either: the end of a desk before a chair fills part of the chair's box, and the
-  nearest rule gave the desk the name (on the issue-20 logs with the truth detector, the
-  nearest blob was the detected object in about half of the detections that named several
-  blobs, the best-fitting one in nearly all).
+  nearest rule gave the desk the name (docs/foreground.md has the measurement).
 """
 
 from __future__ import annotations
@@ -39,7 +37,7 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.match import Match
 from hiper_cli.perceive.foreground.whole import thickness_m
 
-__all__ = ["is_flat", "nearest_named"]
+__all__ = ["detected_blobs", "is_flat"]
 
 DEPTH_RANGE_PERCENTILES = (5.0, 95.0)  # a blob's depth range, robust to a few stray points
 PANEL_MIN_SPAN_M = 0.5  # a flat blob this large would show a body's relief (a torso's width)
@@ -67,7 +65,7 @@ def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
     return thickness_m(points_cam) < flat_m
 
 
-def nearest_named(
+def detected_blobs(
     matches: Sequence[Match], depths_m: Sequence[NDArray[np.float64]], config: ForegroundConfig
 ) -> list[Match]:
     """``matches`` with the blobs a detection names that are not what it saw made

@@ -35,7 +35,7 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.solid import is_flat, nearest_named
+from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
@@ -296,7 +296,7 @@ class ForegroundStage:
             unknown=cfg.unknown_class,
         )
         if cfg.detection_nearest:
-            matches = nearest_named(matches, [b.points_cam[:, 2] for b in blobs], cfg)
+            matches = detected_blobs(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
