@@ -71,7 +71,7 @@ def _plural(kind: str, n: int) -> str:
     """"1 environment", "13 instances", "2 analyses"."""
     if n == 1:
         return kind
-    return kind[:-2] + "es" if kind.endswith("is") else kind + ("es" if kind.endswith("ss") else "s")
+    return kind[:-2] + "es" if kind.endswith("is") else kind + "s"
 
 
 def register(app: typer.Typer) -> None:

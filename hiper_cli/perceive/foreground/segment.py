@@ -35,8 +35,7 @@ from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
     "Blob", "SegmentStats", "cell_inverse", "concat_blobs", "grid_components", "image_box", "segment",
-    "sub_blob",
-    "support_below",
+    "sub_blob", "support_below",
 ]
 
 FloatArray = NDArray[np.float64]
