@@ -212,3 +212,27 @@ def test_a_handover_between_two_tracks_of_one_walker_is_a_resume(old_last_s, apa
     new = _walker_track("new", new_stamps, walk, 3.03)
     found = find_target(new, [old], TrackerConfig(), moving=lambda t: True)
     assert (found == (old, RESUME)) is joined
+
+
+def test_the_rows_after_a_resume_are_smoothed_too():
+    """A walker lost and picked up again: the track closed (its rows smoothed) before the
+    resume; at the end the rows after it are smoothed as well, so their speeds start at the
+    walker's pace, not at the filter's (office 62 read 0.5 m/s for 1.0 where it came back)."""
+    rng = np.random.default_rng(3)
+    run = _Run()
+    pos = np.array([0.0, 0.0, 0.85])
+    for _ in range(int(3.0 * RATE_HZ)):
+        run.frame([(pos + rng.normal(0.0, 0.03, 3), PERSON, "person", None)])
+        pos = pos + np.array([1.0 / RATE_HZ, 0.0, 0.0])
+    run.idle(2.0)
+    pos = pos + np.array([2.0 + 1.0 / RATE_HZ, 0.0, 0.0])
+    back_s = run.t_s
+    for _ in range(int(1.5 * RATE_HZ)):
+        run.frame([(pos + rng.normal(0.0, 0.03, 3), PERSON, "person", None)])
+        pos = pos + np.array([1.0 / RATE_HZ, 0.0, 0.0])
+    assert len(run.uuids()) == 1
+    track = run.tracker.close_all()[0]
+    rows = np.array([r for r in track.trajectory if r[0] >= back_s - 1e-9])
+    assert len(rows) == int(1.5 * RATE_HZ)
+    speeds = np.hypot(rows[:, 4], rows[:, 5])
+    assert np.all(np.abs(speeds[:5] - 1.0) < 0.15)

@@ -27,9 +27,10 @@ def smooth_trajectory(track: Track) -> None:
 
     The filter's estimates at the start of a track rest on few observations; once the track is
     closed every row can use all of them. Rows keep their stamps; positions and velocities
-    become the smoothed ones.
+    become the smoothed ones. Only the rows from ``track.covariances_from`` on are smoothed:
+    those before were smoothed when the track closed earlier (a walker lost, then resumed).
     """
-    rows = track.trajectory
+    rows = track.trajectory[track.covariances_from:]
     n = len(rows)
     if n < 3 or len(track.covariances) != n:
         return
