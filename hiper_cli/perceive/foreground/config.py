@@ -246,6 +246,15 @@ class RefineConfig(SegmentConfig):
     one holds lie this much farther than the other's in median depth (two chairs one behind the
     other at a table's far end); nearer, they are duplicate boxes of one object (a chair's back
     is 0.2-0.45 m behind its seat's front; 0: never)."""
+    carve_classes: tuple[str, ...] = (
+        "bottle", "cup", "wine glass", "bowl", "vase", "book", "laptop", "keyboard", "mouse",
+        "remote", "cell phone", "clock", "scissors", "toothbrush", "potted plant", "teddy bear",
+    )  # fmt: skip
+    """A detection of one of these inside a blob longer than any instance of its class
+    (``class_sizes``) cuts its object out of the blob (``carve.py``: a bottle on an unmapped
+    side table; empty: off) ..."""
+    carve_depth_m: float = 0.2
+    """... the points in its box within this of the box's front."""
     detection_join: bool = True
     """Join blobs inside one detection box that an occluder cut apart."""
     join_containment: float = 0.8
@@ -264,7 +273,8 @@ class RefineConfig(SegmentConfig):
     def __post_init__(self) -> None:
         super().__post_init__()
         _nonnegative(self, ("split_attach_m", "join_depth_m", "join_gap_m", "detection_margin_frac",
-                            "twin_depth_gap_m", "trim_margin_frac", "trim_depth_m"))
+                            "twin_depth_gap_m", "trim_margin_frac", "trim_depth_m", "carve_depth_m"))
+        _as_tuples(self, ("carve_classes",))
         if not 0.0 < self.join_containment <= 1.0:
             raise ConfigError(f"join_containment must be in (0, 1], got {self.join_containment}")
 

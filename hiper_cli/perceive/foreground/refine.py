@@ -22,7 +22,8 @@ IoU matching of Algorithm 4:
    own (a chair seen through the bottle's box keeps the chair's depth). Points outside every
    box join the group of their nearest labelled point when it is within ``split_attach_m``;
    the rest form a group of their own. Groups smaller than ``min_cluster_points`` join the
-   group of their nearest point.
+   group of their nearest point. A small thing's box inside a blob too big for its class cuts
+   the thing out (``carve.py``: a bottle on an unmapped side table).
 2. **Join**: blobs that lie inside the same detection box (a share ``join_containment`` of
    their pixels, the box grown by ``detection_margin_frac`` of its size for detector jitter;
    the smallest such box owns them), whose median depths differ by at most ``join_depth_m``
@@ -42,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.carve import carve_small
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import Blob, concat_blobs, sub_blob, support_below
@@ -234,6 +236,7 @@ def refine_blobs(
     height: int,
     support_boxes_map: Sequence[Box3D] = (),
     classes: Sequence[str] = (),
+    size_tolerance: float | None = None,
 ) -> list[Blob]:
     """Split and join ``blobs`` with this frame's detection boxes (see the module docstring).
 
@@ -241,8 +244,9 @@ def refine_blobs(
     in their detection box; those that do not are dropped.
 
     ``detection_boxes_xyxy`` (K, 4) pixels: the detections the matching will use; ``classes``
-    their class names (``split_twins``; empty: no twins). Blobs that are neither split nor
-    joined are returned as they are.
+    their class names (``split_twins``, ``carve_classes``; empty: neither). ``size_tolerance``:
+    ``class_size_tolerance`` when class sizes are on (None: no carving). Blobs that are neither
+    split nor joined are returned as they are.
     """
     boxes = np.asarray(detection_boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0 or not blobs:
@@ -271,6 +275,11 @@ def refine_blobs(
         else:
             out.extend(sub_blob(blob, g, step, width, height) for g in groups)
             changed.extend([True] * len(groups))
+    if size_tolerance is not None and len(classes) == len(boxes):
+        carved, was_carved = carve_small(out, boxes, classes, config, size_tolerance, width, height)
+        # carving replaces blobs in place and appends the cut parts
+        changed = [c or w for c, w in zip(changed, was_carved, strict=False)] + was_carved[len(changed):]
+        out = carved
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
     pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
     grown = boxes + pad

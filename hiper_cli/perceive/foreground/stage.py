@@ -286,7 +286,8 @@ class ForegroundStage:
                 )
         if refine:
             blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports,
-                                 classes=names)
+                                 classes=names,
+                                 size_tolerance=cfg.class_size_tolerance if cfg.class_sizes else None)
         t_refine = time.perf_counter()
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
