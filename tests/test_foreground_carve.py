@@ -35,11 +35,13 @@ def _scene(with_table=True):
         depth[on] = y_top[on]
         hit_bottle[on] = False
         z = CAMERA_Z_M + rz * HUTCH_Y_M  # the panel
-        on = (np.abs(rx * HUTCH_Y_M) <= TABLE_HALF_M) & (z >= TABLE_TOP_M) & (z <= HUTCH_TOP_M) & (HUTCH_Y_M < depth)
+        on = (np.abs(rx * HUTCH_Y_M) <= TABLE_HALF_M) & (z >= TABLE_TOP_M) & (z <= HUTCH_TOP_M)
+        on &= depth > HUTCH_Y_M
         depth[on] = HUTCH_Y_M
         hit_bottle[on] = False
         z = CAMERA_Z_M + rz * TABLE_NEAR_M  # the front
-        on = (np.abs(rx * TABLE_NEAR_M) <= TABLE_HALF_M) & (z >= 0.0) & (z <= TABLE_TOP_M) & (TABLE_NEAR_M < depth)
+        on = (np.abs(rx * TABLE_NEAR_M) <= TABLE_HALF_M) & (z >= 0.0) & (z <= TABLE_TOP_M)
+        on &= depth > TABLE_NEAR_M
         depth[on] = TABLE_NEAR_M
         hit_bottle[on] = False
     seen = np.isfinite(depth)

@@ -41,7 +41,9 @@ def _contains(blob: Blob, box: NDArray[np.float64], share: float) -> bool:
     return float(np.prod(np.clip(hi - lo, 0.0, None))) >= share * area
 
 
-def _cut(blob: Blob, box: NDArray[np.float64], limit_m: float, config: RefineConfig) -> NDArray[np.bool_] | None:
+def _cut(
+    blob: Blob, box: NDArray[np.float64], limit_m: float, config: RefineConfig
+) -> NDArray[np.bool_] | None:
     """The points of ``blob`` that are the object in ``box``, or None when nothing is cut."""
     step = config.pixel_step
     u = blob.pixels_uv[:, 0].astype(np.float64) + 0.5
