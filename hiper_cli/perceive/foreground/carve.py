@@ -1,7 +1,7 @@
 """Small things cut out of the furniture they stand on: a detection box of a small class inside
 a blob far too big for that class.
 
-A bottle on a cabinet, a cup on a desk the background did not map, a book on a shelf: the
+A bottle on a cabinet, a cup on a desk the background did not map, a vase on a sideboard: the
 clustering joins the object to what it stands on or leans against, the blob's image box is the
 furniture's, the detection box is the object's, their IoU is tiny and the object is never
 named (house 41: a bottle on an unmapped side table became part of a 1 m ``unknown``). When a
