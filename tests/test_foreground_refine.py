@@ -284,3 +284,19 @@ def test_two_chairs_one_behind_the_other_come_apart_and_one_chairs_two_boxes_do_
     assert len(split(_one_blob(near, far), replace(cfg, twin_depth_gap_m=0.0))) == 1
     back = _flat_blob(160, 190, 185, 380, 4.2)  # 0.3 m behind: a chair's back, its second box
     assert len(split(_one_blob(near, back), cfg)) == 1
+
+
+def test_a_cup_beside_a_bottle_in_one_blob_are_two_things():
+    """Small things side by side are twins whatever their classes (hospital 73: a cup 0.23 m
+    from a bottle was one blob, named bottle); a person beside a chair stays one blob."""
+    bottle = _flat_blob(300, 200, 320, 260, 2.0)
+    cup = _flat_blob(328, 236, 348, 260, 2.0)
+    boxes = np.array([[300.0, 200.0, 320.0, 260.0], [328.0, 236.0, 348.0, 260.0]])
+    cfg = ForegroundConfig()
+
+    def split(classes):
+        return refine_blobs([_one_blob(bottle, cup)], boxes, cfg, 640, 480, classes=classes)
+
+    parts = split(["bottle", "cup"])
+    assert sorted(len(b.points_cam) for b in parts) == sorted([len(bottle.points_cam), len(cup.points_cam)])
+    assert len(split(["person", "chair"])) == 1

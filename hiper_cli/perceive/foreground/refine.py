@@ -51,6 +51,7 @@ from hiper_cli.perceive.foreground.segment import Blob, concat_blobs, sub_blob, 
 __all__ = ["refine_blobs"]
 
 FloatArray = NDArray[np.float64]
+SMALL = "\0small"  # ``_twins``: the one kind of every class in ``carve_classes``
 
 
 def _inside(uv: NDArray[np.int32], boxes: FloatArray) -> NDArray[np.bool_]:
@@ -138,7 +139,8 @@ def _apart_in_depth(blob: Blob, a: FloatArray, b: FloatArray, config: RefineConf
 def _twins(
     blob: Blob, boxes: FloatArray, classes: Sequence[str], config: RefineConfig
 ) -> NDArray[np.int64]:
-    """The detection boxes of the class with most boxes side by side in the blob's image box
+    """The detection boxes of the class (every small thing, ``carve_classes``, one class here:
+    a cup beside a bottle) with most boxes side by side in the blob's image box
     (each at least ``join_containment`` inside it, none half inside another unless the two lie
     at different depths, ``_apart_in_depth``: duplicate boxes of one object, a chair and its
     back, are no twins; two chairs one behind the other are); empty when fewer than two."""
@@ -148,8 +150,9 @@ def _twins(
     area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
     inside = np.prod(np.clip(hi - lo, 0.0, None), axis=1) >= config.join_containment * area
     best = np.zeros(0, dtype=np.int64)
-    for name in sorted({c for c, ok in zip(classes, inside, strict=True) if ok}):
-        idx = np.flatnonzero(inside & (np.array(classes, dtype=object) == name))
+    kinds = np.array([SMALL if c in config.carve_classes else c for c in classes], dtype=object)
+    for name in sorted({c for c, ok in zip(kinds, inside, strict=True) if ok}):
+        idx = np.flatnonzero(inside & (kinds == name))
         if len(idx) < 2:
             continue
         b = boxes[idx]
