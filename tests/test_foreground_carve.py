@@ -55,8 +55,8 @@ def _scene(with_table=True):
     return blob, box
 
 
-def _carve(blob, box, name="bottle"):
-    return carve_small([blob], box.reshape(1, 4), [name], RefineConfig(), 0.15, W, H)
+def _carve(blob, box, name="bottle", config=None):
+    return carve_small([blob], [False], box.reshape(1, 4), [name], config or RefineConfig(), 0.15, W, H)
 
 
 def test_a_bottle_on_a_side_table_is_cut_out():
@@ -78,5 +78,4 @@ def test_only_small_classes_in_a_blob_too_big_for_them_are_cut():
     assert len(_carve(blob, box, "chair")[0]) == 1  # a chair's box: no small thing
     alone, alone_box = _scene(with_table=False)
     assert len(_carve(alone, alone_box)[0]) == 1  # the bottle on its own fits its class
-    off = carve_small([blob], box.reshape(1, 4), ["bottle"], RefineConfig(carve_classes=()), 0.15, W, H)
-    assert len(off[0]) == 1
+    assert len(_carve(blob, box, config=RefineConfig(carve_classes=()))[0]) == 1

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.plausible import longest_m, max_longest_m
-from hiper_cli.perceive.foreground.segment import Blob, sub_blob
+from hiper_cli.perceive.foreground.segment import Blob, boxes_within, pixels_in_boxes, sub_blob
 
 __all__ = ["carve_small"]
 
@@ -33,22 +33,12 @@ def _longest(blob: Blob) -> float:
     return longest_m(blob.points_map, float(blob.extent_map_m[2]))
 
 
-def _contains(blob: Blob, box: NDArray[np.float64], share: float) -> bool:
-    """Whether ``share`` of the box's area lies inside the blob's image box."""
-    b = blob.image_box_xyxy
-    lo, hi = np.maximum(b[:2], box[:2]), np.minimum(b[2:], box[2:])
-    area = max(float(np.prod(box[2:] - box[:2])), 1e-9)
-    return float(np.prod(np.clip(hi - lo, 0.0, None))) >= share * area
-
-
 def _cut(
     blob: Blob, box: NDArray[np.float64], limit_m: float, config: RefineConfig
 ) -> NDArray[np.bool_] | None:
     """The points of ``blob`` that are the object in ``box``, or None when nothing is cut."""
-    step = config.pixel_step
-    u = blob.pixels_uv[:, 0].astype(np.float64) + 0.5
-    v = blob.pixels_uv[:, 1].astype(np.float64) + 0.5
-    inside = (u >= box[0] - step) & (u <= box[2] + step) & (v >= box[1] - step) & (v <= box[3] + step)
+    pad = config.pixel_step * np.array([-1.0, -1.0, 1.0, 1.0])
+    inside = pixels_in_boxes(blob.pixels_uv, (box + pad).reshape(1, 4))[:, 0]
     if np.count_nonzero(inside) < config.min_cluster_points:
         return None
     z = blob.points_cam[:, 2]
@@ -64,6 +54,7 @@ def _cut(
 
 def carve_small(
     blobs: Sequence[Blob],
+    changed: Sequence[bool],
     boxes: NDArray[np.float64],
     classes: Sequence[str],
     config: RefineConfig,
@@ -72,8 +63,9 @@ def carve_small(
     height: int,
 ) -> tuple[list[Blob], list[bool]]:
     """``blobs`` with the small objects ``boxes`` (K, 4; ``classes`` their names) name cut out
-    of the furniture they belong to; per blob returned, whether it is a new one."""
-    out, changed = list(blobs), [False] * len(blobs)
+    of the furniture they belong to, and per blob whether it is new (``changed``, per blob
+    given, carried over; a blob cut in two is replaced by the rest, the part is appended)."""
+    out, changed = list(blobs), list(changed)
     if not config.carve_classes or len(classes) != len(boxes):
         return out, changed
     order = np.argsort((boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]))
@@ -82,8 +74,9 @@ def carve_small(
         if name not in config.carve_classes:
             continue
         limit_m = max_longest_m(name, size_tolerance)
+        box = boxes[k : k + 1]
         for i, blob in enumerate(out):
-            if blob.fragment or not _contains(blob, boxes[k], config.join_containment):
+            if blob.fragment or not boxes_within(blob.image_box_xyxy, box, config.join_containment)[0]:
                 continue
             if _longest(blob) <= limit_m:
                 continue

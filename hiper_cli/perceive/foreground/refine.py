@@ -46,20 +46,19 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.carve import carve_small
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.match import iou_matrix
-from hiper_cli.perceive.foreground.segment import Blob, concat_blobs, sub_blob, support_below
+from hiper_cli.perceive.foreground.segment import (
+    Blob,
+    boxes_within,
+    concat_blobs,
+    pixels_in_boxes,
+    sub_blob,
+    support_below,
+)
 
 __all__ = ["refine_blobs"]
 
 FloatArray = NDArray[np.float64]
 SMALL = "\0small"  # ``_twins``: the one kind of every class in ``carve_classes``
-
-
-def _inside(uv: NDArray[np.int32], boxes: FloatArray) -> NDArray[np.bool_]:
-    """(N, K): pixel n inside box k (xyxy, pixel centres, half-open like the image box)."""
-    u = uv[:, 0:1].astype(np.float64) + 0.5
-    v = uv[:, 1:2].astype(np.float64) + 0.5
-    in_u = (u >= boxes[None, :, 0]) & (u <= boxes[None, :, 2])
-    return np.asarray(in_u & (v >= boxes[None, :, 1]) & (v <= boxes[None, :, 3]))
 
 
 def _nearest_label(
@@ -75,7 +74,7 @@ def _split(
     blob: Blob, boxes: FloatArray, areas: FloatArray, config: RefineConfig
 ) -> list[NDArray[np.int64]] | None:
     """Index groups of the points of ``blob``, or None when it stays whole."""
-    inside = _inside(blob.pixels_uv, boxes)
+    inside = pixels_in_boxes(blob.pixels_uv, boxes)
     counts = inside.sum(axis=0)
     cand = np.flatnonzero(counts >= config.min_cluster_points)
     if len(cand) < 2:
@@ -123,7 +122,7 @@ def _apart_in_depth(blob: Blob, a: FloatArray, b: FloatArray, config: RefineConf
     duplicate boxes. False when either side has fewer than ``min_cluster_points``."""
     if config.twin_depth_gap_m <= 0:
         return False
-    inside = _inside(blob.pixels_uv, np.stack([a, b]))
+    inside = pixels_in_boxes(blob.pixels_uv, np.stack([a, b]))
     only_a, only_b = inside[:, 0] & ~inside[:, 1], inside[:, 1] & ~inside[:, 0]
     both = inside[:, 0] & inside[:, 1]
     if np.count_nonzero(only_a) < config.min_cluster_points:
@@ -144,11 +143,8 @@ def _twins(
     (each at least ``join_containment`` inside it, none half inside another unless the two lie
     at different depths, ``_apart_in_depth``: duplicate boxes of one object, a chair and its
     back, are no twins; two chairs one behind the other are); empty when fewer than two."""
-    blob_box = blob.image_box_xyxy
-    lo = np.maximum(blob_box[None, :2], boxes[:, :2])
-    hi = np.minimum(blob_box[None, 2:], boxes[:, 2:])
+    inside = boxes_within(blob.image_box_xyxy, boxes, config.join_containment)
     area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
-    inside = np.prod(np.clip(hi - lo, 0.0, None), axis=1) >= config.join_containment * area
     best = np.zeros(0, dtype=np.int64)
     kinds = np.array([SMALL if c in config.carve_classes else c for c in classes], dtype=object)
     for name in sorted({c for c, ok in zip(kinds, inside, strict=True) if ok}):
@@ -177,8 +173,8 @@ def _trim(
     k = int(np.argmax(iou))
     if iou[k] < config.trim_iou:
         return None
-    inside = _inside(blob.pixels_uv, boxes[k : k + 1] + step_pad)[:, 0]
-    near = _inside(blob.pixels_uv, grown[k : k + 1])[:, 0] & ~inside
+    inside = pixels_in_boxes(blob.pixels_uv, boxes[k : k + 1] + step_pad)[:, 0]
+    near = pixels_in_boxes(blob.pixels_uv, grown[k : k + 1])[:, 0] & ~inside
     if near.any() and inside.any():
         # Just outside the box at the depth of what is inside: the box was jittered smaller.
         z = blob.points_cam[:, 2]
@@ -192,7 +188,7 @@ def _trim(
 
 def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: RefineConfig) -> int | None:
     """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
-    share = np.count_nonzero(_inside(blob.pixels_uv, boxes), axis=0) / len(blob.pixels_uv)
+    share = np.count_nonzero(pixels_in_boxes(blob.pixels_uv, boxes), axis=0) / len(blob.pixels_uv)
     ok = np.flatnonzero(share >= config.join_containment)
     if len(ok) == 0:
         return None
@@ -278,11 +274,8 @@ def refine_blobs(
         else:
             out.extend(sub_blob(blob, g, step, width, height) for g in groups)
             changed.extend([True] * len(groups))
-    if size_tolerance is not None and len(classes) == len(boxes):
-        carved, was_carved = carve_small(out, boxes, classes, config, size_tolerance, width, height)
-        # carving replaces blobs in place and appends the cut parts
-        changed = [c or w for c, w in zip(changed, was_carved, strict=False)] + was_carved[len(changed):]
-        out = carved
+    if size_tolerance is not None:
+        out, changed = carve_small(out, changed, boxes, classes, config, size_tolerance, width, height)
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
     pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
     grown = boxes + pad

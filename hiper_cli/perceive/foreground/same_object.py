@@ -140,5 +140,4 @@ def fold(keep: Track, gone: Track) -> None:
         keep.trajectory[:] = [keep.trajectory[i] for i in order]
         keep.covariances.clear()
         keep.noises.clear()
-        keep.covariances_from = len(keep.trajectory)
     keep._moving = None

@@ -34,8 +34,8 @@ from hiper_cli.perceive.foreground.config import SegmentConfig
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
-    "Blob", "SegmentStats", "cell_inverse", "concat_blobs", "grid_components", "image_box", "segment",
-    "sub_blob", "support_below",
+    "Blob", "SegmentStats", "boxes_within", "cell_inverse", "concat_blobs", "grid_components", "image_box",
+    "pixels_in_boxes", "segment", "sub_blob", "support_below",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -106,6 +106,22 @@ def image_box(uv: NDArray[np.int32], step: int, width: int, height: int) -> Floa
             min(float(height), hi[1] + half),
         ]
     )
+
+
+def pixels_in_boxes(uv: NDArray[np.int32], boxes: FloatArray) -> NDArray[np.bool_]:
+    """(N, K): pixel n inside box k (xyxy, pixel centres, half-open like the image box)."""
+    u = uv[:, 0:1].astype(np.float64) + 0.5
+    v = uv[:, 1:2].astype(np.float64) + 0.5
+    in_u = (u >= boxes[None, :, 0]) & (u <= boxes[None, :, 2])
+    return np.asarray(in_u & (v >= boxes[None, :, 1]) & (v <= boxes[None, :, 3]))
+
+
+def boxes_within(outer_xyxy: FloatArray, boxes: FloatArray, share: float) -> NDArray[np.bool_]:
+    """(K,): whether ``share`` of box k's area (xyxy, (K, 4)) lies inside ``outer_xyxy``."""
+    lo = np.maximum(outer_xyxy[None, :2], boxes[:, :2])
+    hi = np.minimum(outer_xyxy[None, 2:], boxes[:, 2:])
+    area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
+    return np.asarray(np.prod(np.clip(hi - lo, 0.0, None), axis=1) >= share * area)
 
 
 def sub_blob(blob: Blob, sel: NDArray[np.int64], step: int, width: int, height: int) -> Blob:

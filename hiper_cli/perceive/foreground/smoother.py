@@ -32,7 +32,7 @@ def smooth_trajectory(track: Track) -> None:
     """
     rows = track.trajectory[track.covariances_from:]
     n = len(rows)
-    if n < 3 or len(track.covariances) != n:
+    if n < 3:
         return
     xs = [np.asarray(r[ROW_STATE], dtype=np.float64) for r in rows]
     Ps = [np.asarray(P, dtype=np.float64) for P in track.covariances]

@@ -239,24 +239,17 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
         old.hits += new.hits
         return
     if drop_rows > 0:
-        unsmoothed = max(0, min(drop_rows, len(old.trajectory) - old.covariances_from))
+        unsmoothed = min(drop_rows, len(old.covariances))
         del old.trajectory[-drop_rows:]
         if unsmoothed:
             del old.covariances[-unsmoothed:]
             del old.noises[-unsmoothed:]
-        old.covariances_from = min(old.covariances_from, len(old.trajectory))
-    rows_before = len(old.trajectory)
     old.trajectory.extend(new.trajectory)
-    new_whole = new.covariances_from + len(new.covariances) == len(new.trajectory)
-    if new_whole and new.covariances_from == 0 and old.covariances_from + len(old.covariances) == rows_before:
-        old.covariances.extend(new.covariances)  # one filter run: smoothed as one
+    if new.covariances_from == 0:  # none of the new rows smoothed: one run with the old ones left
+        old.covariances.extend(new.covariances)
         old.noises.extend(new.noises)
-    elif new_whole:  # the old track was closed (its rows smoothed then): the new rows on their own
+    else:  # the new track's first rows were smoothed already: only its last rows are left
         old.covariances, old.noises = list(new.covariances), list(new.noises)
-        old.covariances_from = rows_before + new.covariances_from
-    else:
-        old.covariances, old.noises = [], []
-        old.covariances_from = len(old.trajectory)
     if kind == REVISIT:
         centre = (old.hits * old.position + new.hits * new.position) / (old.hits + new.hits)
         x = np.array(new.motion.x, dtype=np.float64)

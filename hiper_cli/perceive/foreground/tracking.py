@@ -188,11 +188,10 @@ class Track:
     observation_uuids: list[str] = field(default_factory=list)
     # one row per update: ``model.TRAJECTORY_COLUMNS`` (stamp, position, velocity; map frame)
     trajectory: list[list[float]] = field(default_factory=list)
-    # per trajectory row from ``covariances_from`` on (the rows not smoothed yet): posterior
+    # per trajectory row not smoothed yet (the last ones, ``covariances_from`` on): posterior
     # covariance and the process noise (q, q_vertical) used
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
-    covariances_from: int = 0
     _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
     # ``moving.was_moving`` for the trajectory of this many rows (rows change only by being added)
     _moving: tuple[int, bool] | None = field(default=None, repr=False)
@@ -204,6 +203,12 @@ class Track:
     @property
     def velocity(self) -> FloatArray:
         return np.asarray(self.motion.x[3:], dtype=np.float64)
+
+    @property
+    def covariances_from(self) -> int:
+        """The first trajectory row not smoothed yet: those before were smoothed when the track
+        closed earlier (a walker lost, then resumed)."""
+        return len(self.trajectory) - len(self.covariances)
 
     @property
     def class_name(self) -> str:
@@ -723,7 +728,6 @@ class Tracker:
             for row in track.trajectory:  # a walker stood on the floor all along
                 row[3], row[6] = level[0], 0.0
         track.covariances, track.noises = [], []
-        track.covariances_from = len(track.trajectory)
 
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
         walks = self.config.walker_level and m.class_name in self.config.walker_classes
