@@ -6,11 +6,14 @@ log with ``run_stages``, and compares with the ground truth in ``LOG/gt``:
 
 - each observation gets the truth instance id that most of its sampled pixels
   (``data["pixels_uv"]``) show in ``gt/instance_ids``; each instance the id most of its
-  observations got;
+  observations got. Truth tables are background, but a ``table`` observation (a top the
+  foreground found where the background mapped none) may take a true table's id, as
+  ``hiper eval scene`` scores it (``FOUND_BOTH_WAYS``);
 - classification: an instance is a TP when its class equals the class of its truth instance,
   else an FP (also when it covers no foreground truth instance); ``unknown`` instances are
   counted apart;
-- localisation: per observation, the distance between the blob centre and the centre of the
+- localisation: per observation of a foreground truth instance (a table's is its top, which
+  the background maps), the distance between the blob centre and the centre of the
   truth instance's visible points in the same frame (what the sensor could see), over the
   classified observations (the Table III row), over all, and horizontally; per instance, the
   distance between the tracked centre and the true box centre at the same stamps (this one
@@ -40,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.evaluate.scene import FOUND_BOTH_WAYS
 from hiper_cli.model import Analysis, Instance, Observation, TrackTrajectory
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.logs.truth import Truth, load_truth
@@ -124,14 +128,19 @@ def _background(truth: Truth, background: str) -> tuple[list[Stage], World, str]
 def _frame_truth(
     frame: Frame, truth: Truth, observations: list[Observation], foreground_ids: set[int], step: int
 ) -> tuple[dict[str, int | None], dict[str, float], dict[str, float]]:
-    """Truth id per observation (majority of its pixel sample), its visible-centre error in
-    3D and horizontally."""
+    """Truth id per observation (majority of its pixel sample among the foreground ids, and
+    for a ``FOUND_BOTH_WAYS`` class the truth instances of that class), and for the foreground
+    ids its visible-centre error in 3D and horizontally."""
     rgb_rel = frame.source.split(" + ")[0] if frame.source else ""
     ids_img = truth.load_instance_ids(rgb_rel)
     ids: dict[str, int | None] = {}
     errors: dict[str, float] = {}
     errors_xy: dict[str, float] = {}
     visible_centres: dict[int, NDArray[np.float64] | None] = {}
+    both_ways: dict[str, set[int]] = {}
+    for i, t in truth.instances.items():
+        if t.class_name in FOUND_BOTH_WAYS:
+            both_ways.setdefault(t.class_name, set()).add(i)
     cam = frame.camera
     for obs in observations:
         uv = np.asarray(obs.data.get("pixels_uv", []), dtype=np.int64).reshape(-1, 2)
@@ -139,12 +148,13 @@ def _frame_truth(
             ids[obs.uuid] = None
             continue
         hits = ids_img[np.clip(uv[:, 1], 0, cam.height - 1), np.clip(uv[:, 0], 0, cam.width - 1)]
-        counts = Counter(int(h) for h in hits if int(h) in foreground_ids)
+        eligible = foreground_ids | both_ways.get(obs.class_name, set())
+        counts = Counter(int(h) for h in hits if int(h) in eligible)
         best = counts.most_common(1)
         gid = best[0][0] if best and best[0][1] * 2 >= len(hits) else None
         ids[obs.uuid] = gid
-        if gid is None:
-            continue
+        if gid is None or gid not in foreground_ids:
+            continue  # a table's centre is its top's, which the background maps: no localisation
         if gid not in visible_centres:
             off = step // 2  # the stage's sampling grid
             sub_ids = ids_img[off::step, off::step]
