@@ -80,3 +80,23 @@ def test_bench_options_are_checked():
     assert bad.exit_code != 0 and "--runs" in bad.output
     bad = runner.invoke(app, ["bench", "-o", "/tmp/never", "--worlds", "moon", "--runs", "1"])
     assert bad.exit_code != 0 and "expected some of house" in bad.output
+
+
+def test_grasp_aims_at_the_bottle_instance_nearest_the_bottle_found():
+    from hiper_cli.bench.perception import Knowledge
+    from hiper_cli.bench.tasks import grasp_error
+
+    truth = np.array([[1.39, 2.09, 0.87], [1.16, 1.85, 0.89]])
+    # Instance 0 joined both bottles (its votes: mostly bottle 1, 0.27 m off it); instance 1
+    # stands on bottle 0. Grasping bottle 0 aims at instance 1, whatever the votes said.
+    bottles = np.array([[1.30, 2.09, 0.86], [1.40, 2.10, 0.87]])
+    knowledge = Knowledge("C1", np.zeros((0, 7)), np.zeros(0, np.int64), None, bottles, None, [], [],
+                          0.0, 0.0, True, [(1.30, 2.09, 0.272), (1.40, 2.10, 0.018)])
+    error, source = grasp_error(knowledge, truth, (1.39, 2.09), None)
+    assert error == pytest.approx(0.014, abs=0.002) and source == "this bottle's instance"
+    error, _ = grasp_error(knowledge, truth, (1.16, 1.85), None)
+    assert error == pytest.approx(0.27, abs=0.01)  # the merged instance is the nearest one
+    far = Knowledge("C1", np.zeros((0, 7)), np.zeros(0, np.int64), None, bottles + 5.0, None, [], [],
+                    0.0, 0.0, True, [(6.3, 7.1, 0.02), (6.4, 7.1, 0.04)])
+    error, source = grasp_error(far, truth, (1.39, 2.09), 0.5)
+    assert (error, source) == (pytest.approx(0.03), "median over the bottle instances")

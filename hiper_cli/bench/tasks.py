@@ -11,8 +11,9 @@ configuration of a run):
 - T2 find a bottle: the same from where T1 ended, guided by the bottle heatmap of the
   configuration's bottle instances (in C1 only those within the learned altitude);
 - T3 grasp: approach the detected bottle, plan on the workspace and grasp; a success when the
-  configuration's estimate of that bottle is within ``grasp_tolerance_m`` of the truth; the
-  time adds planning proportional to the workspace's unexplained points;
+  configuration's estimate of that bottle (its bottle instance nearest the bottle) is within
+  ``grasp_tolerance_m`` of the truth; the time adds planning proportional to the workspace's
+  unexplained points;
 - T4 carry back to the idle position, the people heatmap as path cost in C1-C2.
 
 A detection needs the target in the camera's frustum and range (``nav.NavMap.sees``) and
@@ -27,6 +28,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiper_cli.bench.configs import BenchConfig
 from hiper_cli.bench.nav import XY, NavMap
@@ -37,9 +39,10 @@ from hiper_cli.errors import ConfigError
 from hiper_cli.sim.people import Crowd, SocialForceConfig
 from hiper_cli.sim.route import Grid
 
-__all__ = ["TASKS", "TaskConfig", "TaskResult", "run_episode"]
+__all__ = ["TASKS", "TaskConfig", "TaskResult", "grasp_error", "run_episode"]
 
 TASKS = ("T1", "T2", "T3", "T4")
+GRASP_SEARCH_M = 0.5  # the bottle instance a grasp aims at lies this near the bottle found
 
 
 @dataclass(frozen=True)
@@ -130,6 +133,25 @@ def _search_task(
     return TaskResult(**base, task=name, success=ok, time_s=t, reason=reason, extra=extra)
 
 
+def grasp_error(
+    knowledge: Knowledge, bottles_m: NDArray[np.float64], target: XY, localisation_m: float | None
+) -> tuple[float | None, str]:
+    """(error, where it comes from) of the estimate T3 grasps at for the true bottle at
+    ``target`` (``bottles_m``: the true centres). The estimate is the configuration's bottle
+    instance nearest the bottle (within ``GRASP_SEARCH_M``), and its error is its distance to
+    that bottle, whatever truth its observations voted for; without one, the median error of
+    the configuration's bottle instances, else its localisation of classified observations."""
+    truth_k = int(np.argmin(np.hypot(bottles_m[:, 0] - target[0], bottles_m[:, 1] - target[1])))
+    near = np.hypot(knowledge.bottles[:, 0] - target[0], knowledge.bottles[:, 1] - target[1])
+    if near.size and near.min() < GRASP_SEARCH_M:
+        estimate = knowledge.bottles[int(np.argmin(near))]
+        return float(np.linalg.norm(estimate - bottles_m[truth_k])), "this bottle's instance"
+    errors = [e[2] for e in knowledge.bottle_errors_m]
+    if errors:
+        return float(np.median(errors)), "median over the bottle instances"
+    return localisation_m, "classified observations"
+
+
 def run_episode(
     nav: NavMap, knowledge: Knowledge, cfg: BenchConfig, run: int, seed: int,
     task_config: TaskConfig | None = None, localisation_m: float | None = None,
@@ -180,15 +202,7 @@ def run_episode(
     path, _ = nav.astar(robot.xy, nav.viewpoint(target, 1.0))
     robot.drive(path)
     robot.turn_to(target)
-    error: float | None
-    known = [e for e in knowledge.bottle_errors_m if math.dist((e[0], e[1]), target) < 0.5]
-    errors = [e[2] for e in knowledge.bottle_errors_m]
-    if known:
-        error, source = known[0][2], "this bottle's instance"
-    elif errors:
-        error, source = float(np.median(errors)), "median over the bottle instances"
-    else:
-        error, source = localisation_m, "classified observations"
+    error, source = grasp_error(knowledge, bottles, target, localisation_m)
     plan_s = tc.plan_s + tc.plan_s_per_kpoint * knowledge.workspace_points / 1000.0
     t3_time = robot.t_s + plan_s + tc.grasp_s
     support = any(x0 <= target[0] <= x1 and y0 <= target[1] <= y1 for x0, y0, x1, y1 in knowledge.tables)
