@@ -123,6 +123,17 @@ def test_learned_speed_bound_gates_association():
     assert joined[0] is not None  # within min_gate_m
 
 
+def test_a_learned_speed_bound_never_widens_the_gate():
+    # A bottle's c_u learned from its noisiest rows (2.3 m/s): unseen for 0.5 s, the bottle's
+    # track must not take the bottle 0.6 m beside it (the paper rejects pairs beyond c_u · dt).
+    tracker = Tracker(ForegroundConfig(), lambda c: ClassPrior(cu_mps=2.3, sigma_mps=0.1))
+    for k in range(10):
+        tracker.step(k / RATE_HZ, [meas([1, 0, 0.9], "bottle")])
+    (bottle,) = tracker.tracks
+    _, joined = tracker.step(25 / RATE_HZ, [meas([1.6, 0, 0.9], "bottle")])
+    assert joined != [bottle.uuid]
+
+
 def test_closing_a_track_smooths_its_first_rows():
     rng = np.random.default_rng(5)
     tracker = Tracker(ForegroundConfig())

@@ -514,7 +514,7 @@ class TrackerConfig(_Part):
     """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist
     (``hiper analyze features``); off: the paper's C2 ablation. Each part can be switched alone:"""
     learned_gates: bool = True
-    """The ODS's ``cu_mps · dt`` gates the tracker's association (dt < 1 s)."""
+    """The ODS's ``cu_mps · dt`` bounds the tracker's association gate (dt < 1 s)."""
     learned_motion_noise: bool = True
     """The ODS's stationary-noise ``sigma_mps`` sets the class's acceleration noise."""
     learned_size: bool = True

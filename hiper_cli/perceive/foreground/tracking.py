@@ -2,14 +2,15 @@
 
 - Association: an assignment rule chosen by name (``association``: the paper's Hungarian
   algorithm by default, see ``association.py``) on the distances between the tracks' predicted
-  centres and the observed centres, with a gate: ``gate_m``, or
-  the learned ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods``
-  analysis and dt < 1 s; the gate widens by ``search_speed_mps`` per second a track goes unseen
-  (up to ``max_gate_m``) so that a person who left the view is picked up again; only a track
-  of a class in ``search_classes`` (people, and ``unknown``) that was moving when last seen
-  searches like that (a chair or a bed does not walk away while unseen: a static track that
-  widened its gate would take a different object metres away when the robot comes back); a
-  settled track gates at ``gate_sigmas`` times its predicted position σ (at least ``min_gate_m``).
+  centres and the observed centres, with a gate: ``gate_m``, at most the learned
+  ``c_u · dt + gate_margin_m`` of the class when the knowledge base has an ``ods`` analysis
+  and dt < 1 s (the paper rejects pairs beyond it); the gate widens by ``search_speed_mps``
+  per second a track goes unseen (up to ``max_gate_m``) so that a person who left the view is
+  picked up again; only a track of a class in ``search_classes`` (people, and ``unknown``)
+  that was moving when last seen searches like that (a chair or a bed does not walk away while
+  unseen: a static track that widened its gate would take a different object metres away when
+  the robot comes back); a settled track gates at ``gate_sigmas`` times its predicted position
+  σ (at least ``min_gate_m``).
   Inside the gate, two different known classes cost ``class_mismatch_m`` more (same-class
   pairs are preferred, a confused detection still joins its track); ``unknown`` is neutral.
   A track of a walker class (``walker_classes``) does not take a blob smaller than
@@ -510,10 +511,18 @@ class Tracker:
         when not given)."""
         cfg = self.config
         dt = stamp_s - track.last_update_s
+        base, gate = self._own_gate(track, dt, variance_m2)
         prior = self.priors(track.class_name)
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
+            # The paper rejects pairs beyond c_u · dt: a bound on the gate, never a widening
+            # (a bottle's c_u comes from its noisiest rows; as a gate it joined two bottles).
             learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
-            return learned, learned
+            return min(base, learned), min(gate, learned)
+        return base, gate
+
+    def _own_gate(self, track: Track, dt: float, variance_m2: float | None) -> tuple[float, float]:
+        """(base gate, gate) from the track's filter and search state alone."""
+        cfg = self.config
         searching = track.search_class in cfg.search_classes and was_moving(track, cfg)
         unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
