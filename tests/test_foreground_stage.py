@@ -15,6 +15,7 @@ from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import World, make_stage
 from tests.fg_scene import (
     CAMERA,
+    SceneBox,
     background_instances,
     chair,
     make_frame,
@@ -95,14 +96,18 @@ def test_observations_carry_the_low_level_data():
     assert stage.finish(world).instances[0].data["closed"] is True
 
 
-def test_learned_size_prior_turns_implausible_blobs_unknown():
+def test_learned_size_prior_rules_out_only_blobs_too_large():
+    """Priors are learned from instances, the extent of all views; one view shows at most that."""
     world = World(background=background_instances(room()))
-    world.analyses.append(SizeFeature(7.0, 6.0, 8.0, 5.0, 9.0, 10).to_analysis("person", 0, 1, created_s=1.0))
-    stage = ForegroundStage(detector="log", pixel_step=2)
-    r = stage.process(walker_frames(1)[0], world)
+    bottle_sized = SizeFeature(0.004, 0.003, 0.005, 0.002, 0.01, 10)
+    world.analyses.append(bottle_sized.to_analysis("person", 0, 1, created_s=1.0))
+    r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
     assert [o.class_name for o in r.observations] == ["unknown"]
     switched_off = ForegroundStage(detector="log", pixel_step=2, learned_size=False)
-    r = switched_off.process(walker_frames(1)[0], world)
+    assert [o.class_name for o in switched_off.process(walker_frames(1)[0], world).observations] == ["person"]
+    # A blob smaller than every instance of its class is a partial or sparse view, no evidence.
+    world.analyses = [SizeFeature(7.0, 6.0, 8.0, 5.0, 9.0, 10).to_analysis("person", 0, 1, created_s=1.0)]
+    r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
     assert [o.class_name for o in r.observations] == ["person"]
 
 
@@ -116,6 +121,25 @@ def test_learned_altitude_prior_rejects_a_floating_person():
         walker_frames(1)[0], world
     )
     assert [o.class_name for o in r.observations] == ["person"]
+
+
+def test_learned_altitude_prior_keeps_a_person_cut_by_the_image_edge():
+    """A bottom above the learned range rules a class out only where the blob is seen whole."""
+    world = World(background=background_instances(room()))
+    on_the_floor = AltitudeFeature(0.01, 0.0, 0.02, 0.0, 0.02, 10)
+    world.analyses.append(on_the_floor.to_analysis("person", 0, 1, created_s=1.0))
+    stage = ForegroundStage(detector="log", pixel_step=2)
+    # On a 0.6 m platform (background, so no blob of its own) the whole person is in view.
+    platform = SceneBox(20, np.array([3.0, 0.0, 0.3]), np.array([0.8, 1.0, 0.6]), "other", background=True)
+    raised = SceneBox(10, np.array([3.0, 0.0, 1.45]), np.array([0.3, 0.5, 1.7]), "person", relief_m=0.1)
+    world.background = background_instances([*room(), platform])
+    frame = make_frame([*room(), platform, raised], pose_looking_x(), 0.0, 0)
+    assert [o.class_name for o in stage.process(frame, world).observations] == ["unknown"]
+    # 1.2 m before the camera the legs are below the image's lower edge: the blob's bottom
+    # (0.3 m up) is not the person's.
+    world.background = background_instances(room())
+    frame = make_frame([*room(), person(10, 1.2, 0.0)], pose_looking_x(), 0.0, 0)
+    assert [o.class_name for o in stage.process(frame, world).observations] == ["person"]
 
 
 def test_eval_foreground_command_on_a_small_sim_log(tmp_path):

@@ -160,23 +160,34 @@ class ForegroundStage:
             sigma_mps=ods.sigma_mps if cfg.learned_motion_noise else None,
         )
 
-    def _fits_priors(self, class_name: str, blob: Blob) -> bool:
-        """False when the learned size / altitude of ``class_name`` rule the blob out."""
+    def _fits_priors(self, class_name: str, blob: Blob, frame: Frame) -> bool:
+        """False when the learned size / altitude of ``class_name`` rule the blob out.
+
+        The priors are learned from instances, each the extent of all its views; one view shows
+        at most the whole object. A blob larger than the class's range, or whose bottom lies
+        below it, is something else. A smaller one is no evidence: a partial view, or samples a
+        pixel step apart (a bottle at 3 m is a column of points). A bottom above the range rules
+        the class out only when the blob is seen whole (inside the image, nothing nearer cuts
+        it): a person close by, legs below the image's edge, keeps its class."""
         cfg = self.config
         if not cfg.use_learned_priors:
             return True
         tol = cfg.prior_tolerance
         size = self._priors.get((KIND_SIZE, class_name))
-        if cfg.learned_size and isinstance(size, SizeFeature):
-            volume = float(np.prod(blob.extent_map_m))
-            if not size.lo_m3 * (1 - tol) <= volume <= size.hi_m3 * (1 + tol):
-                return False
+        volume_m3 = float(np.prod(blob.extent_map_m))
+        if cfg.learned_size and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
+            return False
         alt = self._priors.get((KIND_ALTITUDE, class_name))
         if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
             slack = tol * max(alt.hi_m - alt.lo_m, MIN_ALTITUDE_SPAN_M)
             bottom = float(blob.center_map_m[2] - blob.extent_map_m[2] / 2.0)
-            if not alt.lo_m - slack <= bottom <= alt.hi_m + slack:
+            if bottom < alt.lo_m - slack:
                 return False
+            if bottom > alt.hi_m + slack:  # seen whole, its bottom is the object's
+                step = cfg.pixel_step
+                return not inside_image(blob, step, frame.camera) or occluded(
+                    blob, frame.depth_m, frame.camera, frame.T_map_cam, step
+                )
         return True
 
     def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
@@ -306,7 +317,8 @@ class ForegroundStage:
             if match.detection_index is not None and cfg.class_sizes:
                 longest = longest_m(blob.points_map, float(blob.extent_map_m[2]))
             if match.detection_index is not None and not (
-                self._fits_priors(match.class_name, blob) and self._stands(match.class_name, blob, flat)
+                self._fits_priors(match.class_name, blob, frame)
+                and self._stands(match.class_name, blob, flat)
                 and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
                 and (match.class_name not in cfg.fixture_classes
                      or attached(blob.points_map, walls, tops, cfg.fixture_reach_m))
