@@ -99,14 +99,19 @@ def test_observations_carry_the_low_level_data():
 def test_learned_size_prior_rules_out_only_blobs_too_large():
     """Priors are learned from instances, the extent of all views; one view shows at most that."""
     world = World(background=background_instances(room()))
+    frame = make_frame([*room(), chair(11, 3.0, 0.0)], pose_looking_x(), 0.0, 0)
     bottle_sized = SizeFeature(0.004, 0.003, 0.005, 0.002, 0.01, 10)
-    world.analyses.append(bottle_sized.to_analysis("person", 0, 1, created_s=1.0))
-    r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
+    world.analyses.append(bottle_sized.to_analysis("chair", 0, 1, created_s=1.0))
+    r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
     assert [o.class_name for o in r.observations] == ["unknown"]
     switched_off = ForegroundStage(detector="log", pixel_step=2, learned_size=False)
-    assert [o.class_name for o in switched_off.process(walker_frames(1)[0], world).observations] == ["person"]
+    assert [o.class_name for o in switched_off.process(frame, world).observations] == ["chair"]
     # A blob smaller than every instance of its class is a partial or sparse view, no evidence.
-    world.analyses = [SizeFeature(7.0, 6.0, 8.0, 5.0, 9.0, 10).to_analysis("person", 0, 1, created_s=1.0)]
+    world.analyses = [SizeFeature(7.0, 6.0, 8.0, 5.0, 9.0, 10).to_analysis("chair", 0, 1, created_s=1.0)]
+    r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
+    assert [o.class_name for o in r.observations] == ["chair"]
+    # A walker's instance box is the running mean of its views: no bound on one view.
+    world.analyses = [bottle_sized.to_analysis("person", 0, 1, created_s=1.0)]
     r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
     assert [o.class_name for o in r.observations] == ["person"]
 

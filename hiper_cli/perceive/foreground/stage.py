@@ -166,16 +166,18 @@ class ForegroundStage:
         The priors are learned from instances, each the extent of all its views; one view shows
         at most the whole object. A blob larger than the class's range, or whose bottom lies
         below it, is something else. A smaller one is no evidence: a partial view, or samples a
-        pixel step apart (a bottle at 3 m is a column of points). A bottom above the range rules
-        the class out only when the blob is seen whole (inside the image, nothing nearer cuts
-        it): a person close by, legs below the image's edge, keeps its class."""
+        pixel step apart (a bottle at 3 m is a column of points). A walker's instance box is a
+        running mean of its views, partial ones included, so its size range bounds no view. A
+        bottom above the range rules the class out only when the blob is seen whole (inside the
+        image, nothing nearer cuts it): a person close by, legs below the image, keeps its class."""
         cfg = self.config
         if not cfg.use_learned_priors:
             return True
         tol = cfg.prior_tolerance
         size = self._priors.get((KIND_SIZE, class_name))
+        union = cfg.learned_size and class_name not in cfg.walker_classes  # a walker's: a mean
         volume_m3 = float(np.prod(blob.extent_map_m))
-        if cfg.learned_size and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
+        if union and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
             return False
         alt = self._priors.get((KIND_ALTITUDE, class_name))
         if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
