@@ -175,9 +175,9 @@ class ForegroundStage:
             return True
         tol = cfg.prior_tolerance
         size = self._priors.get((KIND_SIZE, class_name))
-        union = cfg.learned_size and class_name not in cfg.walker_classes  # a walker's: a mean
+        bounded = cfg.learned_size and class_name not in cfg.walker_classes  # walkers: a mean box
         volume_m3 = float(np.prod(blob.extent_map_m))
-        if union and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
+        if bounded and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
             return False
         alt = self._priors.get((KIND_ALTITUDE, class_name))
         if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
