@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hiper_cli.evaluate.foreground import _frame_truth
+from hiper_cli.evaluate.foreground import _both_ways_ids, _frame_truth
 from hiper_cli.model import Box3D, Observation
 from hiper_cli.perceive.logs.truth import Truth, TruthInstance
 from hiper_cli.types import CameraIntrinsics, Frame
@@ -39,7 +39,7 @@ def test_a_table_the_foreground_found_votes_for_the_true_table():
     frame = Frame(0.0, np.zeros((30, 40, 3), np.uint8), depth, CAMERA, np.eye(4), 0, source="rgb/0.png")
     table, named_wrong = _observation("table", slice(0, 20)), _observation("bottle", slice(0, 20))
     chair = _observation("chair", slice(20, 40))
-    ids, errors, _ = _frame_truth(frame, truth, [table, named_wrong, chair], {2}, 2)
+    ids, errors, _ = _frame_truth(frame, truth, [table, named_wrong, chair], {2}, _both_ways_ids(truth), 2)
     # Only a table observation may take a background table's id: a bottle there shows no object.
     assert ids == {table.uuid: 1, named_wrong.uuid: None, chair.uuid: 2}
     assert set(errors) == {chair.uuid}  # a table's centre is its top's: no localisation

@@ -125,22 +125,28 @@ def _background(truth: Truth, background: str) -> tuple[list[Stage], World, str]
     return [stage], World(), "hiper background stage"
 
 
+def _both_ways_ids(truth: Truth) -> dict[str, set[int]]:
+    """Per ``FOUND_BOTH_WAYS`` class, the ids of its truth instances."""
+    out: dict[str, set[int]] = {}
+    for i, t in truth.instances.items():
+        if t.class_name in FOUND_BOTH_WAYS:
+            out.setdefault(t.class_name, set()).add(i)
+    return out
+
+
 def _frame_truth(
-    frame: Frame, truth: Truth, observations: list[Observation], foreground_ids: set[int], step: int
+    frame: Frame, truth: Truth, observations: list[Observation], foreground_ids: set[int],
+    both_ways: dict[str, set[int]], step: int,
 ) -> tuple[dict[str, int | None], dict[str, float], dict[str, float]]:
     """Truth id per observation (majority of its pixel sample among the foreground ids, and
-    for a ``FOUND_BOTH_WAYS`` class the truth instances of that class), and for the foreground
-    ids its visible-centre error in 3D and horizontally."""
+    for a ``FOUND_BOTH_WAYS`` class the ids ``both_ways`` gives it), and for the foreground ids
+    its visible-centre error in 3D and horizontally."""
     rgb_rel = frame.source.split(" + ")[0] if frame.source else ""
     ids_img = truth.load_instance_ids(rgb_rel)
     ids: dict[str, int | None] = {}
     errors: dict[str, float] = {}
     errors_xy: dict[str, float] = {}
     visible_centres: dict[int, NDArray[np.float64] | None] = {}
-    both_ways: dict[str, set[int]] = {}
-    for i, t in truth.instances.items():
-        if t.class_name in FOUND_BOTH_WAYS:
-            both_ways.setdefault(t.class_name, set()).add(i)
     cam = frame.camera
     for obs in observations:
         uv = np.asarray(obs.data.get("pixels_uv", []), dtype=np.int64).reshape(-1, 2)
@@ -191,6 +197,7 @@ def _run(
     reader = open_log(log_path)
     run = ForegroundRun(world=world, background_source=source)
     fg_ids = {i for i, t in truth.instances.items() if t.layer == "foreground"}
+    both_ways = _both_ways_ids(truth)
     step = ForegroundConfig.from_options(**options).pixel_step
     frame_index = itertools.count()
 
@@ -217,7 +224,7 @@ def _run(
     again = open_log(log_path)
     for k, frame in enumerate(itertools.islice(iter(again), stats.frames)):
         if by_frame.get(k):
-            ids, errors, errors_xy = _frame_truth(frame, truth, by_frame[k], fg_ids, step)
+            ids, errors, errors_xy = _frame_truth(frame, truth, by_frame[k], fg_ids, both_ways, step)
             run.obs_truth_id.update(ids)
             run.obs_visible_error_m.update(errors)
             run.obs_visible_error_xy_m.update(errors_xy)
