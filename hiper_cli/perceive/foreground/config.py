@@ -463,6 +463,10 @@ class TrackerConfig(_Part):
     vertical velocity: people walk on the floor, so their centre is half their height up (a high
     quantile of their blobs' tops) and is never extrapolated (issue 17: person boxes below the
     floor, and 0.7 m low from the mean of partial blobs)."""
+    complete_footprints: bool = True
+    """A static bed, couch or refrigerator seen in part has its box extended behind the faces
+    the camera saw, to its class's least footprint width (``amodal.py``; issue 17: a bed seen
+    through a doorway as a strip of its side, its centre 0.54 m off)."""
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving (a
     named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its

@@ -31,6 +31,7 @@ MIN_MOVED_BOXES = 8  # blobs before the first and last quarters can tell a move
 MOVED_MARGIN_M = 0.1  # the quarters' boxes lie this far apart horizontally: it moved
 MIN_NAMED_BOXES = 5  # named blobs enough to make the box of them alone
 MIN_BRIDGING_BOXES = 2  # views reaching both where a track was first and last: it did not move
+_NO_VIEWPOINT = np.full(3, np.nan)
 
 
 @dataclass
@@ -40,24 +41,36 @@ class SeenBox:
     lower_m: list[FloatArray] = field(default_factory=list)
     upper_m: list[FloatArray] = field(default_factory=list)
     named: list[bool] = field(default_factory=list)  # per blob: a detection named it
+    # per blob: the camera's position, map frame (NaN: not given), for ``amodal``
+    viewpoints_m: list[FloatArray] = field(default_factory=list)
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
     _moved: tuple[int, bool] | None = field(default=None, repr=False)
 
-    def add(self, lower_m: FloatArray, upper_m: FloatArray, named: bool = False) -> None:
+    def add(
+        self,
+        lower_m: FloatArray,
+        upper_m: FloatArray,
+        named: bool = False,
+        viewpoint_m: FloatArray | None = None,
+    ) -> None:
         self.lower_m.append(np.asarray(lower_m, dtype=np.float64))
         self.upper_m.append(np.asarray(upper_m, dtype=np.float64))
         self.named.append(bool(named))
+        view = _NO_VIEWPOINT if viewpoint_m is None else np.asarray(viewpoint_m, dtype=np.float64)
+        self.viewpoints_m.append(view)
         if len(self.lower_m) > 2 * MAX_SEEN_BOXES:  # trimmed in batches: amortised O(1)
             del self.lower_m[:-MAX_SEEN_BOXES]
             del self.upper_m[:-MAX_SEEN_BOXES]
             del self.named[:-MAX_SEEN_BOXES]
+            del self.viewpoints_m[:-MAX_SEEN_BOXES]
         self._cache = None
         self._moved = None
 
     def extend(self, other: SeenBox) -> None:
         """Add the blobs of ``other`` (a track this one absorbed)."""
-        for lo, hi, named in zip(other.lower_m, other.upper_m, other.named, strict=True):
-            self.add(lo, hi, named)
+        for lo, hi, named, view in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m,
+                                       strict=True):
+            self.add(lo, hi, named, view)
 
     def __len__(self) -> int:
         return len(self.lower_m)
@@ -71,6 +84,17 @@ class SeenBox:
         if int(named.sum()) >= MIN_NAMED_BOXES:
             return lower[named], upper[named]
         return lower, upper
+
+    def viewpoint(self) -> FloatArray | None:
+        """The median camera position (map frame) of the blobs the box is of (the named ones
+        when there are ``MIN_NAMED_BOXES``); None when no blob had one."""
+        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
+        views = np.array(self.viewpoints_m[start:], dtype=np.float64).reshape(-1, 3)
+        named = np.array(self.named[start:], dtype=bool)
+        if int(named.sum()) >= MIN_NAMED_BOXES:
+            views = views[named]
+        views = views[np.isfinite(views).all(axis=1)]
+        return np.median(views, axis=0) if len(views) else None
 
     def moved(self) -> bool:
         """Whether the object moved: the (median) box of its first quarter of blobs and that of

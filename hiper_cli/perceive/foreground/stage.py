@@ -25,6 +25,7 @@ from hiper_cli.learned import (
 )
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.foreground.amodal import complete_footprint
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.carried import drop_carried
@@ -32,6 +33,7 @@ from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
+from hiper_cli.perceive.foreground.moving import is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.segment import Blob, segment
@@ -136,6 +138,7 @@ class ForegroundStage:
         self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
         self.tracker = Tracker(cfg, self._class_prior)
         self._instances: dict[str, Instance] = {}
+        self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
 
     # --- learned priors ---------------------------------------------------------------------
     def _refresh_priors(self, world: World) -> None:
@@ -252,6 +255,7 @@ class ForegroundStage:
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
         walls = [inst.box for inst in world.background.values() if inst.class_name == "wall"]
+        self._walls = walls
         tops = support_boxes(inst for inst in world.background.values() if inst.class_name == "table")
         self._floor_z_m = floor_height_m(world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
@@ -347,6 +351,7 @@ class ForegroundStage:
                     longest_m=longest,
                     solid=not flat,
                     detection_index=match.detection_index,
+                    viewpoint_map_m=frame.T_map_cam[:3, 3],
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -401,6 +406,7 @@ class ForegroundStage:
             self._pool.shutdown(wait=True)
             self._pool = None
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
+        self._walls = [inst.box for inst in world.background.values() if inst.class_name == "wall"]
         return FrameResult(instances=[self._instance(t) for t in closed], deleted_instances=gone)
 
     # --- conversions ------------------------------------------------------------------------
@@ -438,7 +444,7 @@ class ForegroundStage:
     def _instance(self, track: Track) -> Instance:
         speed = float(np.hypot(*track.velocity[:2]))
         state = "dynamic" if speed > self.config.dynamic_speed_mps and not track.closed else "static"
-        box = Box3D(*object_box(track, self.tracker.config))
+        box = self._box(track)
         inst = self._instances.get(track.uuid)
         if inst is None:
             inst = Instance(
@@ -459,6 +465,16 @@ class ForegroundStage:
         inst.confidence = track.confidence
         inst.data["closed"] = track.closed
         return inst
+
+    def _box(self, track: Track) -> Box3D:
+        """The instance's box: ``object_box``, completed behind the faces seen for a static
+        object of a class with a footprint width (``amodal.py``)."""
+        centre, extent = object_box(track, self.tracker.config)
+        if self.config.complete_footprints and is_static(track, self.tracker.config):
+            lower, upper = complete_footprint(centre - extent / 2.0, centre + extent / 2.0, track.class_name,
+                                              track.seen.viewpoint(), self._walls)
+            centre, extent = (lower + upper) / 2.0, upper - lower
+        return Box3D(centre, extent)
 
     def _projector(self, frame: Frame) -> Any:
         """A function taking map points (N, 3) to (in the camera's view: image and depth range,

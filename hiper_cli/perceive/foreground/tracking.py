@@ -125,6 +125,9 @@ class Measurement:
     detection_index: int | None = None
     """Which detection of its frame named the blob (None: none): two tracks named by different
     detections in one frame are two objects (``same_object.seen_apart``)."""
+    viewpoint_map_m: FloatArray | None = None
+    """The camera's position (map frame) when it saw the blob: which side of the object it saw
+    (``amodal``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -437,7 +440,7 @@ class Tracker:
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -753,7 +756,7 @@ class Tracker:
             min_class_share=self.config.min_class_share,
             size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
         )
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

@@ -1,0 +1,82 @@
+"""Large furniture seen in part gets the depth the camera could not see (``amodal.py``): a bed
+seen from its side as a strip is as wide as a bed, behind the strip and never through a wall;
+what was seen whole, or from along the strip, or is of a class without a width, keeps its box."""
+
+import numpy as np
+import pytest
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.amodal import complete_footprint
+from hiper_cli.perceive.foreground.seen_box import SeenBox
+
+STRIP = (np.array([10.0, 4.0, 0.0]), np.array([11.0, 4.26, 0.6]))  # a bed's side, 0.26 m deep
+
+
+def _complete(cls, view, walls=()):
+    lower, upper = complete_footprint(*STRIP, cls, None if view is None else np.array(view, float), walls)
+    return lower, upper
+
+
+def test_a_bed_seen_from_its_side_is_as_deep_as_a_bed_behind_what_was_seen():
+    lower, upper = _complete("bed", [6.0, 1.3, 1.2])  # the camera lies beyond the strip on -y
+    assert np.allclose(lower, STRIP[0])  # the face it saw stays where it was seen
+    assert np.allclose(upper, [11.0, 4.9, 0.6])  # the rest lies behind it, 0.9 m in all
+    lower, upper = _complete("bed", [12.0, 7.0, 1.2])  # seen from the other side: it lies in front
+    assert np.allclose(lower, [10.0, 4.26 - 0.9, 0.0]) and np.allclose(upper, STRIP[1])
+
+
+def test_the_depth_stops_at_a_wall_behind_the_object():
+    wall = Box3D(np.array([10.5, 4.6, 1.2]), np.array([3.0, 2.4, 0.02]),
+                 R=np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]))  # normal along y
+    lower, upper = _complete("bed", [6.0, 1.3, 1.2], [wall])
+    assert np.isclose(upper[1], 4.58) and np.isclose(lower[1], 4.0)
+    aside = Box3D(np.array([14.0, 4.6, 1.2]), np.array([3.0, 2.4, 0.02]), R=wall.R)  # not behind it
+    assert np.isclose(_complete("bed", [6.0, 1.3, 1.2], [aside])[1][1], 4.9)
+
+
+def test_what_was_seen_along_its_thin_side_or_whole_or_has_no_width_is_unchanged():
+    along = [10.5, 4.1, 1.2]  # within the strip's y slab: the camera looked along it, not across
+    for cls, view in (("bed", along), ("chair", [6.0, 1.3, 1.2]), ("bed", None)):
+        lower, upper = _complete(cls, view)
+        assert np.allclose(lower, STRIP[0]) and np.allclose(upper, STRIP[1]), (cls, view)
+    whole = (np.array([0.0, 0.0, 0.0]), np.array([2.0, 1.0, 0.9]))
+    lower, upper = complete_footprint(*whole, "bed", np.array([1.0, -3.0, 1.2]))
+    assert np.allclose(lower, whole[0]) and np.allclose(upper, whole[1])
+
+
+def test_the_seen_box_remembers_where_its_named_blobs_were_seen_from():
+    box = SeenBox()
+    assert box.viewpoint() is None
+    box.add(np.zeros(3), np.ones(3), named=False)  # no viewpoint given
+    assert box.viewpoint() is None
+    for k in range(5):
+        box.add(np.zeros(3), np.ones(3), named=True, viewpoint_m=np.array([k, 0.0, 1.2]))
+    box.add(np.zeros(3), np.ones(3), named=False, viewpoint_m=np.array([50.0, 0.0, 1.2]))  # unnamed
+    assert np.allclose(box.viewpoint(), [2.0, 0.0, 1.2])
+    both = SeenBox()
+    both.extend(box)
+    assert np.allclose(both.viewpoint(), box.viewpoint())
+
+
+def test_a_refrigerator_seen_from_the_front_is_as_deep_as_one_in_the_knowledge_base():
+    from hiper_cli.perceive.foreground import ForegroundStage
+    from hiper_cli.perceive.runner import run_stages
+    from hiper_cli.perceive.stage import World
+    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
+
+    # 0.7 m deep, taller than the camera: only its front (and the handles' relief) is in view
+    fridge = SceneBox(10, np.array([2.9, 0.0, 0.9]), np.array([0.7, 0.7, 1.8]), "refrigerator", relief_m=0.1)
+    frames = [make_frame([*room(), fridge], pose_looking_x(), k / 30.0, k) for k in range(20)]
+
+    def centre_x(**options):
+        stage = ForegroundStage(detector="log", pixel_step=2, **options)
+        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+        (inst,) = world.foreground.values()
+        assert inst.class_name == "refrigerator"
+        return inst.box.center_m[0], inst.box.extent_m[0]
+
+    seen_x, seen_depth = centre_x(complete_footprints=False)
+    assert seen_depth < 0.2 and 2.9 - seen_x > 0.3  # the front only: its centre far before the fridge's
+    x, depth = centre_x()
+    assert depth == pytest.approx(0.55)  # a refrigerator's least depth, behind the front it saw
+    assert x - depth / 2 == pytest.approx(seen_x - seen_depth / 2) and 2.9 - x < (2.9 - seen_x) / 2
