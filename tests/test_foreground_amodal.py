@@ -80,3 +80,41 @@ def test_a_refrigerator_seen_from_the_front_is_as_deep_as_one_in_the_knowledge_b
     x, depth = centre_x()
     assert depth == pytest.approx(0.55)  # a refrigerator's least depth, behind the front it saw
     assert x - depth / 2 == pytest.approx(seen_x - seen_depth / 2) and 2.9 - x < (2.9 - seen_x) / 2
+
+
+def test_a_chair_whose_top_no_view_showed_is_as_tall_as_a_chair():
+    from hiper_cli.perceive.foreground.amodal import complete_height
+
+    lower, upper = np.array([0.0, 0.0, 0.0]), np.array([0.45, 0.4, 0.52])  # a seat under a desk's top
+    assert complete_height(lower, upper, "chair", top_seen=False)[1][2] == pytest.approx(0.7)
+    for cls, seen in (("chair", True), ("bed", False)):  # its top in view; a class with no height
+        assert np.allclose(complete_height(lower, upper, cls, top_seen=seen)[1], upper)
+    box = SeenBox()
+    for k in range(10):
+        box.add(np.zeros(3), np.ones(3), named=True, top_hidden=k > 0)
+    assert not box.top_seen()  # one view in ten is noise
+    box.add(np.zeros(3), np.ones(3), named=True, top_hidden=False)
+    box.add(np.zeros(3), np.ones(3), named=True, top_hidden=False)
+    assert box.top_seen()  # three in twelve: as many as the box's upper quantile takes
+
+
+def test_a_chair_behind_a_panel_is_raised_to_a_chairs_height_in_the_knowledge_base():
+    from hiper_cli.perceive.foreground import ForegroundStage
+    from hiper_cli.perceive.runner import run_stages
+    from hiper_cli.perceive.stage import World
+    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
+
+    chair = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), "chair", relief_m=0.1)
+    # a desk's front, 2 m before it, from 0.6 m up: the camera (1 m high) sees the chair's legs only
+    panel = SceneBox(11, np.array([2.0, 0.0, 0.9]), np.array([0.05, 2.0, 0.6]), "other")
+    frames = [make_frame([*room(), chair, panel], pose_looking_x(), k / 30.0, k) for k in range(20)]
+
+    def chair_box(**options):
+        stage = ForegroundStage(detector="log", pixel_step=2, **options)
+        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+        (inst,) = [i for i in world.foreground.values() if i.class_name == "chair"]
+        return inst.box.center_m[2] - inst.box.extent_m[2] / 2, inst.box.extent_m[2]
+
+    bottom, seen_height = chair_box(complete_footprints=False)
+    assert seen_height < 0.45
+    assert chair_box() == pytest.approx((bottom, 0.7))

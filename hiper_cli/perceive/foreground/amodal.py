@@ -11,8 +11,13 @@ box along that axis (so it saw the face across it), is extended along that axis 
 camera to that width: the part of it the near faces hid. The extension stops at a wall (a
 background plane) behind the object, since nothing stands inside a wall.
 
-Only the depth is completed. How long a bed cut by a doorway's side is, and on which side the
-rest of it lies, the views do not tell.
+A chair behind a desk shows its seat under the desk's top and not its back: where no view
+showed an object's top (``SeenBox.top_seen``: something nearer lay just above the blob, or the
+image ended there), a class with a least height (``LEAST_HEIGHT_M``: a chair with a back is at
+least 0.7 m tall) has its box raised to that height above its bottom.
+
+How long a bed cut by a doorway's side is, and on which side the rest of it lies, the views do
+not tell: the length is not completed.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 
-__all__ = ["FOOTPRINT_MIN_WIDTH_M", "complete_footprint"]
+__all__ = ["FOOTPRINT_MIN_WIDTH_M", "LEAST_HEIGHT_M", "complete_footprint", "complete_height"]
 
 FloatArray = NDArray[np.float64]
 
@@ -34,6 +39,13 @@ FOOTPRINT_MIN_WIDTH_M: dict[str, float] = {
     "refrigerator": 0.55,
 }
 """COCO class -> the narrower side (m) of the footprint of its smallest common instance."""
+LEAST_HEIGHT_M: dict[str, float] = {
+    "chair": 0.7,
+    "couch": 0.6,
+    "refrigerator": 0.8,
+}
+"""COCO class -> the height (m) of its lowest common instance (a chair with a back, a low couch's
+back, an under-counter refrigerator)."""
 WALL_MIN_NORMAL = 0.87  # a wall faces along a map axis when its normal is within 30° of it
 WALL_GAP_M = 0.02  # an extension stops this short of a wall behind the object
 
@@ -65,6 +77,19 @@ def complete_footprint(
             far = max(upper[axis] - width, _wall_behind(lower, upper, axis, -1, walls))
             lower[axis] = min(lower[axis], far)
     return lower, upper
+
+
+def complete_height(
+    lower_m: FloatArray, upper_m: FloatArray, class_name: str, top_seen: bool
+) -> tuple[FloatArray, FloatArray]:
+    """(lower, upper) corners of an object whose top no view showed (``top_seen`` false): at
+    least the class's least height above its bottom. Unchanged otherwise."""
+    height = LEAST_HEIGHT_M.get(class_name)
+    if height is None or top_seen or upper_m[2] - lower_m[2] >= height:
+        return lower_m, upper_m
+    upper = np.array(upper_m, dtype=np.float64)
+    upper[2] = lower_m[2] + height
+    return lower_m, upper
 
 
 def _wall_behind(lower: FloatArray, upper: FloatArray, axis: int, sign: int, walls: Sequence[Box3D]) -> float:

@@ -465,8 +465,10 @@ class TrackerConfig(_Part):
     floor, and 0.7 m low from the mean of partial blobs)."""
     complete_footprints: bool = True
     """A static bed, couch or refrigerator seen in part has its box extended behind the faces
-    the camera saw, to its class's least footprint width (``amodal.py``; issue 17: a bed seen
-    through a doorway as a strip of its side, its centre 0.54 m off)."""
+    the camera saw, to its class's least footprint width, and a chair, couch or refrigerator
+    whose top no view showed is raised to its class's least height (``amodal.py``; issue 17: a
+    bed seen through a doorway as a strip of its side, its centre 0.54 m off; chairs behind a
+    desk kept up to the seat)."""
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving (a
     named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its

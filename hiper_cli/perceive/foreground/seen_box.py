@@ -43,6 +43,7 @@ class SeenBox:
     named: list[bool] = field(default_factory=list)  # per blob: a detection named it
     # per blob: the camera's position, map frame (NaN: not given), for ``amodal``
     viewpoints_m: list[FloatArray] = field(default_factory=list)
+    tops_hidden: list[bool] = field(default_factory=list)  # per blob: its top was not in view
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
     _moved: tuple[int, bool] | None = field(default=None, repr=False)
 
@@ -52,25 +53,28 @@ class SeenBox:
         upper_m: FloatArray,
         named: bool = False,
         viewpoint_m: FloatArray | None = None,
+        top_hidden: bool = False,
     ) -> None:
         self.lower_m.append(np.asarray(lower_m, dtype=np.float64))
         self.upper_m.append(np.asarray(upper_m, dtype=np.float64))
         self.named.append(bool(named))
         view = _NO_VIEWPOINT if viewpoint_m is None else np.asarray(viewpoint_m, dtype=np.float64)
         self.viewpoints_m.append(view)
+        self.tops_hidden.append(bool(top_hidden))
         if len(self.lower_m) > 2 * MAX_SEEN_BOXES:  # trimmed in batches: amortised O(1)
             del self.lower_m[:-MAX_SEEN_BOXES]
             del self.upper_m[:-MAX_SEEN_BOXES]
             del self.named[:-MAX_SEEN_BOXES]
             del self.viewpoints_m[:-MAX_SEEN_BOXES]
+            del self.tops_hidden[:-MAX_SEEN_BOXES]
         self._cache = None
         self._moved = None
 
     def extend(self, other: SeenBox) -> None:
         """Add the blobs of ``other`` (a track this one absorbed)."""
-        for lo, hi, named, view in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m,
-                                       strict=True):
-            self.add(lo, hi, named, view)
+        for lo, hi, named, view, hidden in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m,
+                                               other.tops_hidden, strict=True):
+            self.add(lo, hi, named, view, hidden)
 
     def __len__(self) -> int:
         return len(self.lower_m)
@@ -95,6 +99,16 @@ class SeenBox:
             views = views[named]
         views = views[np.isfinite(views).all(axis=1)]
         return np.median(views, axis=0) if len(views) else None
+
+    def top_seen(self) -> bool:
+        """Whether views showed the object's top: at least ``SEEN_BOX_QUANTILE`` of the blobs
+        the box is of (as ``viewpoint``), as many as its upper quantile needs, had it in view."""
+        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
+        hidden = np.array(self.tops_hidden[start:], dtype=bool)
+        named = np.array(self.named[start:], dtype=bool)
+        if int(named.sum()) >= MIN_NAMED_BOXES:
+            hidden = hidden[named]
+        return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
 
     def moved(self) -> bool:
         """Whether the object moved: the (median) box of its first quarter of blobs and that of

@@ -25,7 +25,7 @@ from hiper_cli.learned import (
 )
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
-from hiper_cli.perceive.foreground.amodal import complete_footprint
+from hiper_cli.perceive.foreground.amodal import LEAST_HEIGHT_M, complete_footprint, complete_height
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.carried import drop_carried
@@ -47,7 +47,7 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     table_match,
     withdraw_mapped,
 )
-from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole
+from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole, top_hidden
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
 
@@ -352,6 +352,8 @@ class ForegroundStage:
                     solid=not flat,
                     detection_index=match.detection_index,
                     viewpoint_map_m=frame.T_map_cam[:3, 3],
+                    top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
+                    and top_hidden(blob, frame.depth_m, frame.camera, cfg.pixel_step),
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -473,6 +475,7 @@ class ForegroundStage:
         if self.config.complete_footprints and is_static(track, self.tracker.config):
             lower, upper = complete_footprint(centre - extent / 2.0, centre + extent / 2.0, track.class_name,
                                               track.seen.viewpoint(), self._walls)
+            lower, upper = complete_height(lower, upper, track.class_name, track.seen.top_seen())
             centre, extent = (lower + upper) / 2.0, upper - lower
         return Box3D(centre, extent)
 

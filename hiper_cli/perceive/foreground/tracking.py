@@ -128,6 +128,8 @@ class Measurement:
     viewpoint_map_m: FloatArray | None = None
     """The camera's position (map frame) when it saw the blob: which side of the object it saw
     (``amodal``)."""
+    top_hidden: bool = False
+    """The view did not show the object's top (``whole.top_hidden``; ``amodal``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -440,7 +442,7 @@ class Tracker:
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -756,7 +758,7 @@ class Tracker:
             min_class_share=self.config.min_class_share,
             size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
         )
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

@@ -20,11 +20,12 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["inside_image", "occluded", "seen_whole", "thickness_m"]
+__all__ = ["inside_image", "occluded", "seen_whole", "thickness_m", "top_hidden"]
 
 OCCLUDER_MARGIN_M = 0.15  # a surface this much nearer than the blob beside it stands in front
 OCCLUDER_RING_CELLS = 2  # ... within this many samples of the blob's outline
 OCCLUDED_SHARE = 0.1  # a blob whose outline borders occluders for this share of it is cut
+TOP_HIDDEN_SHARE = 0.5  # a blob whose top borders occluders in this share of its columns
 
 
 def thickness_m(points: np.ndarray) -> float:
@@ -91,3 +92,20 @@ def occluded(
         base = float(blob.bounds_map[0][2])
         nearer[rows, cols] = height > base + OCCLUDER_MARGIN_M
     return bool(nearer.sum() >= OCCLUDED_SHARE * ring.sum())
+
+
+def top_hidden(blob: Blob, depth_m: NDArray[np.float32], camera: CameraIntrinsics, pixel_step: int) -> bool:
+    """Whether the camera did not see how high ``blob``'s object reaches: the blob reaches the
+    image's top edge, or the image rows just above its box (``OCCLUDER_RING_CELLS`` samples)
+    show, in ``TOP_HIDDEN_SHARE`` of its columns, something more than ``OCCLUDER_MARGIN_M``
+    nearer than the blob (a desk's top over the seat of the chair behind it)."""
+    step = pixel_step
+    x0, y0, x1, _ = (int(v) for v in blob.image_box_xyxy)
+    if y0 <= step:
+        return True
+    rows = depth_m[max(y0 - step * OCCLUDER_RING_CELLS, 0):y0, x0:max(x1, x0 + 1):step].astype(np.float64)
+    if rows.size == 0:
+        return False
+    near = float(np.median(blob.points_cam[:, 2])) - OCCLUDER_MARGIN_M
+    nearer = ((rows > 0) & (rows < near)).any(axis=0)
+    return bool(nearer.mean() >= TOP_HIDDEN_SHARE)
