@@ -59,9 +59,9 @@ def complete_footprint(
 ) -> tuple[FloatArray, FloatArray]:
     """(lower, upper) map-frame corners of the object whose seen box is ``lower_m``-``upper_m``,
     seen from ``viewpoint_m`` (the camera's position, map frame): extended away from the camera
-    to the class's footprint width along each horizontal axis it is thinner along and the camera
-    lies beyond, up to the nearest of ``walls`` behind it. Unchanged for a class without a width, without a
-    viewpoint, or already as wide."""
+    to the class's footprint width along each horizontal axis it is thinner along and the
+    camera lies beyond, up to the nearest of ``walls`` behind it. Unchanged for a class without
+    a width, without a viewpoint, or already as wide."""
     width = FOOTPRINT_MIN_WIDTH_M.get(class_name)
     if width is None or viewpoint_m is None:
         return lower_m, upper_m

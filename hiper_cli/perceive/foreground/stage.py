@@ -353,7 +353,7 @@ class ForegroundStage:
                     detection_index=match.detection_index,
                     viewpoint_map_m=frame.T_map_cam[:3, 3],
                     top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
-                    and top_hidden(blob, frame.depth_m, frame.camera, cfg.pixel_step),
+                    and top_hidden(blob, frame.depth_m, cfg.pixel_step),
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -469,8 +469,8 @@ class ForegroundStage:
         return inst
 
     def _box(self, track: Track) -> Box3D:
-        """The instance's box: ``object_box``, completed behind the faces seen for a static
-        object of a class with a footprint width (``amodal.py``)."""
+        """The instance's box: ``object_box``; a static object's completed behind the faces seen
+        and up to its class's least height when no view showed its top (``amodal.py``)."""
         centre, extent = object_box(track, self.tracker.config)
         if self.config.complete_footprints and is_static(track, self.tracker.config):
             lower, upper = complete_footprint(centre - extent / 2.0, centre + extent / 2.0, track.class_name,

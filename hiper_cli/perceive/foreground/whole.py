@@ -8,7 +8,9 @@ surface the background did not claim: a wall, a floor, a furniture side.
 
 A blob inside the image may still be cut by something nearer: a bed seen through a doorway, a
 couch behind a chair (``occluded``). Its outline then borders nearer surfaces; an object seen
-whole borders only farther ones, or what it stands on.
+whole borders only farther ones, or what it stands on. A blob whose top borders a nearer
+surface (a chair's seat under a desk's top) does not show how tall its object is
+(``top_hidden``).
 """
 
 from __future__ import annotations
@@ -94,7 +96,7 @@ def occluded(
     return bool(nearer.sum() >= OCCLUDED_SHARE * ring.sum())
 
 
-def top_hidden(blob: Blob, depth_m: NDArray[np.float32], camera: CameraIntrinsics, pixel_step: int) -> bool:
+def top_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> bool:
     """Whether the camera did not see how high ``blob``'s object reaches: the blob reaches the
     image's top edge, or the image rows just above its box (``OCCLUDER_RING_CELLS`` samples)
     show, in ``TOP_HIDDEN_SHARE`` of its columns, something more than ``OCCLUDER_MARGIN_M``
