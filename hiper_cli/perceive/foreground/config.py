@@ -297,6 +297,10 @@ class MatchConfig(_Part):
     ``fixture_reach_m`` of the top's height). Pipes come out of walls; a round stool seen from
     above, standing free in the room, is no sink (empty: off)."""
     fixture_reach_m: float = 0.3
+    couch_or_bed: bool = True
+    """A blob a detection names ``couch`` or ``bed`` takes the other name when its tall part
+    says so (``couch_or_bed.py``): a back along a long side is a couch's, a headboard across a
+    short end a bed's (issue 17: YOLOX-Nano named a couch ``bed`` in 26 views of 27)."""
     unknown_max_extent_m: float = 1.0
     """An unmatched blob is seen *whole* (``whole.py``: evidence for an ``unknown`` instance)
     only when inside the image (not within one ``pixel_step`` of its edge: a shelf, a wall or a

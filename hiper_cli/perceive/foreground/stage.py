@@ -31,6 +31,7 @@ from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.carried import drop_carried
 from hiper_cli.perceive.foreground.classes import filter_classes
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.moving import is_static
@@ -195,6 +196,17 @@ class ForegroundStage:
                 )
         return True
 
+    def _couch_or_bed(self, match: Match, blob: Blob) -> Match:
+        """``match`` renamed to the other of couch and bed when the blob's tall part says so
+        (``couch_or_bed.py``) and that class is one the stage names."""
+        cfg = self.config
+        told = couch_or_bed(blob.points_map, self._floor_z_m)
+        if told is None or told == match.class_name or told in cfg.exclude_classes or (
+            cfg.classes and told not in cfg.classes
+        ):
+            return match
+        return Match(told, match.score, match.detection_index, match.iou)
+
     def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
         above the floor: people stand on it, and even behind a counter their visible part
@@ -318,6 +330,8 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         for blob, match in zip(blobs, matches, strict=True):
+            if cfg.couch_or_bed and match.class_name in (COUCH, BED):
+                match = self._couch_or_bed(match, blob)
             flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
             longest = None
             if match.detection_index is not None and cfg.class_sizes:
