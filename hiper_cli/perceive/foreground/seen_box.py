@@ -17,7 +17,9 @@ bed), the union is of the named ones only.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -79,35 +81,29 @@ class SeenBox:
     def __len__(self) -> int:
         return len(self.lower_m)
 
-    def _boxes(self) -> tuple[FloatArray, FloatArray]:
-        """(lower, upper) corners (K, 3) of the latest ``MAX_SEEN_BOXES`` blobs, of the named
-        ones alone when there are ``MIN_NAMED_BOXES`` of them."""
+    def _used(self, per_blob: Sequence[Any]) -> NDArray[Any]:
+        """``per_blob`` (one value per blob) of the blobs the box is of: the latest
+        ``MAX_SEEN_BOXES``, the named ones alone when there are ``MIN_NAMED_BOXES`` of them."""
         start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
-        lower, upper = np.array(self.lower_m[start:]), np.array(self.upper_m[start:])
+        values = np.array(per_blob[start:])
         named = np.array(self.named[start:], dtype=bool)
-        if int(named.sum()) >= MIN_NAMED_BOXES:
-            return lower[named], upper[named]
-        return lower, upper
+        return values[named] if int(named.sum()) >= MIN_NAMED_BOXES else values
+
+    def _boxes(self) -> tuple[FloatArray, FloatArray]:
+        """(lower, upper) corners (K, 3) of the blobs the box is of (``_used``)."""
+        return self._used(self.lower_m), self._used(self.upper_m)
 
     def viewpoint(self) -> FloatArray | None:
-        """The median camera position (map frame) of the blobs the box is of (the named ones
-        when there are ``MIN_NAMED_BOXES``); None when no blob had one."""
-        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
-        views = np.array(self.viewpoints_m[start:], dtype=np.float64).reshape(-1, 3)
-        named = np.array(self.named[start:], dtype=bool)
-        if int(named.sum()) >= MIN_NAMED_BOXES:
-            views = views[named]
+        """The median camera position (map frame) of the blobs the box is of (``_used``); None
+        when no blob had one."""
+        views = self._used(self.viewpoints_m).astype(np.float64).reshape(-1, 3)
         views = views[np.isfinite(views).all(axis=1)]
         return np.median(views, axis=0) if len(views) else None
 
     def top_seen(self) -> bool:
         """Whether views showed the object's top: at least ``SEEN_BOX_QUANTILE`` of the blobs
-        the box is of (as ``viewpoint``), as many as its upper quantile needs, had it in view."""
-        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
-        hidden = np.array(self.tops_hidden[start:], dtype=bool)
-        named = np.array(self.named[start:], dtype=bool)
-        if int(named.sum()) >= MIN_NAMED_BOXES:
-            hidden = hidden[named]
+        the box is of (``_used``), as many as its upper quantile needs, had it in view."""
+        hidden = self._used(self.tops_hidden).astype(bool)
         return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
 
     def moved(self) -> bool:

@@ -266,8 +266,7 @@ class ForegroundStage:
         self._refresh_priors(world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
-        walls = [inst.box for inst in world.background.values() if inst.class_name == "wall"]
-        self._walls = walls
+        walls = self._walls = _wall_boxes(world)
         tops = support_boxes(inst for inst in world.background.values() if inst.class_name == "table")
         self._floor_z_m = floor_height_m(world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
@@ -422,7 +421,7 @@ class ForegroundStage:
             self._pool.shutdown(wait=True)
             self._pool = None
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
-        self._walls = [inst.box for inst in world.background.values() if inst.class_name == "wall"]
+        self._walls = _wall_boxes(world)
         return FrameResult(instances=[self._instance(t) for t in closed], deleted_instances=gone)
 
     # --- conversions ------------------------------------------------------------------------
@@ -533,6 +532,10 @@ class ForegroundStage:
             return np.asarray(ok & ~occluded)
 
         return visible
+
+
+def _wall_boxes(world: World) -> list[Box3D]:
+    return [inst.box for inst in world.background.values() if inst.class_name == "wall"]
 
 
 def _corners(blob: Blob) -> tuple[FloatArray, FloatArray]:
