@@ -473,6 +473,11 @@ class TrackerConfig(_Part):
     whose top no view showed is raised to its class's least height (``amodal.py``; issue 17: a
     bed seen through a doorway as a strip of its side, its centre 0.54 m off; chairs behind a
     desk kept up to the seat)."""
+    reidentify: bool = True
+    """At the end of a session, a static object of a class that stays put whose box overlaps an
+    earlier session's instance of its class (``stitch_min_overlap``, ``stitch_overlap_m``) joins
+    that instance (``reidentify.py``): a second log of one place, or ``perceive --again``, gave
+    every chair and bed a second instance."""
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving (a
     named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its

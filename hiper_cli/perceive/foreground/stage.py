@@ -37,6 +37,7 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.moving import is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
+from hiper_cli.perceive.foreground.reidentify import fold, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
@@ -415,6 +416,7 @@ class ForegroundStage:
                            timings_s=timings)
 
     def finish(self, world: World) -> FrameResult:
+        tracks = [*self.tracker.tracks, *self.tracker.dormant]
         closed = self.tracker.close_all()
         self._ahead.clear()
         if self._pool is not None:
@@ -422,7 +424,29 @@ class ForegroundStage:
             self._pool = None
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
         self._walls = _wall_boxes(world)
-        return FrameResult(instances=[self._instance(t) for t in closed], deleted_instances=gone)
+        instances = [self._instance(t) for t in closed]
+        if self.config.reidentify:
+            static = {t.uuid for t in tracks if t.confirmed and is_static(t, self.tracker.config)}
+            earlier, absorbed = self._reidentify(world, static)
+            instances = [i for i in instances if i.uuid not in absorbed] + earlier
+            gone += absorbed
+        return FrameResult(instances=instances, deleted_instances=gone)
+
+    def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str]]:
+        """Earlier sessions' instances that absorbed one of this session's static ones
+        (``reidentify.py``), and the uuids of those absorbed."""
+        cfg = self.tracker.config
+
+        def stays(inst: Instance) -> bool:
+            return inst.class_name not in cfg.walker_classes and inst.state == "static"
+
+        earlier = [i for u, i in world.foreground.items() if u not in self._instances and stays(i)]
+        new = [i for u, i in self._instances.items() if u in static and stays(i)]
+        found = pairs(new, earlier, min_share=cfg.stitch_min_overlap, max_gap_m=cfg.stitch_overlap_m)
+        for old, absorbed in found:
+            fold(old, absorbed)
+            del self._instances[absorbed.uuid]
+        return [old for old, _ in found], [absorbed.uuid for _, absorbed in found]
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:

@@ -1,0 +1,84 @@
+"""Re-identification across sessions: a static object this session tracked is the instance an
+earlier session of the environment made of it, when their boxes say so.
+
+Within a session, stitching keeps one instance per object (``stitch.py``). A second log of the
+same place (or ``perceive --again``) starts with no tracks, so without this every chair would
+get a second instance and "how many chairs" would double. At the end of the session each
+static instance of a known, non-walking class is paired with an earlier one of its class whose
+box's footprint overlaps it by ``stitch_min_overlap`` of the smaller footprint (of the larger
+for ``unknown``), at most ``stitch_overlap_m`` apart vertically: the rule that joins a static
+track seen again within a session. Pairs are taken best overlap first, one to one; the earlier
+instance absorbs the new one (``fold``) and keeps its uuid. An object that moved between the
+sessions keeps both instances; people are never paired (nothing in a box tells two apart).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+
+from hiper_cli.model import ROW_STAMP, Box3D, Instance
+
+__all__ = ["fold", "footprint_share", "pairs"]
+
+UNKNOWN = "unknown"
+
+
+def footprint_share(a: Box3D, b: Box3D, *, max_gap_m: float, larger: bool = False) -> float:
+    """The share of the smaller (``larger``: the larger) footprint of ``a`` and ``b`` their
+    footprints have in common; 0 when they lie more than ``max_gap_m`` apart vertically."""
+    (lo_a, hi_a), (lo_b, hi_b) = a.aabb(), b.aabb()
+    lo, hi = np.maximum(lo_a, lo_b), np.minimum(hi_a, hi_b)
+    if float(lo[2] - hi[2]) > max_gap_m:
+        return 0.0
+    common = float(np.prod(np.maximum(hi[:2] - lo[:2], 0.0)))
+    areas = sorted((float(np.prod((hi_a - lo_a)[:2])), float(np.prod((hi_b - lo_b)[:2]))))
+    return common / max(areas[1] if larger else areas[0], 1e-9)
+
+
+def pairs(
+    new: Iterable[Instance],
+    earlier: Iterable[Instance],
+    *,
+    min_share: float,
+    max_gap_m: float,
+) -> list[tuple[Instance, Instance]]:
+    """(earlier, new) pairs of one object: same class, footprints overlapping by at least
+    ``min_share`` (``footprint_share``), best overlap first, each instance in one pair at most.
+    The caller passes only static instances of classes that stay put."""
+    candidates = []
+    earlier = list(earlier)
+    for n in new:
+        for e in earlier:
+            if e.class_name != n.class_name or e.uuid == n.uuid:
+                continue
+            share = footprint_share(n.box, e.box, max_gap_m=max_gap_m, larger=n.class_name == UNKNOWN)
+            if share >= min_share:
+                candidates.append((-share, e.uuid, n.uuid, e, n))
+    out: list[tuple[Instance, Instance]] = []
+    used: set[str] = set()
+    for _, e_uuid, n_uuid, e, n in sorted(candidates, key=lambda c: c[:3]):
+        if e_uuid not in used and n_uuid not in used:
+            used.update((e_uuid, n_uuid))
+            out.append((e, n))
+    return out
+
+
+def fold(earlier: Instance, new: Instance) -> Instance:
+    """``earlier`` with ``new`` absorbed (in place, and returned): its observations appended, its
+    trajectory rows merged in time, the seen span widened, and the box and class confidence of
+    the one seen last (the memory says where the object is now: a bed pushed half a metre
+    between two visits is where the later visit saw it)."""
+    known = set(earlier.observation_uuids)
+    earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
+    if new.last_seen_s >= earlier.last_seen_s:
+        earlier.box, earlier.confidence = new.box, new.confidence
+    earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
+    earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
+    earlier.state = "static"
+    rows: Sequence[list[float]] = [*(earlier.data.get("trajectory") or []),
+                                   *(new.data.get("trajectory") or [])]
+    earlier.data["trajectory"] = sorted(rows, key=lambda r: r[ROW_STAMP])
+    earlier.data["closed"] = True
+    return earlier
