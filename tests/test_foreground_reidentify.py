@@ -87,6 +87,8 @@ def test_fold_keeps_the_earlier_uuid_and_the_box_seen_last():
     assert [r[0] for r in out.data["trajectory"]] == [5.0, 10.0, 20.0, 30.0]
     older_log = _inst("bed", [1.0, 0.0, 0.0], [3.0, 1.0, 0.6], t=(0.0, 4.0))  # a log of an earlier day
     assert np.allclose(fold(out, older_log).box.aabb()[0], [0.4, 0.0, 0.0])
+    same_clock = _inst("bed", [0.6, 0.0, 0.0], [2.6, 1.0, 0.6], t=(1.0, 12.0))  # stamps from 0 again
+    assert np.allclose(fold(out, same_clock).box.aabb()[0], [0.6, 0.0, 0.0])
 
 
 def _foreground_counts(kb_path: Path) -> Counter[str]:
@@ -115,3 +117,38 @@ def test_a_second_session_of_one_log_keeps_one_instance_per_static_object(tmp_pa
         assert twice == once
     else:  # the switch off: what perceive --again did before
         assert twice == once + once
+
+
+def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str) -> tuple[str, str]:
+    """Move the first session's chair by ``shift_chair_m`` (as if it had stood there) and add an
+    instance of class ``add`` where the chair now seems to have been; their uuids."""
+    with open_kb(kb_path) as kb:
+        (chair,) = [i for i in kb.instances(layer="foreground") if i.class_name == "chair"]
+        moved = chair.to_dict()
+        moved["box"]["center_m"][0] += shift_chair_m[0]
+        moved["box"]["center_m"][1] += shift_chair_m[1]
+        other = Instance(layer="foreground", class_name=add, box=Box3D.from_dict(moved["box"]),
+                         first_seen_s=chair.first_seen_s, last_seen_s=chair.last_seen_s)
+        kb.put_documents([moved, other.to_dict()], env_uuid=kb.environment("house_small").uuid)
+        kb.sync_graph()
+    return chair.uuid, other.uuid
+
+
+def test_a_chair_that_moved_keeps_its_instance_and_an_empty_place_is_vacated(tmp_path):
+    """The fixture's chair stood 1 m further along x in the first session (the place this
+    session sees empty): one chair, the first session's uuid, this session's box; a couch the
+    first session left there is marked vacated, and "how many couches" says none."""
+    from hiper_cli.query import ask
+
+    kb_path = tmp_path / "kb.hiper"
+    _run(kb_path, again=False)
+    chair_uuid, couch_uuid = _edit_earlier(kb_path, (1.0, 0.0), add="couch")
+    _run(kb_path, again=True)
+    with open_kb(kb_path) as kb:
+        chairs = [i for i in kb.instances(layer="foreground") if i.class_name == "chair"]
+        couch = kb.instance(couch_uuid)
+        assert [c.uuid for c in chairs] == [chair_uuid]
+        assert chairs[0].box.center_m[0] == pytest.approx(2.1, abs=0.1)  # where it stands now
+        assert couch is not None and couch.data["vacated_s"] >= couch.last_seen_s
+        assert ask(kb, "how many couches").count == 0
+        assert ask(kb, "how many chairs").count == 1

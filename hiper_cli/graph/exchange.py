@@ -223,6 +223,7 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
             "confidence": d.get("confidence"),
             "observation_count": len(d.get("observation_uuids", [])),
             "speed_mps": speed_mps(d),
+            "vacated_s": (d.get("data") or {}).get("vacated_s"),
             **({"observation_uuids": d["observation_uuids"]} if observations else {}),
             "data": d.get("data", {}) if observations else None,
         })
@@ -261,7 +262,8 @@ def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]
             "state": i.get("state") or "static",
             "confidence": 1.0 if i.get("confidence") is None else i["confidence"],
             "observation_uuids": i.get("observation_uuids", []), "frame_id": i.get("frame", "map"),
-            "data": i.get("data") or {},
+            "data": {**(i.get("data") or {}),
+                     **({"vacated_s": i["vacated_s"]} if i.get("vacated_s") is not None else {})},
         }))
     for k, a in enumerate(data.get("analyses", [])):
         out.append((f"analyses[{k}]", {**a, "type": "analysis"}))
@@ -313,7 +315,8 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, 
                 "first_seen_s": float(one(p, "firstSeenS", 0.0)),
                 "last_seen_s": float(one(p, "lastSeenS", 0.0)),
                 "state": one(p, "state", "static"), "confidence": float(one(p, "confidence", 1.0)),
-                "observation_uuids": links.get(iri, []), "frame_id": one(p, "frame", "map"), "data": {},
+                "observation_uuids": links.get(iri, []), "frame_id": one(p, "frame", "map"),
+                "data": {} if one(p, "vacatedS") is None else {"vacated_s": float(one(p, "vacatedS"))},
                 **({"env_uuid": env.removeprefix("urn:uuid:")} if env else {}),
             })
         elif kind == "Analysis":

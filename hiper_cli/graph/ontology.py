@@ -149,6 +149,9 @@ def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[
         speed = speed_mps(doc)
         if speed is not None:
             t.append((h("speedMps"), _dbl(speed)))
+        vacated = (doc.get("data") or {}).get("vacated_s")
+        if vacated is not None:
+            t.append((h("vacatedS"), _dbl(vacated)))
         if doc.get("env_uuid"):
             t.append((h("inEnvironment"), node(doc["env_uuid"])))
     elif kind == "analysis":

@@ -25,6 +25,7 @@ class ClassCount:
     count: int
     first_seen_s: float
     last_seen_s: float
+    vacated: int = 0  # of ``count``: those whose place a later session saw empty
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -33,6 +34,7 @@ class ClassCount:
             "count": self.count,
             "first_seen_s": self.first_seen_s,
             "last_seen_s": self.last_seen_s,
+            "vacated": self.vacated,
         }
 
 
@@ -59,7 +61,8 @@ class Description:
                 f"Time span {iso_time(t0)} .. {iso_time(t1)} ({t1 - t0:.0f} s); now {iso_time(self.now_s)}."
             )
         for layer in ("background", "foreground"):
-            parts = [f"{c.count} {c.class_name}" for c in self.classes if c.layer == layer]
+            parts = [f"{c.count} {c.class_name}" + (f" ({c.vacated} vacated)" if c.vacated else "")
+                     for c in self.classes if c.layer == layer]
             lines.append(f"{layer.capitalize()}: {', '.join(parts) if parts else 'nothing'}.")
         if self.movers:
             lines.append(
@@ -125,7 +128,8 @@ def describe(kb: KnowledgeBase, *, now_s: float | None = None, recent_s: float =
         sorted(
             (
                 ClassCount(
-                    layer, name, len(rows), float(idx.first_s[rows].min()), float(idx.last_s[rows].max())
+                    layer, name, len(rows), float(idx.first_s[rows].min()), float(idx.last_s[rows].max()),
+                    int(np.isfinite(idx.vacated_s[rows]).sum()),
                 )
                 for (layer, name), rows in groups.items()
             ),

@@ -121,10 +121,12 @@ class Candidates:
 
 def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
     """The instances passing the non-spatial filters of ``spec`` (class, layer, state, time
-    window, confidence)."""
+    window, confidence). An instance whose place a later session saw empty (``vacated_s``)
+    was there until then: a window starting (or, without a start, ending) later leaves it out."""
     idx = ctx.index
     until = spec.until_s if spec.until_s is not None else ctx.now_s
     mask = (idx.first_s <= until) & (idx.confidence >= spec.min_confidence)
+    mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
     if spec.since_s is not None:
         mask &= idx.last_s >= spec.since_s
     if spec.classes:

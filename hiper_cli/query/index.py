@@ -30,7 +30,8 @@ _LOCK = threading.Lock()
 @dataclass(frozen=True)
 class InstanceIndex:
     """One row per instance: uuid, class, layer, state, first/last seen (s), confidence, box
-    centre and extent (m, map frame), observation count, mean speed (m/s, NaN when none)."""
+    centre and extent (m, map frame), observation count, mean speed (m/s, NaN when none), and
+    when a later session saw its place empty (s, inf when none: ``vacated.py``)."""
 
     uuids: tuple[str, ...]
     classes: NDArray[Any]
@@ -43,6 +44,7 @@ class InstanceIndex:
     extents: NDArray[np.float64]
     counts: NDArray[np.int64]
     speeds: NDArray[np.float64]
+    vacated_s: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.uuids)
@@ -87,6 +89,9 @@ class InstanceIndex:
             counts=np.array(col("count"), dtype=np.int64),
             speeds=np.array(
                 [float(r["speed"].value) if "speed" in r else np.nan for r in rows], dtype=np.float64
+            ),
+            vacated_s=np.array(
+                [float(r["vacated"].value) if "vacated" in r else np.inf for r in rows], dtype=np.float64
             ),
         )
 

@@ -477,7 +477,11 @@ class TrackerConfig(_Part):
     """At the end of a session, a static object of a class that stays put whose box overlaps an
     earlier session's instance of its class (``stitch_min_overlap``, ``stitch_overlap_m``) joins
     that instance (``reidentify.py``): a second log of one place, or ``perceive --again``, gave
-    every chair and bed a second instance."""
+    every chair and bed a second instance. An earlier instance whose place this session saw
+    empty (``vacated.py``) joins the nearest new instance of its class that no earlier one
+    took, within ``reidentify_moved_m`` (the object moved); unpaired, it is marked vacated
+    (``data["vacated_s"]``: the first stamp its place was seen empty)."""
+    reidentify_moved_m: float = 3.0
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving (a
     named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its
@@ -549,7 +553,8 @@ class TrackerConfig(_Part):
         _as_tuples(self, ("search_classes", "walker_classes", "search_same_class"))
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m",
-                            "stitch_pace_factor", "stitch_min_pace_mps", "search_max_footprint_m"))
+                            "stitch_pace_factor", "stitch_min_pace_mps", "search_max_footprint_m",
+                            "reidentify_moved_m"))
         _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance"))
 
 

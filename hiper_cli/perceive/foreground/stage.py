@@ -37,7 +37,7 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.moving import is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.reidentify import fold, pairs
+from hiper_cli.perceive.foreground.reidentify import fold, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
@@ -49,6 +49,7 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     table_match,
     withdraw_mapped,
 )
+from hiper_cli.perceive.foreground.vacated import EmptyPlaces
 from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole, top_hidden
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
@@ -141,6 +142,7 @@ class ForegroundStage:
         self.tracker = Tracker(cfg, self._class_prior)
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
+        self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
 
     # --- learned priors ---------------------------------------------------------------------
     def _refresh_priors(self, world: World) -> None:
@@ -265,6 +267,8 @@ class ForegroundStage:
         elif cfg.detector_threads:
             future = self._submit(frame)
         self._refresh_priors(world)
+        if cfg.reidentify:
+            self._look_for_earlier(frame, world)
         boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
         supports = support_boxes(world.background.values())
         walls = self._walls = _wall_boxes(world)
@@ -432,21 +436,38 @@ class ForegroundStage:
             gone += absorbed
         return FrameResult(instances=instances, deleted_instances=gone)
 
+    def _stays(self, inst: Instance) -> bool:
+        return inst.class_name not in self.tracker.config.walker_classes and inst.state == "static"
+
+    def _look_for_earlier(self, frame: Frame, world: World) -> None:
+        """Whether this frame saw the places of earlier sessions' static objects empty."""
+        if self._empty is None:  # the first frame: the world holds earlier sessions' instances only
+            self._empty = EmptyPlaces([i for i in world.foreground.values() if self._stays(i)])
+        if self._empty.uuids:
+            self._empty.look(self._projector(frame), frame.T_map_cam[:3, 3], frame.stamp_s)
+
     def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str]]:
-        """Earlier sessions' instances that absorbed one of this session's static ones
-        (``reidentify.py``), and the uuids of those absorbed."""
-        cfg = self.tracker.config
-
-        def stays(inst: Instance) -> bool:
-            return inst.class_name not in cfg.walker_classes and inst.state == "static"
-
-        earlier = [i for u, i in world.foreground.items() if u not in self._instances and stays(i)]
-        new = [i for u, i in self._instances.items() if u in static and stays(i)]
-        found = pairs(new, earlier, min_share=cfg.stitch_min_overlap, max_gap_m=cfg.stitch_overlap_m)
+        """Earlier sessions' instances that absorbed one of this session's static ones, or
+        whose place this session saw empty (``reidentify.py``, ``vacated.py``), and the uuids
+        of the instances absorbed."""
+        cfg = self.config
+        earlier = {u: i for u, i in world.foreground.items() if u not in self._instances and self._stays(i)}
+        new = [i for u, i in self._instances.items() if u in static and self._stays(i)]
+        found = pairs(new, earlier.values(), min_share=cfg.stitch_min_overlap, max_gap_m=cfg.stitch_overlap_m)
+        paired = {u for e, n in found for u in (e.uuid, n.uuid)}
+        vacated = self._empty.vacated() if self._empty is not None else {}
+        gone = [earlier[u] for u in vacated if u in earlier and u not in paired]
+        found += moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
         for old, absorbed in found:
             fold(old, absorbed)
             del self._instances[absorbed.uuid]
-        return [old for old, _ in found], [absorbed.uuid for _, absorbed in found]
+        moved = {old.uuid for old, _ in found}
+        for inst in gone:
+            if inst.uuid not in moved:
+                # never before it was last seen (logs whose stamps all start at 0 overlap in time)
+                inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
+        updated = [old for old, _ in found] + [i for i in gone if i.uuid not in moved]
+        return updated, [absorbed.uuid for _, absorbed in found]
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
