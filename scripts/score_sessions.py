@@ -58,7 +58,8 @@ def main(export: Path, logs: list[Path]) -> None:
     union: list[dict] = []
     for log in logs:  # an object at one place in two logs is one object
         for obj in _objects(log):
-            same = [o for o in union if o["cls"] == obj["cls"] and np.linalg.norm(o["centre"] - obj["centre"]) < 0.1]
+            same = [o for o in union
+                    if o["cls"] == obj["cls"] and np.linalg.norm(o["centre"] - obj["centre"]) < 0.1]
             if not same:
                 union.append(obj)
     matched, near = _match(insts, union)
