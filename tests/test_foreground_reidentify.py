@@ -88,7 +88,9 @@ def test_fold_keeps_the_earlier_uuid_and_the_box_seen_last():
     older_log = _inst("bed", [1.0, 0.0, 0.0], [3.0, 1.0, 0.6], t=(0.0, 4.0))  # a log of an earlier day
     assert np.allclose(fold(out, older_log).box.aabb()[0], [0.4, 0.0, 0.0])
     same_clock = _inst("bed", [0.6, 0.0, 0.0], [2.6, 1.0, 0.6], t=(1.0, 12.0))  # stamps from 0 again
+    out.data["vacated_s"] = 31.0  # a session had seen its place empty
     assert np.allclose(fold(out, same_clock).box.aabb()[0], [0.6, 0.0, 0.0])
+    assert "vacated_s" not in out.data
 
 
 def _foreground_counts(kb_path: Path) -> Counter[str]:
@@ -119,14 +121,18 @@ def test_a_second_session_of_one_log_keeps_one_instance_per_static_object(tmp_pa
         assert twice == once + once
 
 
-def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str) -> tuple[str, str]:
-    """Move the first session's chair by ``shift_chair_m`` (as if it had stood there) and add an
-    instance of class ``add`` where the chair now seems to have been; their uuids."""
+def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str,
+                  vacated_s: float | None = None) -> tuple[str, str]:
+    """Move the first session's chair by ``shift_chair_m`` (as if it had stood there; marked
+    vacated at ``vacated_s``) and add an instance of class ``add`` where the chair now seems to
+    have been; their uuids."""
     with open_kb(kb_path) as kb:
         (chair,) = [i for i in kb.instances(layer="foreground") if i.class_name == "chair"]
         moved = chair.to_dict()
         moved["box"]["center_m"][0] += shift_chair_m[0]
         moved["box"]["center_m"][1] += shift_chair_m[1]
+        if vacated_s is not None:
+            moved["data"]["vacated_s"] = vacated_s
         other = Instance(layer="foreground", class_name=add, box=Box3D.from_dict(moved["box"]),
                          first_seen_s=chair.first_seen_s, last_seen_s=chair.last_seen_s)
         kb.put_documents([moved, other.to_dict()], env_uuid=kb.environment("house_small").uuid)
@@ -152,3 +158,16 @@ def test_a_chair_that_moved_keeps_its_instance_and_an_empty_place_is_vacated(tmp
         assert couch is not None and couch.data["vacated_s"] >= couch.last_seen_s
         assert ask(kb, "how many couches").count == 0
         assert ask(kb, "how many chairs").count == 1
+
+
+def test_a_chair_an_earlier_session_found_gone_is_found_again_where_it_stands(tmp_path):
+    """The chair was marked vacated by some session, at a place this one cannot see (behind
+    the table): it is the chair this session finds, and no longer vacated."""
+    kb_path = tmp_path / "kb.hiper"
+    _run(kb_path, again=False)
+    chair_uuid, _ = _edit_earlier(kb_path, (-1.0, 0.0), add="bottle", vacated_s=5.0)
+    _run(kb_path, again=True)
+    with open_kb(kb_path) as kb:
+        (chair,) = [i for i in kb.instances(layer="foreground") if i.class_name == "chair"]
+    assert chair.uuid == chair_uuid and "vacated_s" not in chair.data
+    assert chair.box.center_m[0] == pytest.approx(2.1, abs=0.1)

@@ -456,18 +456,18 @@ class ForegroundStage:
         found = pairs(new, earlier.values(), min_share=cfg.stitch_min_overlap, max_gap_m=cfg.stitch_overlap_m)
         paired = {u for e, n in found for u in (e.uuid, n.uuid)}
         vacated = self._empty.vacated() if self._empty is not None else {}
-        gone = [earlier[u] for u in vacated if u in earlier and u not in paired]
+        # seen empty now, or by an earlier session: gone from where it was
+        gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
         found += moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
         for old, absorbed in found:
             fold(old, absorbed)
             del self._instances[absorbed.uuid]
         moved = {old.uuid for old, _ in found}
-        for inst in gone:
-            if inst.uuid not in moved:
-                # never before it was last seen (logs whose stamps all start at 0 overlap in time)
-                inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
-        updated = [old for old, _ in found] + [i for i in gone if i.uuid not in moved]
-        return updated, [absorbed.uuid for _, absorbed in found]
+        marked = [i for i in gone if i.uuid not in moved and "vacated_s" not in i.data]
+        for inst in marked:
+            # never before it was last seen (logs whose stamps all start at 0 overlap in time)
+            inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
+        return [old for old, _ in found] + marked, [absorbed.uuid for _, absorbed in found]
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
