@@ -12,8 +12,9 @@ import pytest
 
 from hiper_cli.graph import open_kb
 from hiper_cli.model import Box3D, Instance
-from hiper_cli.perceive.foreground.reidentify import fold, footprint_share, pairs
+from hiper_cli.perceive.foreground.reidentify import fold, pairs
 from hiper_cli.perceive.foreground.stage import ForegroundStage
+from hiper_cli.perceive.foreground.stitch import footprint_share
 from hiper_cli.perceive.logs import open_log
 from hiper_cli.pipeline import PerceiveOptions, perceive
 
@@ -33,13 +34,13 @@ def _pairs(new, earlier):
 
 
 def test_footprint_share_is_of_the_smaller_footprint_and_nothing_when_stacked():
-    chair = Box3D([0.0, 0.0, 0.45], [0.5, 0.5, 0.9])
-    shifted = Box3D([0.25, 0.0, 0.45], [0.5, 0.5, 0.9])
+    chair = Box3D([0.0, 0.0, 0.45], [0.5, 0.5, 0.9]).aabb()
+    shifted = Box3D([0.25, 0.0, 0.45], [0.5, 0.5, 0.9]).aabb()
     assert footprint_share(chair, shifted, max_gap_m=GAP_M) == pytest.approx(0.5)
-    big = Box3D([0.0, 0.0, 0.45], [2.0, 2.0, 0.9])
+    big = Box3D([0.0, 0.0, 0.45], [2.0, 2.0, 0.9]).aabb()
     assert footprint_share(chair, big, max_gap_m=GAP_M) == pytest.approx(1.0)
     assert footprint_share(chair, big, max_gap_m=GAP_M, larger=True) == pytest.approx(0.0625)
-    shelf_above = Box3D([0.0, 0.0, 1.6], [0.5, 0.5, 0.2])  # 0.6 m above the chair's top
+    shelf_above = Box3D([0.0, 0.0, 1.6], [0.5, 0.5, 0.2]).aabb()  # 0.6 m above the chair's top
     assert footprint_share(chair, shelf_above, max_gap_m=GAP_M) == 0.0
 
 

@@ -308,7 +308,7 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, 
                 "instance_uuid": None, "data": {},
             })
         elif kind == "Instance":
-            env = one(p, "inEnvironment")
+            env, vacated = one(p, "inEnvironment"), one(p, "vacatedS")
             out.append({
                 "uuid": uuid, "type": "instance", "layer": layer, "class": one(p, "className"),
                 "box": {"center_m": _vec(one(p, "boxCenterM")), "extent_m": _vec(one(p, "boxExtentM"))},
@@ -316,7 +316,7 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, 
                 "last_seen_s": float(one(p, "lastSeenS", 0.0)),
                 "state": one(p, "state", "static"), "confidence": float(one(p, "confidence", 1.0)),
                 "observation_uuids": links.get(iri, []), "frame_id": one(p, "frame", "map"),
-                "data": {} if one(p, "vacatedS") is None else {"vacated_s": float(one(p, "vacatedS"))},
+                "data": {} if vacated is None else {"vacated_s": float(vacated)},
                 **({"env_uuid": env.removeprefix("urn:uuid:")} if env else {}),
             })
         elif kind == "Analysis":

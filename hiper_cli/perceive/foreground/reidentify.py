@@ -22,23 +22,12 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from hiper_cli.model import ROW_STAMP, Box3D, Instance
+from hiper_cli.model import ROW_STAMP, Instance
+from hiper_cli.perceive.foreground.stitch import footprint_share
 
-__all__ = ["fold", "footprint_share", "moved_pairs", "pairs"]
+__all__ = ["fold", "moved_pairs", "pairs"]
 
 UNKNOWN = "unknown"
-
-
-def footprint_share(a: Box3D, b: Box3D, *, max_gap_m: float, larger: bool = False) -> float:
-    """The share of the smaller (``larger``: the larger) footprint of ``a`` and ``b`` their
-    footprints have in common; 0 when they lie more than ``max_gap_m`` apart vertically."""
-    (lo_a, hi_a), (lo_b, hi_b) = a.aabb(), b.aabb()
-    lo, hi = np.maximum(lo_a, lo_b), np.minimum(hi_a, hi_b)
-    if float(lo[2] - hi[2]) > max_gap_m:
-        return 0.0
-    common = float(np.prod(np.maximum(hi[:2] - lo[:2], 0.0)))
-    areas = sorted((float(np.prod((hi_a - lo_a)[:2])), float(np.prod((hi_b - lo_b)[:2]))))
-    return common / max(areas[1] if larger else areas[0], 1e-9)
 
 
 def pairs(
@@ -53,7 +42,8 @@ def pairs(
     The caller passes only static instances of classes that stay put."""
 
     def cost(e: Instance, n: Instance) -> float | None:
-        share = footprint_share(n.box, e.box, max_gap_m=max_gap_m, larger=n.class_name == UNKNOWN)
+        share = footprint_share(n.box.aabb(), e.box.aabb(), max_gap_m=max_gap_m,
+                                larger=n.class_name == UNKNOWN)
         return -share if share >= min_share else None
 
     return _one_to_one(new, earlier, cost)

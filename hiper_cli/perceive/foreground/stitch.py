@@ -38,7 +38,7 @@ if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "find_target", "gap_ok",
+__all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "find_target", "footprint_share", "gap_ok",
            "provisional_class", "stale_rows"]
 
 FloatArray = NDArray[np.float64]
@@ -200,17 +200,26 @@ def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     box_new, box_old = new.seen.box(), old.seen.box()
     c_new, e_new = box_new if box_new is not None else (new.position, new.extent_m)
     c_old, e_old = box_old if box_old is not None else (old.position, old.extent_m)
-    lo = np.maximum(c_new - e_new / 2.0, c_old - e_old / 2.0)
-    hi = np.minimum(c_new + e_new / 2.0, c_old + e_old / 2.0)
-    if float(lo[2] - hi[2]) > config.stitch_overlap_m:
-        return None
-    common = float(np.prod(np.maximum(hi[:2] - lo[:2], 0.0)))
-    areas = sorted((float(np.prod(e_new[:2])), float(np.prod(e_old[:2]))))
-    base = areas[1] if UNKNOWN in (provisional_class(new), provisional_class(old)) else areas[0]
-    share = common / max(base, 1e-9)
+    share = footprint_share((c_new - e_new / 2.0, c_new + e_new / 2.0),
+                            (c_old - e_old / 2.0, c_old + e_old / 2.0), max_gap_m=config.stitch_overlap_m,
+                            larger=UNKNOWN in (provisional_class(new), provisional_class(old)))
     if share < config.stitch_min_overlap:
         return None
     return 1.0 - share, REVISIT
+
+
+def footprint_share(a: tuple[FloatArray, FloatArray], b: tuple[FloatArray, FloatArray], *,
+                    max_gap_m: float, larger: bool = False) -> float:
+    """The share of the smaller (``larger``: the larger) footprint of boxes ``a`` and ``b``
+    ((lower, upper) corners, map frame) their footprints have in common; 0 when the boxes lie
+    more than ``max_gap_m`` apart vertically."""
+    (lo_a, hi_a), (lo_b, hi_b) = a, b
+    lo, hi = np.maximum(lo_a, lo_b), np.minimum(hi_a, hi_b)
+    if float(lo[2] - hi[2]) > max_gap_m:
+        return 0.0
+    common = float(np.prod(np.maximum(hi[:2] - lo[:2], 0.0)))
+    areas = sorted((float(np.prod((hi_a - lo_a)[:2])), float(np.prod((hi_b - lo_b)[:2]))))
+    return common / max(areas[1] if larger else areas[0], 1e-9)
 
 
 def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
