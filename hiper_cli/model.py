@@ -407,7 +407,8 @@ class FrameResult:
     """What one stage made of one frame.
 
     ``instances`` are created or updated (upserted by uuid); ``deleted_instances`` are uuids
-    merged away. ``timings_s`` holds named durations (e.g. ``background_s``) for reports.
+    merged away. ``timings_s`` holds named durations (e.g. ``background_s``) for reports;
+    ``counts`` named counts of what the stage did (e.g. ``found_again``), summed per run.
     ``skipped`` is a reason when the stage did not process the frame (e.g. not a keyframe).
     """
 
@@ -415,6 +416,7 @@ class FrameResult:
     instances: list[Instance] = field(default_factory=list)
     deleted_instances: list[str] = field(default_factory=list)
     timings_s: dict[str, float] = field(default_factory=dict)
+    counts: dict[str, int] = field(default_factory=dict)
     skipped: str | None = None
 
     def extend(self, other: FrameResult) -> None:
@@ -422,3 +424,5 @@ class FrameResult:
         self.instances.extend(other.instances)
         self.deleted_instances.extend(other.deleted_instances)
         self.timings_s.update(other.timings_s)
+        for name, n in other.counts.items():
+            self.counts[name] = self.counts.get(name, 0) + n

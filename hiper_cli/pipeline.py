@@ -202,6 +202,9 @@ class PerceiveSummary:
     # per step (the stages' named timings, ``kb_write_s``): total seconds and frames it ran in
     step_total_s: dict[str, float] = field(default_factory=dict)
     step_frames: dict[str, int] = field(default_factory=dict)
+    # what the stages counted (``FrameResult.counts``): earlier sessions' objects found again,
+    # moved or vacated
+    counts: dict[str, int] = field(default_factory=dict)
 
     def add_steps(self, timings_s: dict[str, float]) -> None:
         """Add one frame's step timings (names ending in ``_s``; others are counts)."""
@@ -246,6 +249,7 @@ class PerceiveSummary:
             "observations": self.observations,
             "instances": self.instances,
             "deleted_instances": self.deleted_instances,
+            "earlier_sessions": {k: self.counts.get(k, 0) for k in ("found_again", "moved", "vacated")},
             "stage_mean_s": {k: round(v, 4) for k, v in self.stage_mean_s.items()},
             "graph_sync_s": round(self.graph_sync_s, 3),
             "steps": self.steps(),
@@ -371,6 +375,8 @@ def perceive(
         for obs in result.observations:
             obs_counts[(obs.layer, obs.class_name)] += 1
         summary.deleted_instances += len(result.deleted_instances)
+        for name, n in result.counts.items():
+            summary.counts[name] = summary.counts.get(name, 0) + n
         now = time.perf_counter()
         if now - last_sync >= graph_sync_s:
             t0 = time.perf_counter()

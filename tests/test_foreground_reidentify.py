@@ -102,24 +102,30 @@ def _foreground_counts(kb_path: Path) -> Counter[str]:
                        if i.class_name not in ("person", "unknown"))
 
 
-def _run(kb_path: Path, again: bool, **options) -> None:
+def _run(kb_path: Path, again: bool, **options) -> dict[str, int]:
+    """Perceive the fixture into ``kb_path``; the summary's counts of earlier sessions' objects."""
     stage = ForegroundStage(log_path=FIXTURE, detector="truth", **options)
     with open_kb(kb_path) as kb:
-        perceive(open_log(FIXTURE), kb, [stage], PerceiveOptions(on_existing="again" if again else "refuse"))
+        summary = perceive(open_log(FIXTURE), kb, [stage],
+                           PerceiveOptions(on_existing="again" if again else "refuse"))
+    return summary.to_dict()["earlier_sessions"]
 
 
 @pytest.mark.parametrize("reidentify", [True, False])
 def test_a_second_session_of_one_log_keeps_one_instance_per_static_object(tmp_path, reidentify):
     kb_path = tmp_path / "kb.hiper"
-    _run(kb_path, again=False, reidentify=reidentify)
+    first = _run(kb_path, again=False, reidentify=reidentify)
     once = _foreground_counts(kb_path)
     assert sum(once.values()) >= 2  # the fixture's chair and table, seen in its mapping phase
-    _run(kb_path, again=True, reidentify=reidentify)
+    assert first == {"found_again": 0, "moved": 0, "vacated": 0}
+    second = _run(kb_path, again=True, reidentify=reidentify)
     twice = _foreground_counts(kb_path)
     if reidentify:
         assert twice == once
+        assert second["found_again"] >= sum(once.values()) and second["moved"] == second["vacated"] == 0
     else:  # the switch off: what perceive --again did before
         assert twice == once + once
+        assert second == first
 
 
 def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str,
@@ -150,7 +156,8 @@ def test_a_chair_that_moved_keeps_its_instance_and_an_empty_place_is_vacated(tmp
     kb_path = tmp_path / "kb.hiper"
     _run(kb_path, again=False)
     chair_uuid, couch_uuid = _edit_earlier(kb_path, (1.0, 0.0), add="couch")
-    _run(kb_path, again=True)
+    second = _run(kb_path, again=True)
+    assert second["moved"] == 1 and second["vacated"] == 1
     with open_kb(kb_path) as kb:
         chairs = [i for i in kb.instances(layer="foreground") if i.class_name == "chair"]
         couch = kb.instance(couch_uuid)

@@ -29,6 +29,10 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
         f"{data['frames_per_s']:.2f} frames/s -> {data['kb']} (environment {data['environment']!r}, "
         f"session {data['session_id']})"
     )
+    again = data.get("earlier_sessions", {})
+    if any(again.values()):
+        out.print(f"earlier sessions' objects: {again['found_again']} found again "
+                  f"({again['moved']} moved), {again['vacated']} vacated")
     for name, why in data["unavailable_stages"].items():
         out.print(f"[yellow]stage {name} not run:[/] {why}")
     for item in data["skipped"][:10]:

@@ -429,12 +429,13 @@ class ForegroundStage:
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
         self._walls = _wall_boxes(world)
         instances = [self._instance(t) for t in closed]
+        counts: dict[str, int] = {}
         if self.config.reidentify:
             static = {t.uuid for t in tracks if t.confirmed and is_static(t, self.tracker.config)}
-            earlier, absorbed = self._reidentify(world, static)
+            earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
-        return FrameResult(instances=instances, deleted_instances=gone)
+        return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
 
     def _stays(self, inst: Instance) -> bool:
         return inst.class_name not in self.tracker.config.walker_classes and inst.state == "static"
@@ -446,10 +447,10 @@ class ForegroundStage:
         if self._empty.uuids:
             self._empty.look(self._projector(frame), frame.T_map_cam[:3, 3], frame.stamp_s)
 
-    def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str]]:
+    def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str], dict[str, int]]:
         """Earlier sessions' instances that absorbed one of this session's static ones, or
-        whose place this session saw empty (``reidentify.py``, ``vacated.py``), and the uuids
-        of the instances absorbed."""
+        whose place this session saw empty (``reidentify.py``, ``vacated.py``), the uuids
+        of the instances absorbed, and how many were found again, moved and vacated."""
         cfg = self.config
         earlier = {u: i for u, i in world.foreground.items() if u not in self._instances and self._stays(i)}
         new = [i for u, i in self._instances.items() if u in static and self._stays(i)]
@@ -458,16 +459,18 @@ class ForegroundStage:
         vacated = self._empty.vacated() if self._empty is not None else {}
         # seen empty now, or by an earlier session: gone from where it was
         gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
-        found += moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
+        moved = moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
+        found += moved
         for old, absorbed in found:
             fold(old, absorbed)
             del self._instances[absorbed.uuid]
-        moved = {old.uuid for old, _ in found}
-        marked = [i for i in gone if i.uuid not in moved and "vacated_s" not in i.data]
+        joined = {old.uuid for old, _ in found}
+        marked = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
         for inst in marked:
             # never before it was last seen (logs whose stamps all start at 0 overlap in time)
             inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
-        return [old for old, _ in found] + marked, [absorbed.uuid for _, absorbed in found]
+        counts = {"found_again": len(found), "moved": len(moved), "vacated": len(marked)}
+        return [old for old, _ in found] + marked, [absorbed.uuid for _, absorbed in found], counts
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
