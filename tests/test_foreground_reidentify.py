@@ -138,6 +138,9 @@ def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str,
         moved = chair.to_dict()
         moved["box"]["center_m"][0] += shift_chair_m[0]
         moved["box"]["center_m"][1] += shift_chair_m[1]
+        assert moved["data"]["surface_map"]  # the chair's observed surface moves with it
+        moved["data"]["surface_map"] = [[x + shift_chair_m[0], y + shift_chair_m[1], z]
+                                        for x, y, z in moved["data"]["surface_map"]]
         if vacated_s is not None:
             moved["data"]["vacated_s"] = vacated_s
         other = Instance(layer="foreground", class_name=add, box=Box3D.from_dict(moved["box"]),

@@ -82,3 +82,65 @@ def test_a_cup_gone_from_a_table_is_told_gone_from_the_side_not_from_above():
     above = np.array([1.2, 0.0, 2.5])
     assert _look(EmptyPlaces([_inst(*CUP, cls="cup")]), [TABLE], frames=20, camera=above) == {}
     assert _look(EmptyPlaces([_inst(*CUP, cls="cup")]), [TABLE, CUP], frames=20) == {}
+
+
+WALL = (np.array([2.5, -3.0, 0.0]), np.array([2.6, 3.0, 2.5]))  # right behind the chair's back
+TOP = (np.array([1.5, -0.6, 0.72]), np.array([2.3, 0.6, 0.75]))
+LEGS = [(np.array([x, y, 0.0]), np.array([x + 0.05, y + 0.05, 0.72]))
+        for x in (1.5, 2.25) for y in (-0.6, 0.55)]
+
+
+def _observed(lower, upper, points, cls="chair"):
+    """An earlier instance with the surface points its session observed."""
+    inst = _inst(lower, upper, cls=cls)
+    inst.data["surface_map"] = [list(map(float, p)) for p in points]
+    return inst
+
+
+def _chair_front():
+    return [(2.0, y, z) for y in (-0.2, 0.0, 0.2) for z in (0.3, 0.5, 0.7)]
+
+
+def test_a_place_against_a_wall_is_told_empty_from_the_surface_seen_there():
+    """The wall is the chair box's far side, so box rays cannot tell the chair gone; rays to
+    the chair's observed front pass on to the wall half a metre behind it."""
+    assert _look(EmptyPlaces([_inst(*CHAIR)]), [WALL], frames=20) == {}
+    chair = _observed(*CHAIR, _chair_front())
+    assert _look(EmptyPlaces([chair]), [WALL]) == {chair.uuid: 10.0}
+    places = EmptyPlaces([_observed(*CHAIR, _chair_front())])
+    assert _look(places, [WALL, CHAIR], frames=20) == {}
+    assert places.present[0] == 20
+
+
+def test_a_table_still_standing_is_not_taken_for_an_empty_place():
+    """A table's box is mostly air under its top: box rays pass under it and call it gone;
+    rays to its observed top and legs meet them."""
+    table = [TOP, *LEGS]
+    assert len(_look(EmptyPlaces([_inst(*TABLE, cls="table")]), table, frames=20)) == 1
+    seen = [(1.6, y, 0.75) for y in (-0.4, -0.1, 0.2, 0.4)] + [(1.5, -0.58, 0.3), (1.5, 0.57, 0.3)]
+    places = EmptyPlaces([_observed(*TABLE, seen, cls="table")])
+    assert _look(places, table, frames=20) == {}
+    assert places.present[0] == 20
+    gone = _observed(*TABLE, seen, cls="table")
+    assert _look(EmptyPlaces([gone]), []) == {gone.uuid: 10.0}
+
+
+def test_places_with_and_without_surfaces_are_judged_together():
+    """Each verdict from its own rays: a chair with observed points gone, another without
+    them still there beside it."""
+    beside = (CHAIR[0] + [0.0, 1.0, 0.0], CHAIR[1] + [0.0, 1.0, 0.0])
+    gone, kept = _observed(*CHAIR, _chair_front()), _inst(*beside)
+    places = EmptyPlaces([kept, gone])
+    assert _look(places, [WALL, beside], frames=5) == {gone.uuid: 10.0}
+    assert list(places.present) == [5, 0]
+
+
+def test_a_cup_gone_from_a_table_is_told_by_its_points_above_the_foot():
+    """The table returns at the depth of the cup's lowest points whether the cup is there or
+    not: those are left out, and the rest pass on to the table top behind."""
+    front = [(1.9, y, z) for y in (-0.04, 0.0, 0.04) for z in (0.75, 0.8, 0.85)]
+    cup = _observed(*CUP, front, cls="cup")
+    assert _look(EmptyPlaces([cup]), [TABLE]) == {cup.uuid: 10.0}
+    places = EmptyPlaces([_observed(*CUP, front, cls="cup")])
+    assert _look(places, [TABLE, CUP], frames=5) == {}
+    assert places.present[0] == 5

@@ -91,14 +91,16 @@ def fold(earlier: Instance, new: Instance) -> Instance:
     """``earlier`` with ``new`` absorbed (in place, and returned): its observations appended, its
     trajectory rows merged in time and the seen span widened. Unless the new sighting ended
     before the earlier one began (an older log perceived later; logs whose stamps all start at
-    0 overlap), the new one says where the object is now: its box and class confidence, and
-    no longer vacated (``vacated.py``); a bed pushed half a metre between two visits is where
-    the later visit saw it."""
+    0 overlap), the new one says where the object is now: its box, class confidence and
+    observed surface, and no longer vacated (``vacated.py``); a bed pushed half a metre
+    between two visits is where the later visit saw it."""
     known = set(earlier.observation_uuids)
     earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
     if new.last_seen_s >= earlier.first_seen_s:
         earlier.box, earlier.confidence = new.box, new.confidence
         earlier.data.pop("vacated_s", None)
+        if "surface_map" in new.data:
+            earlier.data["surface_map"] = new.data["surface_map"]
     earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
     earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
     earlier.state = "static"

@@ -40,6 +40,7 @@ from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import fold, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
+from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
@@ -143,6 +144,7 @@ class ForegroundStage:
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
+        self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
 
     # --- learned priors ---------------------------------------------------------------------
     def _refresh_priors(self, world: World) -> None:
@@ -333,6 +335,7 @@ class ForegroundStage:
             matches = detected_blobs(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
+        surfaces: list[FloatArray | None] = []  # per observation: its blob's map points, not a walker's
         for blob, match in zip(blobs, matches, strict=True):
             if cfg.couch_or_bed and match.class_name in (COUCH, BED):
                 match = self._couch_or_bed(match, blob)
@@ -359,6 +362,7 @@ class ForegroundStage:
             obs = self._observation(frame, blob, match, dets)
             walker = match.class_name in cfg.walker_classes
             observations.append(obs)
+            surfaces.append(None if walker else blob.points_map)
             measurements.append(
                 Measurement(
                     blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
@@ -377,6 +381,7 @@ class ForegroundStage:
         for blob in found_tables if cfg.unseen_table_instances else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
+            surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
         t_match = time.perf_counter()
@@ -393,9 +398,11 @@ class ForegroundStage:
             listed = {id(t) for t in changed}
             changed += [t for t in {id(t): t for t in pieces.values()}.values() if id(t) not in listed]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
-        for obs, track_uuid in zip(observations, joined, strict=True):
+        for obs, points, track_uuid in zip(observations, surfaces, joined, strict=True):
             if track_uuid in confirmed:
                 obs.instance_uuid = track_uuid
+            if points is not None and track_uuid is not None:
+                self._surfaces.add(track_uuid, points)
         instances = [self._instance(t) for t in changed]
         # a track stitched into another after it became an instance (merged away), one whose
         # evidence failed (``unknown_evidence_held``), or a table the background mapped
@@ -527,6 +534,8 @@ class ForegroundStage:
         inst.state = state  # type: ignore[assignment]
         inst.confidence = track.confidence
         inst.data["closed"] = track.closed
+        if track.closed and self._stays(inst) and (points := self._surfaces.of(track.uuid)):
+            inst.data["surface_map"] = points  # for a later session's empty-place test
         return inst
 
     def _box(self, track: Track) -> Box3D:

@@ -1,17 +1,22 @@
 """Places seen empty: an earlier session's static object whose box this session's camera saw
 through, while nothing stood in front of it, is no longer where that session left it.
 
-Each frame, rays to a few points inside each such box (its centre and four points halfway to
-its sides, at the centre's height) are followed to the depth measured at their pixels. A ray
-whose return lies beyond the far side of the box (``THROUGH_MARGIN_M``) passed through empty
-space; one whose return lies inside the box hit the object; one nearer than the box is
+Each frame, rays to points of each object are followed to the depth measured at their pixels:
+to the points of its surface the earlier session observed (``data["surface_map"]``,
+``surface_samples.py``), or, for an instance without them, to its box (its centre and four
+points halfway to its sides, at the centre's height). A ray whose return lies beyond its point
+(beyond the box's far side, for a box point) by ``THROUGH_MARGIN_M`` passed through empty
+space; one whose return lies at the point (within the box) hit the object; one nearer is
 occluded and says nothing. A frame where most of a box's usable rays passed through counts
 as empty, one where half of them hit counts as present. A box empty in ``MIN_EMPTY_FRAMES``
 frames, and in more frames than present, was vacated.
 
-Seen from above, the surface under a cup is the far side of the cup's box, and no ray passes
-through it: such a place is told empty only from a view low enough for rays to pass the box's
-far side above the surface. Something standing on the floor is, from a robot's camera height.
+A surface point lets a ray tell an object gone from in front of a wall, or a cup gone from a
+table seen from above, when the wall or table lies ``THROUGH_MARGIN_M`` behind the point on
+the ray; points within ``SUPPORT_MARGIN_M`` of its foot are left out, as the floor or table
+under them returns at their depth whether the object is there or not. A box point cannot: the
+wall or table is the box's far side, so such a place is told empty only from a view low
+enough for rays to pass the box's far side above the surface.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ MIN_RAYS = 3  # usable rays (in view, with a return, not occluded) a frame needs
 EMPTY_SHARE = 0.8  # of the usable rays through: the frame saw the place empty
 PRESENT_SHARE = 0.5  # of the usable rays hitting: the frame saw the object there
 MIN_EMPTY_FRAMES = 3
+SUPPORT_MARGIN_M = 0.05  # surface points this near the object's lowest one are not aimed at
 
 
 class EmptyPlaces:
@@ -45,15 +51,30 @@ class EmptyPlaces:
     def __init__(self, instances: Sequence[Instance]) -> None:
         self.uuids = [inst.uuid for inst in instances]
         n = len(self.uuids)
-        self._lower = np.zeros((n, 3))
-        self._upper = np.zeros((n, 3))
-        for k, inst in enumerate(instances):
-            self._lower[k], self._upper[k] = inst.box.aabb()
-        centre, half = (self._lower + self._upper) / 2.0, (self._upper - self._lower) / 2.0
         offsets = np.zeros((len(SAMPLE_OFFSETS), 3))
         offsets[:, :2] = SAMPLE_OFFSETS
-        # (n, k, 3): k sample points per box
-        self._points = centre[:, None, :] + offsets[None, :, :] * half[:, None, :]
+        points, lower, upper, owner, on_surface = [], [], [], [], []
+        for k, inst in enumerate(instances):
+            surface = np.asarray(inst.data.get("surface_map") or [], dtype=np.float64).reshape(-1, 3)
+            if len(surface):  # a point at the object's foot: the support under it answers for it
+                surface = surface[surface[:, 2] >= surface[:, 2].min() + SUPPORT_MARGIN_M]
+            if len(surface):  # a surface point: near and far side at its depth
+                lo = hi = surface
+            else:
+                box_lo, box_hi = inst.box.aabb()
+                surface = (box_lo + box_hi) / 2.0 + offsets * (box_hi - box_lo) / 2.0
+                lo, hi = np.broadcast_to(box_lo, surface.shape), np.broadcast_to(box_hi, surface.shape)
+            points.append(surface)
+            lower.append(lo)
+            upper.append(hi)
+            owner.append(np.full(len(surface), k))
+            on_surface.append(np.full(len(surface), lo is surface))
+        # per ray target: its point, the box it judges (lower, upper corners), whose it is
+        self._points = np.concatenate(points) if points else np.zeros((0, 3))
+        self._lower = np.concatenate(lower) if lower else np.zeros((0, 3))
+        self._upper = np.concatenate(upper) if upper else np.zeros((0, 3))
+        self._owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
+        self._on_surface = np.concatenate(on_surface) if on_surface else np.zeros(0, dtype=bool)
         self.empty = np.zeros(n, dtype=np.int64)
         self.present = np.zeros(n, dtype=np.int64)
         self.first_empty_s = np.full(n, np.nan)
@@ -61,17 +82,17 @@ class EmptyPlaces:
     def look(self, project: Projector, camera_map_m: FloatArray, stamp_s: float) -> None:
         """Count this frame's verdict on every box (``project``: map points to (in view, their
         depth, the depth measured at their pixel); ``camera_map_m``: the camera centre)."""
-        n, k = self._points.shape[:2]
-        points = self._points.reshape(-1, 3)
+        n, points = len(self.uuids), self._points
         ok, z, measured = project(points)
-        lower, upper = np.repeat(self._lower, k, axis=0), np.repeat(self._upper, k, axis=0)
-        entry, exit_ = _slab(camera_map_m, points - camera_map_m, lower, upper)
+        entry, exit_ = _slab(camera_map_m, points - camera_map_m, self._lower, self._upper)
+        entry, exit_ = np.where(self._on_surface, 1.0, entry), np.where(self._on_surface, 1.0, exit_)
         # depth grows linearly along a ray from the camera: the box spans these depths on it
         near_m, far_m = entry * z, exit_ * z
-        usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M)
-        through = usable & (measured > far_m + THROUGH_MARGIN_M)
-        hit = usable & (measured <= far_m + HIT_MARGIN_M)
-        usable, through, hit = (a.reshape(n, k).sum(axis=1) for a in (usable, through, hit))
+        ray_usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M)
+        ray_through = ray_usable & (measured > far_m + THROUGH_MARGIN_M)
+        ray_hit = ray_usable & (measured <= far_m + HIT_MARGIN_M)
+        usable, through, hit = (np.bincount(self._owner, weights=a, minlength=n)
+                                for a in (ray_usable, ray_through, ray_hit))
         judged = usable >= MIN_RAYS
         empty = judged & (through >= EMPTY_SHARE * usable)
         present = judged & (hit >= PRESENT_SHARE * usable)
