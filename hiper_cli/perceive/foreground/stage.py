@@ -404,6 +404,8 @@ class ForegroundStage:
             if points is not None and track_uuid is not None:
                 self._surfaces.add(track_uuid, points)
         instances = [self._instance(t) for t in changed]
+        # a track closed for good has its instance's surface already (tentative ones: none)
+        self._surfaces.keep({t.uuid for t in (*self.tracker.tracks, *self.tracker.dormant)})
         # a track stitched into another after it became an instance (merged away), one whose
         # evidence failed (``unknown_evidence_held``), or a table the background mapped
         gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn, *pieces]

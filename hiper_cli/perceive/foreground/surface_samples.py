@@ -42,6 +42,11 @@ class SurfaceSamples:
             elif (j := int(self._rng.integers(n + 1))) < SAMPLE_POINTS:
                 kept[j] = np.asarray(point, dtype=np.float64)
 
+    def keep(self, uuids: set[str]) -> None:
+        """Forget every track but ``uuids`` (those that may still be seen or closed again)."""
+        for uuid in [u for u in self._points if u not in uuids]:
+            del self._points[uuid], self._offered[uuid]
+
     def of(self, uuid: str) -> list[list[float]] | None:
         """The sample of ``uuid`` as rounded lists (mm), None when it has none."""
         kept = self._points.get(uuid)

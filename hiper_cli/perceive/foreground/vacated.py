@@ -45,8 +45,9 @@ SUPPORT_MARGIN_M = 0.05  # surface points this near the object's lowest one are 
 
 
 class EmptyPlaces:
-    """The boxes of earlier static instances, and per box the frames that saw it empty (and
-    the first such stamp) and the frames that saw something in it."""
+    """The places of earlier static instances (their observed surface points, or their box),
+    and per instance the frames that saw its place empty (and the first such stamp) and the
+    frames that saw something there."""
 
     def __init__(self, instances: Sequence[Instance]) -> None:
         self.uuids = [inst.uuid for inst in instances]
@@ -58,7 +59,8 @@ class EmptyPlaces:
             surface = np.asarray(inst.data.get("surface_map") or [], dtype=np.float64).reshape(-1, 3)
             if len(surface):  # a point at the object's foot: the support under it answers for it
                 surface = surface[surface[:, 2] >= surface[:, 2].min() + SUPPORT_MARGIN_M]
-            if len(surface):  # a surface point: near and far side at its depth
+            seen = len(surface) > 0
+            if seen:  # a surface point: near and far side at its depth
                 lo = hi = surface
             else:
                 box_lo, box_hi = inst.box.aabb()
@@ -68,7 +70,7 @@ class EmptyPlaces:
             lower.append(lo)
             upper.append(hi)
             owner.append(np.full(len(surface), k))
-            on_surface.append(np.full(len(surface), lo is surface))
+            on_surface.append(np.full(len(surface), seen))
         # per ray target: its point, the box it judges (lower, upper corners), whose it is
         self._points = np.concatenate(points) if points else np.zeros((0, 3))
         self._lower = np.concatenate(lower) if lower else np.zeros((0, 3))
