@@ -1,6 +1,7 @@
 """Re-identification across sessions (``reidentify.py``): a static object a later session tracks
-again joins the earlier session's instance; people, other classes, objects that moved and things
-stacked above one another do not; and a second session of one log leaves one instance per object."""
+again joins the earlier session's instance; other classes, objects that moved and things stacked
+above one another do not; a walker joins only one seen at the same times and place; and a second
+session of one log leaves one instance per object, people included."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pytest
 
 from hiper_cli.graph import open_kb
 from hiper_cli.model import Box3D, Instance
-from hiper_cli.perceive.foreground.reidentify import fold, pairs
+from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, pairs
 from hiper_cli.perceive.foreground.stage import ForegroundStage
 from hiper_cli.perceive.foreground.stitch import footprint_share
 from hiper_cli.perceive.logs import open_log
@@ -94,12 +95,64 @@ def test_fold_keeps_the_earlier_uuid_and_the_box_seen_last():
     assert "vacated_s" not in out.data
 
 
+def _walk(t0, t1, *, x0=0.0, y=1.0, speed=1.0, step=0.1, noise_m=0.0, seed=0):
+    """Rows of a walker going along x at ``speed`` from ``x0`` at t0."""
+    rng = np.random.default_rng(seed)
+    return [[t, x0 + speed * (t - t0) + rng.normal(0, noise_m), y + rng.normal(0, noise_m), 0.9,
+             speed, 0.0, 0.0] for t in np.round(np.arange(t0, t1 + 1e-9, step), 6)]
+
+
+def _walker(rows, obs=("w",)):
+    xy, half = np.asarray(rows)[-1, 1:4], np.array([0.2, 0.2, 0.9])
+    return _inst("person", xy - half, xy + half, obs=obs,
+                 t=(rows[0][0], rows[-1][0]), rows=rows)
+
+
+def _cosighted(new, earlier):
+    return [(e.uuid, n.uuid) for e, n in cosighted_pairs(new, earlier, max_m=0.4, min_common=3)]
+
+
+def test_a_walker_joins_only_one_seen_at_the_same_times_and_place():
+    earlier = _walker(_walk(10.0, 20.0))
+    again = _walker(_walk(10.0, 20.0, noise_m=0.03, seed=1))  # the same log perceived again
+    other_robot = _walker(_walk(10.05, 19.95, noise_m=0.05, seed=2))  # its own clock ticks
+    beside = _walker(_walk(10.0, 20.0, y=2.0))  # someone 1 m away at the same times
+    later = _walker(_walk(110.0, 120.0, x0=0.0))  # the same path, another time
+    got = _cosighted([again, other_robot, beside, later], [earlier])
+    assert sorted(got) == sorted([(earlier.uuid, again.uuid), (earlier.uuid, other_robot.uuid)])
+    pieces = [_walker(_walk(10.0, 13.0)), _walker(_walk(14.0, 20.0, x0=4.0))]  # tracked in two pieces
+    assert sorted(_cosighted(pieces, [earlier])) == sorted((earlier.uuid, p.uuid) for p in pieces)
+
+
+def test_a_walker_seen_twice_keeps_each_row_once_and_the_place_seen_last():
+    earlier = _walker(_walk(10.0, 15.0), obs=("a", "b"))
+    new = _walker(_walk(10.0, 18.0, noise_m=0.02, seed=3), obs=("b", "c"))
+    new.state = "dynamic"
+    uuid = earlier.uuid
+    out = fold_mover(earlier, new)
+    stamps = [r[0] for r in out.data["trajectory"]]
+    assert out.uuid == uuid and out.observation_uuids == ["a", "b", "c"]
+    assert stamps == sorted(set(stamps)) and len(stamps) == 81  # 10.0 to 18.0 every 0.1 s, once
+    assert (out.first_seen_s, out.last_seen_s, out.state) == (10.0, 18.0, "dynamic")
+    assert out.box.center_m[0] == pytest.approx(8.0, abs=0.1)
+
+
+def test_fold_drops_a_row_seen_twice_but_keeps_a_moved_object_rows_of_the_same_stamps():
+    """Logs whose stamps all start at 0 share stamps: only a row at the same place is a repeat."""
+    rows = [[float(t), 1.0, 1.0, 0.45, 0, 0, 0] for t in range(5)]
+    earlier = _inst("chair", [0.75, 0.75, 0.0], [1.25, 1.25, 0.9], rows=rows)
+    fold(earlier, _inst("chair", [0.75, 0.75, 0.0], [1.25, 1.25, 0.9], rows=[r[:] for r in rows]))
+    assert len(earlier.data["trajectory"]) == 5
+    moved = [[float(t), 1.5, 1.0, 0.45, 0, 0, 0] for t in range(5)]
+    fold(earlier, _inst("chair", [1.25, 0.75, 0.0], [1.75, 1.25, 0.9], rows=moved))
+    assert len(earlier.data["trajectory"]) == 10
+
+
 def _foreground_counts(kb_path: Path) -> Counter[str]:
-    """Instances per class, people and ``unknown`` left out (the fixture's one unknown is a blob
-    the tracker saw moving: no box tells two moving things apart, so it is never paired)."""
+    """Instances per class, ``unknown`` left out (the fixture's one unknown is a blob the
+    tracker saw moving: no box tells two moving things apart, so it is never paired)."""
     with open_kb(kb_path) as kb:
-        return Counter(i.class_name for i in kb.instances(layer="foreground")
-                       if i.class_name not in ("person", "unknown"))
+        return Counter(i.class_name for i in kb.instances(layer="foreground") if i.class_name != "unknown")
 
 
 def _run(kb_path: Path, again: bool, **options) -> dict[str, int]:
@@ -121,8 +174,13 @@ def test_a_second_session_of_one_log_keeps_one_instance_per_static_object(tmp_pa
     second = _run(kb_path, again=True, reidentify=reidentify)
     twice = _foreground_counts(kb_path)
     if reidentify:
-        assert twice == once
+        assert twice == once  # people too: seen at the same times and places
+        assert once["person"] >= 1
         assert second["found_again"] >= sum(once.values()) and second["moved"] == second["vacated"] == 0
+        with open_kb(kb_path) as kb:
+            for inst in kb.instances(layer="foreground"):
+                stamps = [r[0] for r in inst.data.get("trajectory") or []]
+                assert len(stamps) == len(set(stamps)), inst.class_name  # each row once
     else:  # the switch off: what perceive --again did before
         assert twice == once + once
         assert second == first

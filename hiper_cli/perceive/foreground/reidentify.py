@@ -14,6 +14,11 @@ static instance of a class that stays put (not a walker) is paired with an earli
 
 Pairs are one to one; the earlier instance absorbs the new one (``fold``) and keeps its uuid.
 An earlier instance seen empty and left unpaired is marked vacated by the stage.
+
+A walker is not where it was, so it is never joined by place; but one seen at the same times
+at the same place is the same walker (``cosighted_pairs``): the same log perceived again
+(``--again``), or two robots' logs of one time. The rule is the one that joins two tracks of
+one walker within a session (``stitch_duplicate_m``, median over the common stamps).
 """
 
 from __future__ import annotations
@@ -23,11 +28,12 @@ from collections.abc import Callable, Iterable, Sequence
 import numpy as np
 
 from hiper_cli.model import ROW_STAMP, Instance
-from hiper_cli.perceive.foreground.stitch import footprint_share
+from hiper_cli.perceive.foreground.stitch import STAMP_MATCH_S, common_distance_m, footprint_share
 
-__all__ = ["fold", "moved_pairs", "pairs"]
+__all__ = ["cosighted_pairs", "fold", "fold_mover", "moved_pairs", "pairs"]
 
 UNKNOWN = "unknown"
+SAME_ROW_M = 0.25  # a row at a stamp the earlier trajectory has, this near its row there, is it
 
 
 def pairs(
@@ -61,6 +67,29 @@ def moved_pairs(
         return d if d <= max_m else None
 
     return _one_to_one(new, gone, cost)
+
+
+def cosighted_pairs(
+    new: Iterable[Instance], earlier: Iterable[Instance], *, max_m: float, min_common: int
+) -> list[tuple[Instance, Instance]]:
+    """(earlier, new) pairs of one walker seen twice at once: of one class, within ``max_m`` of
+    each other (median, horizontal) at ``min_common`` or more of the new one's stamps. Each
+    new instance joins its nearest; an earlier one may take several (a walker the first pass
+    tracked whole and the second in pieces)."""
+    earlier = [e for e in earlier if len(e.data.get("trajectory") or []) >= 2]
+    out = []
+    for n in sorted(new, key=lambda i: i.uuid):
+        rows = n.data.get("trajectory") or []
+        best: tuple[float, str, Instance] | None = None
+        for e in earlier:
+            if e.class_name != n.class_name or e.uuid == n.uuid or not rows:
+                continue
+            apart = common_distance_m(rows, e.data["trajectory"], min_common)
+            if apart is not None and apart <= max_m and (best is None or (apart, e.uuid) < best[:2]):
+                best = (apart, e.uuid, e)
+        if best is not None:
+            out.append((best[2], n))
+    return out
 
 
 def _one_to_one(
@@ -104,8 +133,42 @@ def fold(earlier: Instance, new: Instance) -> Instance:
     earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
     earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
     earlier.state = "static"
-    rows: Sequence[list[float]] = [*(earlier.data.get("trajectory") or []),
-                                   *(new.data.get("trajectory") or [])]
+    _merge_rows(earlier, new)
+    return earlier
+
+
+def fold_mover(earlier: Instance, new: Instance) -> Instance:
+    """``earlier`` with ``new``, the same walker seen at the same times, absorbed (in place,
+    and returned): its observations and the rows of stamps the earlier one lacks; the box and
+    state of whichever was seen last."""
+    known = set(earlier.observation_uuids)
+    earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
+    if new.last_seen_s > earlier.last_seen_s:
+        earlier.box, earlier.confidence, earlier.state = new.box, new.confidence, new.state
+    earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
+    earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
+    _merge_rows(earlier, new)
+    return earlier
+
+
+def _merge_rows(earlier: Instance, new: Instance) -> None:
+    """The two trajectories in one, in time. A new row at a stamp the earlier trajectory has,
+    within ``SAME_ROW_M`` of its row there, is that row again (one log perceived twice gives
+    every row twice) and is left out; logs whose stamps all start at 0 share stamps too, so
+    the place must agree as well (a moved object's rows stay)."""
+    old: Sequence[list[float]] = earlier.data.get("trajectory") or []
+    arr = np.asarray([r[:3] for r in old], dtype=np.float64).reshape(-1, 3)
+    arr = arr[np.argsort(arr[:, ROW_STAMP], kind="stable")]
+
+    def again(row: Sequence[float]) -> bool:
+        t = float(row[ROW_STAMP])
+        k = int(np.searchsorted(arr[:, ROW_STAMP], t - STAMP_MATCH_S))
+        while k < len(arr) and arr[k, ROW_STAMP] <= t + STAMP_MATCH_S:
+            if np.hypot(arr[k, 1] - row[1], arr[k, 2] - row[2]) <= SAME_ROW_M:
+                return True
+            k += 1
+        return False
+
+    rows = [*old, *(r for r in (new.data.get("trajectory") or []) if not again(r))]
     earlier.data["trajectory"] = sorted(rows, key=lambda r: r[ROW_STAMP])
     earlier.data["closed"] = True
-    return earlier

@@ -37,7 +37,7 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes
 from hiper_cli.perceive.foreground.moving import is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.reidentify import fold, moved_pairs, pairs
+from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
@@ -457,9 +457,10 @@ class ForegroundStage:
             self._empty.look(self._projector(frame), frame.T_map_cam[:3, 3], frame.stamp_s)
 
     def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str], dict[str, int]]:
-        """Earlier sessions' instances that absorbed one of this session's static ones, or
-        whose place this session saw empty (``reidentify.py``, ``vacated.py``), the uuids
-        of the instances absorbed, and how many were found again, moved and vacated."""
+        """Earlier sessions' instances that absorbed one of this session's static ones or a
+        walker seen at the same times (``reidentify.py``), or whose place this session saw
+        empty (``vacated.py``), the uuids of the instances absorbed, and how many were found
+        again, moved and vacated."""
         cfg = self.config
         earlier = {u: i for u, i in world.foreground.items() if u not in self._instances and self._stays(i)}
         new = [i for u, i in self._instances.items() if u in static and self._stays(i)]
@@ -473,13 +474,24 @@ class ForegroundStage:
         for old, absorbed in found:
             fold(old, absorbed)
             del self._instances[absorbed.uuid]
+        walkers = self.tracker.config.walker_classes
+        cosighted = cosighted_pairs(
+            [i for i in self._instances.values() if i.class_name in walkers],
+            [i for u, i in world.foreground.items() if u not in self._instances and i.class_name in walkers],
+            max_m=self.tracker.config.stitch_duplicate_m, min_common=self.tracker.config.confirm_hits,
+        )
+        for old, absorbed in cosighted:
+            fold_mover(old, absorbed)
+            del self._instances[absorbed.uuid]
+        found += cosighted
         joined = {old.uuid for old, _ in found}
         marked = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
         for inst in marked:
             # never before it was last seen (logs whose stamps all start at 0 overlap in time)
             inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
-        counts = {"found_again": len(found), "moved": len(moved), "vacated": len(marked)}
-        return [old for old, _ in found] + marked, [absorbed.uuid for _, absorbed in found], counts
+        earlier_joined = list({old.uuid: old for old, _ in found}.values())
+        counts = {"found_again": len(earlier_joined), "moved": len(moved), "vacated": len(marked)}
+        return earlier_joined + marked, [absorbed.uuid for _, absorbed in found], counts
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:

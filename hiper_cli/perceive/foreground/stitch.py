@@ -25,7 +25,7 @@ so the instance keeps its uuid and the knowledge base one instance per object.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -38,8 +38,8 @@ if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "find_target", "footprint_share", "gap_ok",
-           "provisional_class", "stale_rows"]
+__all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "common_distance_m", "find_target", "footprint_share",
+           "gap_ok", "provisional_class", "stale_rows"]
 
 FloatArray = NDArray[np.float64]
 RESUME, DUPLICATE, REVISIT = "resume", "duplicate", "revisit"
@@ -170,18 +170,23 @@ def _similarity(new: Track, old: Track) -> float:
 
 
 def _common_distance_m(new: Track, old: Track, min_common: int) -> float | None:
-    """Median horizontal distance of the two tracks at the stamps of ``new``'s rows where the
-    old track was where its rows say (at a row of that stamp, or between two rows at most
-    ``INTERPOLATE_MAX_S`` apart: two tracks that took one walker in turns), when there are
-    at least ``min_common`` of them (None otherwise)."""
-    a = np.asarray(new.trajectory, dtype=np.float64)
-    b = np.asarray(old.trajectory, dtype=np.float64)
+    return common_distance_m(new.trajectory, old.trajectory, min_common)
+
+
+def common_distance_m(rows_new: Sequence[Sequence[float]], rows_old: Sequence[Sequence[float]],
+                      min_common: int) -> float | None:
+    """Median horizontal distance of two trajectories (rows [stamp_s, x, y, z, ...]) at the
+    stamps of ``rows_new`` where the old one was where its rows say (at a row of that stamp,
+    or between two rows at most ``INTERPOLATE_MAX_S`` apart: two tracks that took one walker
+    in turns), when there are at least ``min_common`` of them (None otherwise)."""
+    a = np.asarray(rows_new, dtype=np.float64).reshape(len(rows_new), -1)
+    b = np.asarray(rows_old, dtype=np.float64).reshape(len(rows_old), -1)
     if len(a) == 0 or len(b) < 2:
         return None
     stamps = a[:, ROW_STAMP]
     after = np.clip(np.searchsorted(b[:, ROW_STAMP], stamps), 1, len(b) - 1)
     t0, t1 = b[after - 1, ROW_STAMP], b[after, ROW_STAMP]
-    same = np.abs(b[after, ROW_STAMP] - stamps) <= STAMP_MATCH_S
+    same = np.abs(t1 - stamps) <= STAMP_MATCH_S
     inside = (stamps >= t0) & (stamps <= t1) & (t1 - t0 <= INTERPOLATE_MAX_S)
     use = same | inside
     if int(use.sum()) < min_common:
