@@ -480,7 +480,9 @@ class TrackerConfig(_Part):
     every chair and bed a second instance. An earlier instance whose place this session saw
     empty (``vacated.py``) joins the nearest new instance of its class that no earlier one
     took, within ``reidentify_moved_m`` (the object moved); unpaired, it is marked vacated
-    (``data["vacated_s"]``: the first stamp its place was seen empty)."""
+    (``data["vacated_s"]``: the first stamp its place was seen empty). A walker joins an
+    earlier walker of its class only when seen at the same times and place
+    (``stitch_duplicate_m`` at ``confirm_hits`` or more common stamps): one log perceived again."""
     reidentify_moved_m: float = 3.0
     settled_hits: int = 15
     """A track not of a walker class, with at least this many observations and not moving (a
