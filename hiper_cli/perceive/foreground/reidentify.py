@@ -80,15 +80,11 @@ def cosighted_pairs(
     out = []
     for n in sorted(new, key=lambda i: i.uuid):
         rows = n.data.get("trajectory") or []
-        best: tuple[float, str, Instance] | None = None
-        for e in earlier:
-            if e.class_name != n.class_name or e.uuid == n.uuid or not rows:
-                continue
-            apart = common_distance_m(rows, e.data["trajectory"], min_common)
-            if apart is not None and apart <= max_m and (best is None or (apart, e.uuid) < best[:2]):
-                best = (apart, e.uuid, e)
-        if best is not None:
-            out.append((best[2], n))
+        near = [(apart, e.uuid, e) for e in earlier if rows and e.class_name == n.class_name
+                and (apart := common_distance_m(rows, e.data["trajectory"], min_common)) is not None
+                and apart <= max_m]
+        if near:
+            out.append((min(near, key=lambda c: c[:2])[2], n))
     return out
 
 
@@ -123,17 +119,13 @@ def fold(earlier: Instance, new: Instance) -> Instance:
     0 overlap), the new one says where the object is now: its box, class confidence and
     observed surface, and no longer vacated (``vacated.py``); a bed pushed half a metre
     between two visits is where the later visit saw it."""
-    known = set(earlier.observation_uuids)
-    earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
     if new.last_seen_s >= earlier.first_seen_s:
         earlier.box, earlier.confidence = new.box, new.confidence
         earlier.data.pop("vacated_s", None)
         if "surface_map" in new.data:
             earlier.data["surface_map"] = new.data["surface_map"]
-    earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
-    earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
     earlier.state = "static"
-    _merge_rows(earlier, new)
+    _absorb(earlier, new)
     return earlier
 
 
@@ -141,18 +133,15 @@ def fold_mover(earlier: Instance, new: Instance) -> Instance:
     """``earlier`` with ``new``, the same walker seen at the same times, absorbed (in place,
     and returned): its observations and the rows of stamps the earlier one lacks; the box and
     state of whichever was seen last."""
-    known = set(earlier.observation_uuids)
-    earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
     if new.last_seen_s > earlier.last_seen_s:
         earlier.box, earlier.confidence, earlier.state = new.box, new.confidence, new.state
-    earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
-    earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
-    _merge_rows(earlier, new)
+    _absorb(earlier, new)
     return earlier
 
 
-def _merge_rows(earlier: Instance, new: Instance) -> None:
-    """The two trajectories in one, in time. A new row at a stamp the earlier trajectory has,
+def _absorb(earlier: Instance, new: Instance) -> None:
+    """What both folds take from ``new``: its observations, its seen span and its rows. The two
+    trajectories become one, in time. A new row at a stamp the earlier trajectory has,
     within ``SAME_ROW_M`` of its row there, is that row again (one log perceived twice gives
     every row twice) and is left out; logs whose stamps all start at 0 share stamps too, so
     the place must agree as well (a moved object's rows stay)."""
@@ -169,6 +158,10 @@ def _merge_rows(earlier: Instance, new: Instance) -> None:
             k += 1
         return False
 
+    known = set(earlier.observation_uuids)
+    earlier.observation_uuids.extend(u for u in new.observation_uuids if u not in known)
+    earlier.first_seen_s = min(earlier.first_seen_s, new.first_seen_s)
+    earlier.last_seen_s = max(earlier.last_seen_s, new.last_seen_s)
     rows = [*old, *(r for r in (new.data.get("trajectory") or []) if not again(r))]
     earlier.data["trajectory"] = sorted(rows, key=lambda r: r[ROW_STAMP])
     earlier.data["closed"] = True

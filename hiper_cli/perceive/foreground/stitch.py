@@ -11,7 +11,7 @@ The frame-to-frame association misses in three ways that leave one object as sev
   tracks (``appearance.py``) agree to at least ``stitch_min_similarity``;
 - **duplicate**: two blobs of one walker (the head above a shelf, the legs below it) fed two
   tracks at once, or two tracks took it in turns; the new one stays within
-  ``stitch_duplicate_m`` of the old one at the same times (``_common_distance_m``); when
+  ``stitch_duplicate_m`` of the old one at the same times (``common_distance_m``); when
   the old one took the walker only once or twice after the new one started (at most
   ``HANDOVER_MAX_S`` later) and was within ``stitch_duplicate_m`` then, the new one resumes it;
 - **revisit**: a static object (a chair, a shelf's junk) seen again after its track closed, or
@@ -115,13 +115,13 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
         ):
             return 1.0 + (1.0 - similar), RESUME
         return None
-    apart_m = _common_distance_m(new, old, config.confirm_hits)
+    apart_m = common_distance_m(new.trajectory, old.trajectory, config.confirm_hits)
     if apart_m is not None and apart_m <= config.stitch_duplicate_m:
         return apart_m / config.stitch_duplicate_m, DUPLICATE
     if old.last_update_s - new.first_seen_s <= HANDOVER_MAX_S:
         # A handover: the old track took the walker once or twice more after the new one
         # started, too few common stamps for a duplicate; the new one goes on as the walker.
-        apart_m = _common_distance_m(new, old, 1)
+        apart_m = common_distance_m(new.trajectory, old.trajectory, 1)
         if apart_m is not None and apart_m <= config.stitch_duplicate_m:
             return apart_m / config.stitch_duplicate_m, RESUME
     return None
@@ -167,10 +167,6 @@ def _similarity(new: Track, old: Track) -> float:
     if new.appearance is None or old.appearance is None:
         return 0.0
     return similarity(new.appearance, old.appearance)
-
-
-def _common_distance_m(new: Track, old: Track, min_common: int) -> float | None:
-    return common_distance_m(new.trajectory, old.trajectory, min_common)
 
 
 def common_distance_m(rows_new: Sequence[Sequence[float]], rows_old: Sequence[Sequence[float]],
