@@ -25,14 +25,17 @@ class _Run:
         self.t_s, self.k = 0.0, 0
 
     def frames(self, blobs, n=1):
+        """``blobs``: (lower, upper, class[, the detection's image box]) each."""
         for _ in range(n):
             measurements = []
-            for j, (lower, upper, cls) in enumerate(blobs):  # each named blob: a detection of its own
+            for j, (lower, upper, cls, *box_px) in enumerate(blobs):  # each named: a detection of its own
                 lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+                named_px = np.asarray(box_px[0], float) if box_px else None
                 self.k += 1
                 measurements.append(Measurement((lower + upper) / 2, upper - lower, cls, 0.9, f"o{self.k}",
                                                 bounds_map_m=(lower, upper),
-                                                detection_index=None if cls == "unknown" else j))
+                                                detection_index=None if cls == "unknown" else j,
+                                                detection_xyxy_px=named_px))
             changed, _ = self.tracker.step(self.t_s, measurements)
             self.instances.update(t.uuid for t in changed if t.confirmed)
             self.instances -= set(self.tracker.absorbed)
@@ -99,15 +102,63 @@ def test_two_chairs_side_by_side_stay_two():
 def test_one_detection_naming_two_blobs_saw_one_thing():
     """House 44: a track on a table leg took some blobs of the chair beside it, named by the
     chair's detection; the chair's own track took the chair's other blob in those frames."""
-    from hiper_cli.perceive.foreground.same_object import seen_apart
+    from hiper_cli.perceive.foreground.same_object import NamedBlob, seen_apart
 
     a = Track("a", make_motion_model("constant_velocity", np.zeros(3), 0.03), 0.0, 1.0, 1.0, np.ones(3))
     b = Track("b", make_motion_model("constant_velocity", np.zeros(3), 0.03), 0.0, 1.0, 1.0, np.ones(3))
-    a.named_at = {0.1 * k: 0 for k in range(10)}
-    b.named_at = {0.1 * k: 0 for k in range(5)}  # the same detection
-    assert not seen_apart(a, b)
-    b.named_at = {0.1 * k: 1 for k in range(5)}  # another one: two things at once
-    assert seen_apart(a, b)
+    left = np.array([0.0, 0.0, 0.0]), np.array([0.45, 0.45, 0.9])
+    right = np.array([0.5, 0.0, 0.0]), np.array([0.95, 0.45, 0.9])
+    a.named_at = {0.1 * k: NamedBlob(0, *left) for k in range(10)}
+    b.named_at = {0.1 * k: NamedBlob(0, *right) for k in range(5)}  # the same detection
+    assert not seen_apart(a, b, TrackerConfig())
+    b.named_at = {0.1 * k: NamedBlob(1, *right) for k in range(5)}  # another one: two things at once
+    assert seen_apart(a, b, TrackerConfig())
+
+
+def test_a_chair_cut_in_two_by_a_table_top_is_one_chair():
+    """House 61: the detector named a chair's back above a table top and its seat below it with
+    two boxes, one above the other, frame after frame; the two tracks were seen apart at once
+    and stayed two chairs."""
+    back = ([0.0, 0.38, 0.78], [0.45, 0.45, 0.92], "chair", [538, 238, 587, 344])
+    seat = ([0.0, 0.0, 0.0], [0.45, 0.45, 0.62], "chair", [465, 307, 582, 450])
+    run = _Run()
+    run.frames([seat], 30)
+    run.frames([seat, back], 60)
+    assert len(run.instances) == 1
+    (chair,) = run.objects()
+    _, extent = object_box(chair, run.tracker.config)
+    assert extent[2] > 0.85  # the back is part of it
+
+
+def test_a_piece_the_detector_mostly_left_unnamed_is_not_joined_to_what_it_named():
+    """House 44: a back above a table, unnamed for five seconds, then named in a few frames
+    beside its seat: its votes leave it ``unknown``, and the seat stays the chair instance."""
+    back = ([0.0, 0.38, 0.78], [0.45, 0.45, 0.92])
+    seat = ([0.0, 0.0, 0.0], [0.45, 0.45, 0.62], "chair", [465, 307, 582, 450])
+    run = _Run()
+    run.frames([(*back, "unknown")], 75)
+    run.frames([seat, (*back, "chair", [538, 238, 587, 344])], 10)
+    classes = sorted(t.class_name for t in run.objects())
+    assert classes == ["chair", "unknown"]
+
+
+def test_two_things_named_side_by_side_stay_two_whatever_a_blob_spans():
+    """Office 45: two chairs 0.26 m apart, named side by side in the image; a blob that joined
+    them put both under one chair's footprint. Two bottles side by side, one atop the other's
+    footprint by depth noise, likewise stay two."""
+    left = ([11.28, 7.41, 0.0], [11.72, 7.85, 0.92], "chair", [8, 218, 57, 330])
+    both = ([11.28, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [8, 218, 57, 330])
+    right = ([11.98, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [50, 214, 100, 323])
+    run = _Run()
+    run.frames([left], 30)
+    run.frames([both, right], 60)
+    assert len(run.instances) == 2
+    left = ([0.0, 0.0, 0.8], [0.08, 0.1, 1.1], "bottle", [100, 200, 130, 300])
+    right = ([0.04, 0.0, 0.8], [0.12, 0.1, 1.1], "bottle", [140, 200, 170, 300])
+    run = _Run()
+    run.frames([left], 30)
+    run.frames([left, right], 60)
+    assert len(run.instances) == 2
 
 
 def test_fold_keeps_time_order_and_the_earlier_first_sighting():

@@ -14,36 +14,55 @@ module decides *when* and *which way* it is asked, and what "static" means for a
 - **which way**: the older track keeps its instance; when the track asked is the older one, a
   newer live track it matches folds into it (``newer_match``, ``fold``);
 - **static**: two tracks are one static object when neither walks, they did not take blobs
-  of the same frames (two bottles side by side seen at once are two bottles, whatever a blob
-  that once joined them did to one track's box), and the boxes of all their blobs together
-  did not move (``static_together``): views of one object from different
-  sides each show some of it, so a track that saw only the foot end of a bed and then its
-  side looks as if it moved on its own, but together with the track that saw the whole bed
-  its first and last views overlap. A cart that drove away does not: its last views lie
+  side by side in the same frames (two bottles side by side seen at once are two bottles,
+  whatever a blob that once joined them did to one track's box; a chair's back above a table
+  and its seat below it, each named by a detection of its own, are one chair), and the boxes
+  of all their blobs together did not move (``static_together``): views of one object from
+  different sides each show some of it, so a track that saw only the foot end of a bed and
+  then its side looks as if it moved on its own, but together with the track that saw the
+  whole bed its first and last views overlap. A cart that drove away does not: its last views lie
   apart from its first ones whatever else saw it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiper_cli.model import ROW_STAMP
 from hiper_cli.perceive.foreground.seen_box import SeenBox
-from hiper_cli.perceive.foreground.stitch import REVISIT, UNKNOWN, absorb, find_target, provisional_class
+from hiper_cli.perceive.foreground.stitch import (
+    REVISIT,
+    UNKNOWN,
+    absorb,
+    find_target,
+    footprint_share,
+    provisional_class,
+)
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["APART_SHARE", "GROWN_FACTOR", "due", "fold", "footprint_m2", "newer_match", "seen_apart",
-           "static_together"]
+__all__ = ["APART_SHARE", "GROWN_FACTOR", "STACKED_SHARE", "NamedBlob", "cut_in_two", "due", "fold",
+           "footprint_m2", "newer_match", "seen_apart", "static_together"]
 
 APART_SHARE = 0.5  # of the shorter track's frames, taken apart at once: two objects
+STACKED_SHARE = 0.5  # of the narrower detection's width, in columns both cover: one above the other
 STAMP_DECIMALS = 4  # stamps of one frame agree to well within this (0.1 ms)
 GROWN_FACTOR = 1.5  # a static track's footprint this many times what it was when last offered
+
+
+class NamedBlob(NamedTuple):
+    """The blob a detection named in one frame: which detection, and the blob's map-frame box."""
+
+    detection: int
+    lower_m: NDArray[np.float64]
+    upper_m: NDArray[np.float64]
+    xyxy_px: NDArray[np.float64] | None = None  # the detection's image box
 
 
 def footprint_m2(track: Track) -> float:
@@ -67,20 +86,45 @@ def due(track: Track, walkers: tuple[str, ...], every_class: bool) -> bool:
     return track.stitch_class not in walkers and footprint_m2(track) >= GROWN_FACTOR * track.stitch_area_m2
 
 
-def seen_apart(a: Track, b: Track) -> bool:
-    """Whether different detections named blobs of ``a`` and of ``b`` in the same frames, in
-    at least ``APART_SHARE`` of the frames detections named the less often named one: the
-    detector saw two things at once (two bottles side by side, one track's box stretched over
-    both by a blob that once joined them). One detection naming two blobs, a chair's back
-    above a table and its seat below, saw one thing."""
+def seen_apart(a: Track, b: Track, config: TrackerConfig) -> bool:
+    """Whether different detections named blobs of ``a`` and of ``b`` in the same frames as two
+    things, in at least ``APART_SHARE`` of the frames detections named the less often named
+    one: the detector saw two things at once (two bottles side by side, one track's box
+    stretched over both by a blob that once joined them). One detection naming two blobs (a
+    chair's back above a table and its seat below it) saw one thing, and so did two
+    detections one above the other in the image whose blobs are one object (``cut_in_two``),
+    when the votes of both tracks gave them that class: a piece the detector mostly left
+    unnamed may be something else."""
     if not a.named_at or not b.named_at:
         return False
-    apart = sum(1 for stamp, k in a.named_at.items() if b.named_at.get(stamp, k) != k)
+    one_class = a.class_name == b.class_name != UNKNOWN
+    apart = 0
+    for stamp, seen_a in a.named_at.items():
+        seen_b = b.named_at.get(stamp)
+        if seen_b is not None and seen_b.detection != seen_a.detection:
+            apart += not (one_class and cut_in_two(seen_a, seen_b, config))
     return apart >= APART_SHARE * min(len(a.named_at), len(b.named_at))
 
 
+def cut_in_two(a: NamedBlob, b: NamedBlob, config: TrackerConfig) -> bool:
+    """Whether two detections of one frame named two pieces of one object: the detections
+    stand one above the other in the image (their columns overlap by ``STACKED_SHARE`` of
+    the narrower one), and their blobs share a footprint as two tracks of one object do
+    (``stitch_min_overlap``, at most ``stitch_overlap_m`` apart vertically). A table top
+    cuts a chair behind it into its back and its seat for the detector too; two chairs side
+    by side stand side by side in the image, whatever a blob that joined them spans."""
+    if a.xyxy_px is None or b.xyxy_px is None:
+        return False
+    common_px = min(a.xyxy_px[2], b.xyxy_px[2]) - max(a.xyxy_px[0], b.xyxy_px[0])
+    narrower_px = min(a.xyxy_px[2] - a.xyxy_px[0], b.xyxy_px[2] - b.xyxy_px[0])
+    if common_px < STACKED_SHARE * narrower_px:
+        return False
+    share = footprint_share((a.lower_m, a.upper_m), (b.lower_m, b.upper_m), max_gap_m=config.stitch_overlap_m)
+    return share >= config.stitch_min_overlap
+
+
 def static_together(
-    a: Track, b: Track, walkers: tuple[str, ...], filter_moving: Callable[[Track], bool]
+    a: Track, b: Track, config: TrackerConfig, filter_moving: Callable[[Track], bool]
 ) -> bool:
     """Whether ``a`` and ``b`` together are one static object: neither is of a walking class,
     an ``unknown`` one (perhaps a person not named yet) was not moving by its filter
@@ -88,9 +132,9 @@ def static_together(
     boxes of all their blobs, older track first, did not move (``SeenBox.moved``)."""
     for track in (a, b):
         name = provisional_class(track)
-        if name in walkers or (name == UNKNOWN and filter_moving(track)):
+        if name in config.walker_classes or (name == UNKNOWN and filter_moving(track)):
             return False
-    if seen_apart(a, b):
+    if seen_apart(a, b, config):
         return False
     both = SeenBox()
     for track in sorted((a, b), key=lambda t: t.first_seen_s):

@@ -361,6 +361,7 @@ class ForegroundStage:
                 continue
             obs = self._observation(frame, blob, match, dets)
             walker = match.class_name in cfg.walker_classes
+            named_px = None if match.detection_index is None else dets.xyxy[match.detection_index]
             observations.append(obs)
             surfaces.append(None if walker else blob.points_map)
             measurements.append(
@@ -373,6 +374,7 @@ class ForegroundStage:
                     longest_m=longest,
                     solid=not flat,
                     detection_index=match.detection_index,
+                    detection_xyxy_px=named_px,
                     viewpoint_map_m=frame.T_map_cam[:3, 3],
                     top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
                     and top_hidden(blob, frame.depth_m, cfg.pixel_step),

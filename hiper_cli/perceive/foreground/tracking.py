@@ -59,6 +59,7 @@ from hiper_cli.perceive.foreground.moving import is_static, was_moving
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 from hiper_cli.perceive.foreground.same_object import (
     STAMP_DECIMALS,
+    NamedBlob,
     due,
     fold,
     footprint_m2,
@@ -124,7 +125,9 @@ class Measurement:
     """Not flat (``solid.is_flat``): a walker's track takes only solid blobs (``walker_solid``)."""
     detection_index: int | None = None
     """Which detection of its frame named the blob (None: none): two tracks named by different
-    detections in one frame are two objects (``same_object.seen_apart``)."""
+    detections side by side in one frame are two objects (``same_object.seen_apart``)."""
+    detection_xyxy_px: FloatArray | None = None
+    """The image box (x0, y0, x1, y1; pixels) of the detection that named the blob."""
     viewpoint_map_m: FloatArray | None = None
     """The camera's position (map frame) when it saw the blob: which side of the object it saw
     (``amodal``)."""
@@ -180,7 +183,7 @@ class Track:
     # the boxes of its blobs: a static object's box (``object_box``)
     seen: SeenBox = field(default_factory=SeenBox)
     # stamp (rounded, ``same_object.STAMP_DECIMALS``) -> the detection that named its blob then
-    named_at: dict[float, int] = field(default_factory=dict)
+    named_at: dict[float, NamedBlob] = field(default_factory=dict)
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -497,7 +500,8 @@ class Tracker:
         track._class_name = None
         track.score_sum += m.score
         if m.detection_index is not None:
-            track.named_at[round(track.last_update_s, STAMP_DECIMALS)] = m.detection_index
+            stamp = round(track.last_update_s, STAMP_DECIMALS)
+            track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         if m.whole:
             track.whole_stamps_s.append(track.last_update_s)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
@@ -681,7 +685,7 @@ class Tracker:
             return not is_static(track, cfg)
 
         def together(a: Track, b: Track) -> bool:
-            return static_together(a, b, cfg.walker_classes, lambda t: was_moving(t, cfg))
+            return static_together(a, b, cfg, lambda t: was_moving(t, cfg))
 
         pair = together if cfg.stitch_static_again else None
         for new in fresh:
