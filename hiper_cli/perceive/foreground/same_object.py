@@ -20,8 +20,8 @@ module decides *when* and *which way* it is asked, and what "static" means for a
   of all their blobs together did not move (``static_together``): views of one object from
   different sides each show some of it, so a track that saw only the foot end of a bed and
   then its side looks as if it moved on its own, but together with the track that saw the
-  whole bed its first and last views overlap. A cart that drove away does not: its last views lie
-  apart from its first ones whatever else saw it.
+  whole bed its first and last views overlap. A cart that drove away does not: its last
+  views lie apart from its first ones whatever else saw it.
 """
 
 from __future__ import annotations
