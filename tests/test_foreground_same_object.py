@@ -14,6 +14,11 @@ from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, 
 RATE_HZ = 15.0
 CHAIR = ([2.0, 1.0, 0.0], [2.45, 1.45, 0.9], "chair")
 LEG = ([2.5, 1.5, 0.0], [2.55, 1.55, 0.7], "chair")  # a table leg beside the chair, in its box
+# a chair behind a table top, house 61: its back above the top and its seat below it, the
+# image boxes of the two detections that named them, one above the other
+BACK = ([0.0, 0.38, 0.78], [0.45, 0.45, 0.92])
+SEAT = ([0.0, 0.0, 0.0], [0.45, 0.45, 0.62], "chair", [465, 307, 582, 450])
+BACK_PX = [538, 238, 587, 344]
 
 
 class _Run:
@@ -119,11 +124,9 @@ def test_a_chair_cut_in_two_by_a_table_top_is_one_chair():
     """House 61: the detector named a chair's back above a table top and its seat below it with
     two boxes, one above the other, frame after frame; the two tracks were seen apart at once
     and stayed two chairs."""
-    back = ([0.0, 0.38, 0.78], [0.45, 0.45, 0.92], "chair", [538, 238, 587, 344])
-    seat = ([0.0, 0.0, 0.0], [0.45, 0.45, 0.62], "chair", [465, 307, 582, 450])
     run = _Run()
-    run.frames([seat], 30)
-    run.frames([seat, back], 60)
+    run.frames([SEAT], 30)
+    run.frames([SEAT, (*BACK, "chair", BACK_PX)], 60)
     assert len(run.instances) == 1
     (chair,) = run.objects()
     _, extent = object_box(chair, run.tracker.config)
@@ -133,11 +136,9 @@ def test_a_chair_cut_in_two_by_a_table_top_is_one_chair():
 def test_a_piece_the_detector_mostly_left_unnamed_is_not_joined_to_what_it_named():
     """House 44: a back above a table, unnamed for five seconds, then named in a few frames
     beside its seat: its votes leave it ``unknown``, and the seat stays the chair instance."""
-    back = ([0.0, 0.38, 0.78], [0.45, 0.45, 0.92])
-    seat = ([0.0, 0.0, 0.0], [0.45, 0.45, 0.62], "chair", [465, 307, 582, 450])
     run = _Run()
-    run.frames([(*back, "unknown")], 75)
-    run.frames([seat, (*back, "chair", [538, 238, 587, 344])], 10)
+    run.frames([(*BACK, "unknown")], 75)
+    run.frames([SEAT, (*BACK, "chair", BACK_PX)], 10)
     classes = sorted(t.class_name for t in run.objects())
     assert classes == ["chair", "unknown"]
 

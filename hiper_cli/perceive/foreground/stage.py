@@ -476,11 +476,12 @@ class ForegroundStage:
         for old, absorbed in found:
             fold(old, absorbed)
             del self._instances[absorbed.uuid]
-        walkers = self.tracker.config.walker_classes
+        tracking = self.tracker.config
+        walkers = tracking.walker_classes
         cosighted = cosighted_pairs(
             [i for i in self._instances.values() if i.class_name in walkers],
             [i for u, i in world.foreground.items() if u not in self._instances and i.class_name in walkers],
-            max_m=self.tracker.config.stitch_duplicate_m, min_common=self.tracker.config.confirm_hits,
+            max_m=tracking.stitch_duplicate_m, min_common=tracking.confirm_hits,
         )
         for old, absorbed in cosighted:
             fold_mover(old, absorbed)
