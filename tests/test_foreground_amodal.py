@@ -118,3 +118,88 @@ def test_a_chair_behind_a_panel_is_raised_to_a_chairs_height_in_the_knowledge_ba
     bottom, seen_height = chair_box(complete_footprints=False)
     assert seen_height < 0.45
     assert chair_box() == pytest.approx((bottom, 0.7))
+
+
+def test_a_chair_whose_base_no_view_showed_stands_on_the_floor():
+    from hiper_cli.perceive.foreground.amodal import complete_base
+
+    lower, upper = np.array([0.0, 0.0, 0.66]), np.array([0.44, 0.17, 0.92])  # a back above a table
+    base_lower, base_upper = complete_base(lower, upper, "chair", bottom_seen=False, floor_z_m=0.02)
+    assert np.allclose(base_lower, [0.0, 0.0, 0.02]) and np.allclose(base_upper, upper)
+    for cls, seen in (("chair", True), ("bottle", False)):  # its base in view; a class on tables too
+        assert np.allclose(complete_base(lower, upper, cls, bottom_seen=seen, floor_z_m=0.02)[0], lower)
+    box = SeenBox()
+    for k in range(10):
+        box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=k > 0)
+    assert not box.bottom_seen()  # one view in ten is noise
+    box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=False)
+    box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=False)
+    assert box.bottom_seen()  # three in twelve: as many as the box's lower quantile takes
+
+
+def _behind_a_counter(obstacle_class, **options):
+    """The box (bottom, height) of an object 0.9 m tall 3.5 m before the camera (1 m high), with
+    a counter's front 0.75 m high 2 m before the camera: only the object's upper part is in view."""
+    from hiper_cli.perceive.foreground import ForegroundStage
+    from hiper_cli.perceive.runner import run_stages
+    from hiper_cli.perceive.stage import World
+    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
+
+    thing = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), obstacle_class, relief_m=0.1)
+    counter = SceneBox(11, np.array([2.0, 0.0, 0.375]), np.array([0.05, 2.0, 0.75]), "other")
+    frames = [make_frame([*room(), thing, counter], pose_looking_x(), k / 30.0, k) for k in range(20)]
+    stage = ForegroundStage(detector="log", pixel_step=2, **options)
+    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+    (inst,) = [i for i in world.foreground.values() if i.class_name == obstacle_class]
+    return inst.box.center_m[2] - inst.box.extent_m[2] / 2, inst.box.extent_m[2]
+
+
+def test_a_chair_behind_a_counter_reaches_down_to_the_floor_in_the_knowledge_base():
+    seen_bottom, seen_height = _behind_a_counter("chair", complete_footprints=False)
+    assert seen_bottom > 0.4 and seen_height < 0.5  # the back above the counter only
+    bottom, height = _behind_a_counter("chair")
+    assert bottom == pytest.approx(0.0, abs=0.01) and height == pytest.approx(seen_bottom + seen_height)
+
+
+def test_what_may_stand_on_a_table_keeps_the_base_it_was_seen_with():
+    seen = _behind_a_counter("potted plant", complete_footprints=False)
+    assert seen[0] > 0.4
+    assert _behind_a_counter("potted plant") == pytest.approx(seen)
+
+
+def test_a_chair_seen_standing_keeps_its_box():
+    from hiper_cli.perceive.foreground import ForegroundStage
+    from hiper_cli.perceive.runner import run_stages
+    from hiper_cli.perceive.stage import World
+    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
+
+    chair = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), "chair", relief_m=0.1)
+    frames = [make_frame([*room(), chair], pose_looking_x(), k / 30.0, k) for k in range(20)]
+
+    def box(**options):
+        stage = ForegroundStage(detector="log", pixel_step=2, **options)
+        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+        (inst,) = world.foreground.values()
+        return np.concatenate([inst.box.center_m, inst.box.extent_m])
+
+    assert np.allclose(box(), box(complete_footprints=False))
+
+
+def test_a_base_is_hidden_by_something_nearer_below_it_not_by_what_it_stands_on():
+    from hiper_cli.perceive.foreground.segment import Blob
+    from hiper_cli.perceive.foreground.whole import bottom_hidden
+
+    v, u = np.mgrid[100:200:2, 300:340:2]
+    uv = np.stack([u.ravel(), v.ravel()], axis=1).astype(np.int32)
+    points = np.column_stack([np.zeros(len(uv)), np.zeros(len(uv)), np.full(len(uv), 3.5)])
+    blob = Blob(points, points.copy(), uv, np.array([299.0, 99.0, 341.0, 201.0]))
+    depth = np.zeros((480, 640), np.float32)
+    depth[201:, :] = 3.45  # the floor it stands on, just before its base
+    assert not bottom_hidden(blob, depth, 2)
+    depth[201:, :] = 2.0  # a counter's front 1.5 m before it
+    assert bottom_hidden(blob, depth, 2)
+    depth[201:, :] = 0.0  # no return below it
+    assert not bottom_hidden(blob, depth, 2)
+    lower_uv = uv + np.array([0, 280], np.int32)
+    low = Blob(points, points.copy(), lower_uv, np.array([299.0, 379.0, 341.0, 480.0]))
+    assert bottom_hidden(low, depth, 2)  # cut by the image's bottom edge

@@ -14,7 +14,11 @@ background plane) behind the object, since nothing stands inside a wall.
 A chair behind a desk shows its seat under the desk's top and not its back: where no view
 showed an object's top (``SeenBox.top_seen``: something nearer lay just above the blob, or the
 image ended there), a class with a least height (``LEAST_HEIGHT_M``: a chair with a back is at
-least 0.7 m tall) has its box raised to that height above its bottom.
+least 0.7 m tall) has its box raised to that height above its bottom. The back of a chair seen
+across a table shows above the table's top and not its seat or legs: where no view showed where
+an object stands (``SeenBox.bottom_seen``: something nearer lay just below the blob, or the image
+ended there), a class that stands on the floor (``FLOOR_STANDING``) has its box lowered to the
+floor.
 
 How long a bed cut by a doorway's side is, and on which side the rest of it lies, the views do
 not tell: the length is not completed.
@@ -29,7 +33,8 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
 
-__all__ = ["FOOTPRINT_MIN_WIDTH_M", "LEAST_HEIGHT_M", "complete_footprint", "complete_height"]
+__all__ = ["FLOOR_STANDING", "FOOTPRINT_MIN_WIDTH_M", "LEAST_HEIGHT_M", "complete_base", "complete_footprint",
+           "complete_height"]
 
 FloatArray = NDArray[np.float64]
 
@@ -46,6 +51,8 @@ LEAST_HEIGHT_M: dict[str, float] = {
 }
 """COCO class -> the height (m) of its lowest common instance (a chair with a back, a low couch's
 back, an under-counter refrigerator)."""
+FLOOR_STANDING = frozenset({"bed", "bench", "chair", "couch", "refrigerator", "toilet"})
+"""COCO classes whose objects stand on the floor, never on a table or a shelf."""
 WALL_MIN_NORMAL = 0.87  # a wall faces along a map axis when its normal is within 30° of it
 WALL_GAP_M = 0.02  # an extension stops this short of a wall behind the object
 
@@ -90,6 +97,19 @@ def complete_height(
     upper = np.array(upper_m, dtype=np.float64)
     upper[2] = lower_m[2] + height
     return lower_m, upper
+
+
+def complete_base(
+    lower_m: FloatArray, upper_m: FloatArray, class_name: str, bottom_seen: bool, floor_z_m: float
+) -> tuple[FloatArray, FloatArray]:
+    """(lower, upper) corners of an object whose base no view showed (``bottom_seen`` false):
+    down to the floor (``floor_z_m``, map frame) for a class in ``FLOOR_STANDING``. Unchanged
+    otherwise."""
+    if class_name not in FLOOR_STANDING or bottom_seen or lower_m[2] <= floor_z_m:
+        return lower_m, upper_m
+    lower = np.array(lower_m, dtype=np.float64)
+    lower[2] = floor_z_m
+    return lower, upper_m
 
 
 def _wall_behind(lower: FloatArray, upper: FloatArray, axis: int, sign: int, walls: Sequence[Box3D]) -> float:

@@ -46,6 +46,7 @@ class SeenBox:
     # per blob: the camera's position, map frame (NaN: not given), for ``amodal``
     viewpoints_m: list[FloatArray] = field(default_factory=list)
     tops_hidden: list[bool] = field(default_factory=list)  # per blob: its top was not in view
+    bottoms_hidden: list[bool] = field(default_factory=list)  # per blob: its base was not in view
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
     _moved: tuple[int, bool] | None = field(default=None, repr=False)
 
@@ -56,6 +57,7 @@ class SeenBox:
         named: bool = False,
         viewpoint_m: FloatArray | None = None,
         top_hidden: bool = False,
+        bottom_hidden: bool = False,
     ) -> None:
         self.lower_m.append(np.asarray(lower_m, dtype=np.float64))
         self.upper_m.append(np.asarray(upper_m, dtype=np.float64))
@@ -63,20 +65,22 @@ class SeenBox:
         view = _NO_VIEWPOINT if viewpoint_m is None else np.asarray(viewpoint_m, dtype=np.float64)
         self.viewpoints_m.append(view)
         self.tops_hidden.append(bool(top_hidden))
+        self.bottoms_hidden.append(bool(bottom_hidden))
         if len(self.lower_m) > 2 * MAX_SEEN_BOXES:  # trimmed in batches: amortised O(1)
             del self.lower_m[:-MAX_SEEN_BOXES]
             del self.upper_m[:-MAX_SEEN_BOXES]
             del self.named[:-MAX_SEEN_BOXES]
             del self.viewpoints_m[:-MAX_SEEN_BOXES]
             del self.tops_hidden[:-MAX_SEEN_BOXES]
+            del self.bottoms_hidden[:-MAX_SEEN_BOXES]
         self._cache = None
         self._moved = None
 
     def extend(self, other: SeenBox) -> None:
         """Add the blobs of ``other`` (a track this one absorbed)."""
-        for lo, hi, named, view, hidden in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m,
-                                               other.tops_hidden, strict=True):
-            self.add(lo, hi, named, view, hidden)
+        for blob in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m, other.tops_hidden,
+                        other.bottoms_hidden, strict=True):
+            self.add(*blob)
 
     def __len__(self) -> int:
         return len(self.lower_m)
@@ -104,6 +108,12 @@ class SeenBox:
         """Whether views showed the object's top: at least ``SEEN_BOX_QUANTILE`` of the blobs
         the box is of (``_used``), as many as its upper quantile needs, had it in view."""
         hidden = self._used(self.tops_hidden).astype(bool)
+        return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
+
+    def bottom_seen(self) -> bool:
+        """Whether views showed where the object stands: at least ``SEEN_BOX_QUANTILE`` of the
+        blobs the box is of (``_used``), as many as its lower quantile needs, had its base in view."""
+        hidden = self._used(self.bottoms_hidden).astype(bool)
         return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
 
     def moved(self) -> bool:

@@ -25,7 +25,13 @@ from hiper_cli.learned import (
 )
 from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
-from hiper_cli.perceive.foreground.amodal import LEAST_HEIGHT_M, complete_footprint, complete_height
+from hiper_cli.perceive.foreground.amodal import (
+    FLOOR_STANDING,
+    LEAST_HEIGHT_M,
+    complete_base,
+    complete_footprint,
+    complete_height,
+)
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.carried import drop_carried
@@ -51,7 +57,7 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     withdraw_mapped,
 )
 from hiper_cli.perceive.foreground.vacated import EmptyPlaces
-from hiper_cli.perceive.foreground.whole import inside_image, occluded, seen_whole, top_hidden
+from hiper_cli.perceive.foreground.whole import bottom_hidden, inside_image, occluded, seen_whole, top_hidden
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
 
@@ -140,6 +146,7 @@ class ForegroundStage:
         self._priors: dict[tuple[str, str], ObjectDynamics | SizeFeature | AltitudeFeature] = {}
         self._analyses_seen = -1
         self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
+        self._floor_mapped = False  # the background found a floor (``complete_base``)
         self.tracker = Tracker(cfg, self._class_prior)
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
@@ -276,6 +283,7 @@ class ForegroundStage:
         walls = self._walls = _wall_boxes(world)
         tops = support_boxes(inst for inst in world.background.values() if inst.class_name == "table")
         self._floor_z_m = floor_height_m(world.background.values())
+        self._floor_mapped = any(inst.class_name == "floor" for inst in world.background.values())
         if cfg.background_filter and cfg.table_leg_band_m > 0:
             for inst in world.background.values():
                 if inst.class_name == "table":
@@ -378,6 +386,8 @@ class ForegroundStage:
                     viewpoint_map_m=frame.T_map_cam[:3, 3],
                     top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
                     and top_hidden(blob, frame.depth_m, cfg.pixel_step),
+                    bottom_hidden=cfg.complete_footprints and match.class_name in FLOOR_STANDING
+                    and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -556,12 +566,16 @@ class ForegroundStage:
         return inst
 
     def _box(self, track: Track) -> Box3D:
-        """The instance's box: ``object_box``; a static object's completed behind the faces seen
-        and up to its class's least height when no view showed its top (``amodal.py``)."""
+        """The instance's box: ``object_box``; a static object's completed behind the faces seen,
+        down to the floor when no view showed where it stands, and up to its class's least height
+        when no view showed its top (``amodal.py``)."""
         centre, extent = object_box(track, self.tracker.config)
         if self.config.complete_footprints and is_static(track, self.tracker.config):
             lower, upper = complete_footprint(centre - extent / 2.0, centre + extent / 2.0, track.class_name,
                                               track.seen.viewpoint(), self._walls)
+            if self._floor_mapped:
+                lower, upper = complete_base(lower, upper, track.class_name, track.seen.bottom_seen(),
+                                             self._floor_z_m)
             lower, upper = complete_height(lower, upper, track.class_name, track.seen.top_seen())
             centre, extent = (lower + upper) / 2.0, upper - lower
         return Box3D(centre, extent)

@@ -133,6 +133,8 @@ class Measurement:
     (``amodal``)."""
     top_hidden: bool = False
     """The view did not show the object's top (``whole.top_hidden``; ``amodal``)."""
+    bottom_hidden: bool = False
+    """The view did not show where the object stands (``whole.bottom_hidden``; ``amodal``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -445,7 +447,8 @@ class Tracker:
         track.last_update_s = stamp_s
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
+                       m.bottom_hidden)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -762,7 +765,8 @@ class Tracker:
             min_class_share=self.config.min_class_share,
             size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
         )
-        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden)
+        track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
+                       m.bottom_hidden)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

@@ -10,7 +10,8 @@ A blob inside the image may still be cut by something nearer: a bed seen through
 couch behind a chair (``occluded``). Its outline then borders nearer surfaces; an object seen
 whole borders only farther ones, or what it stands on. A blob whose top borders a nearer
 surface (a chair's seat under a desk's top) does not show how tall its object is
-(``top_hidden``).
+(``top_hidden``); one whose bottom borders a nearer surface (the back of a chair behind a table,
+above the table's top) does not show where its object stands (``bottom_hidden``).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["inside_image", "occluded", "seen_whole", "thickness_m", "top_hidden"]
+__all__ = ["bottom_hidden", "inside_image", "occluded", "seen_whole", "thickness_m", "top_hidden"]
 
 OCCLUDER_MARGIN_M = 0.15  # a surface this much nearer than the blob beside it stands in front
 OCCLUDER_RING_CELLS = 2  # ... within this many samples of the blob's outline
@@ -110,4 +111,24 @@ def top_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> boo
         return False
     near = float(np.median(blob.points_cam[:, 2])) - OCCLUDER_MARGIN_M
     nearer = ((rows > 0) & (rows < near)).any(axis=0)
+    return bool(nearer.mean() >= TOP_HIDDEN_SHARE)
+
+
+def bottom_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> bool:
+    """Whether the camera did not see where ``blob``'s object stands: the blob reaches the image's
+    bottom edge, or the image rows just below its box (``OCCLUDER_RING_CELLS`` samples) show, in
+    ``TOP_HIDDEN_SHARE`` of its columns, something more than ``OCCLUDER_MARGIN_M`` nearer than
+    the blob's lowest samples (a table's top in front of the back of the chair behind it). What
+    an object stands on meets its base at the base's depth, and hides nothing."""
+    step, reach = pixel_step, pixel_step * OCCLUDER_RING_CELLS
+    x0, _, x1, y1 = (int(v) for v in blob.image_box_xyxy)
+    height = depth_m.shape[0]
+    if y1 >= height - step:
+        return True
+    rows = depth_m[y1:min(y1 + reach, height), x0:max(x1, x0 + 1):step].astype(np.float64)
+    if rows.size == 0:
+        return False
+    v = blob.pixels_uv[:, 1]
+    base = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
+    nearer = ((rows > 0) & (rows < base - OCCLUDER_MARGIN_M)).any(axis=0)
     return bool(nearer.mean() >= TOP_HIDDEN_SHARE)
