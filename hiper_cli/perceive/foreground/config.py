@@ -154,9 +154,13 @@ class SegmentConfig(BackgroundFilterConfig):
     again (``legs.py``, ``refine.py``; 0: off) ..."""
     unseen_table_min_height_m: float = 0.6
     unseen_table_max_height_m: float = 1.2
-    unseen_table_skip_classes: tuple[str, ...] = ("couch", "bed", "bench", "dining table", "toilet")
+    unseen_table_skip_classes: tuple[str, ...] = ("couch", "bed", "dining table", "toilet")
     """... except in blobs matched to these detector classes: furniture with tops of its own (a
     couch's arms and back are such a slab) ..."""
+    unseen_table_lookalikes: tuple[str, ...] = ("bench",)
+    """... A detection of these classes (no top at table height: a bench's seat lies below it)
+    whose blob holds a table top named the table, and names nothing else in that frame
+    (YOLOX-Nano names a table with things on it ``bench``) ..."""
     unseen_table_holding: float = 0.8
     """... and also in a blob that no detection names but that holds a detected object: a
     detection box (not of those classes) lies at least this share inside the blob's image box
@@ -211,7 +215,7 @@ class SegmentConfig(BackgroundFilterConfig):
         if self.cluster_tolerance_m <= 0:
             raise ConfigError("cluster_tolerance_m and gate_m must be positive")
         _nonnegative(self, ("table_rim_depth_m", "table_rim_reach_m"))
-        _as_tuples(self, ("unseen_table_skip_classes",))
+        _as_tuples(self, ("unseen_table_skip_classes", "unseen_table_lookalikes"))
 
 
 @dataclass(frozen=True)

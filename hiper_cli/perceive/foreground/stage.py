@@ -317,9 +317,11 @@ class ForegroundStage:
         hidden = self._hidden(frame)
         names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
         if cfg.background_filter:
-            blobs, found_tables = split_unseen_tables(
+            blobs, found_tables, lookalikes = split_unseen_tables(
                 blobs, usable, names, cfg, frame.camera.width, frame.camera.height
             )
+            if lookalikes:  # each named a table: none names what remains of its blob
+                dets, ok, usable, names = _without(dets, ok, np.flatnonzero(ok)[lookalikes])
             found_tables = join_hidden_pieces(
                 found_tables, hidden, cfg, frame.camera.width, frame.camera.height
             )
@@ -620,6 +622,18 @@ class ForegroundStage:
             return np.asarray(ok & ~occluded)
 
         return visible
+
+
+def _without(
+    dets: Detections, ok: NDArray[np.bool_], drop: NDArray[np.int64]
+) -> tuple[Detections, NDArray[np.bool_], FloatArray, list[str]]:
+    """``dets`` without the detections ``drop``, and its usable mask, boxes and class names."""
+    keep = np.ones(len(dets), dtype=bool)
+    keep[drop] = False
+    kept = Detections(dets.xyxy[keep], tuple(n for n, k in zip(dets.class_names, keep, strict=True) if k),
+                      dets.scores[keep])
+    ok = ok[keep]
+    return kept, ok, kept.xyxy[ok], [n for n, k in zip(kept.class_names, ok, strict=True) if k]
 
 
 def _wall_boxes(world: World) -> list[Box3D]:

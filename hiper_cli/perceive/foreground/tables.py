@@ -9,7 +9,9 @@ horizontal slab at table height, of columns that end there (a person or a chair'
 the table rises above it), whose footprint spans ``unseen_table_min_side_m`` along its minor
 axis (a chair's back or a shelf board is narrow). The slab and the legs under it
 (``legs.leg_points``) leave the blob, and what remains is clustered again as the segmentation
-does; parts smaller than ``min_cluster_points`` are dropped. Once the background layer maps the
+does; parts smaller than ``min_cluster_points`` are dropped. A detection of a class with no top
+at table height (``unseen_table_lookalikes``: a bench's seat is lower) whose blob holds a table
+top named the table, not what remains of the blob. Once the background layer maps the
 table, its filter removes the top and ``legs.py`` the legs before this step.
 
 Each frame decides anew. Remembering a table found once and removing it from every blob that
@@ -134,15 +136,18 @@ def drop_unseen_tables(
 def split_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
     width: int, height: int,
-) -> tuple[list[Blob], list[Blob]]:
+) -> tuple[list[Blob], list[Blob], list[int]]:
     """(``blobs`` without the tops and legs of tables found in them, one blob per table found:
-    its top and legs); ``boxes_xyxy`` (K, 4) and ``classes`` are this frame's detections."""
+    its top and legs, the indices of the detections of an ``unseen_table_lookalikes`` class that
+    name a blob holding a table: they named the table); ``boxes_xyxy`` (K, 4) and ``classes``
+    are this frame's detections."""
     tables: list[Blob] = []
+    lookalikes: list[int] = []
     if config.unseen_table_min_side_m <= 0 or not blobs:
-        return blobs, tables
+        return blobs, tables, lookalikes
     boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0:
-        return blobs, tables
+        return blobs, tables, lookalikes
     out: list[Blob] = []
     blob_boxes = np.array([blob.image_box_xyxy for blob in blobs])
     ious = iou_matrix(blob_boxes, boxes)
@@ -159,6 +164,8 @@ def split_unseen_tables(
         if top is None:
             out.append(blob)
             continue
+        lookalikes.extend(j for j in np.flatnonzero(iou >= config.trim_iou).tolist()
+                          if classes[j] in config.unseen_table_lookalikes)
         on_table = table_points(blob.points_map, top, config)
         if np.count_nonzero(on_table) >= config.min_cluster_points:
             tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
@@ -166,7 +173,7 @@ def split_unseen_tables(
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
                 out.append(_part(blob, rest[part], top, config, width, height))
-    return out, tables
+    return out, tables, lookalikes
 
 
 def _held(
