@@ -63,3 +63,28 @@ def test_eval_reports_the_class_lists_it_applied(tmp_path):
     assert "person" not in report["ours"]["classification"]
     report = json.loads(CliRunner().invoke(app, base).output)
     assert "fire hydrant" in report["exclude_classes"] and "person" in report["ours"]["classification"]
+
+
+def _boxes(*rows):
+    """Detections from (class, score, x0, y0, x1, y1) rows."""
+    return Detections(np.array([r[2:] for r in rows], dtype=np.float64), tuple(r[0] for r in rows),
+                      np.array([r[1] for r in rows]))
+
+
+def test_an_object_the_detector_named_twice_keeps_its_surer_name():
+    from hiper_cli.perceive.foreground.classes import one_name_per_box
+
+    twice = _boxes(("vase", 0.45, 100, 100, 130, 180), ("bottle", 0.6, 101, 99, 131, 181))
+    kept = one_name_per_box(twice, 0.8)
+    assert kept.class_names == ("bottle",) and np.allclose(kept.xyxy, [[101, 99, 131, 181]])
+    assert one_name_per_box(twice, 1.0) is twice  # off
+
+
+def test_objects_that_overlap_less_or_share_a_class_keep_their_boxes():
+    from hiper_cli.perceive.foreground.classes import one_name_per_box
+
+    seated = _boxes(("person", 0.9, 100, 50, 200, 300), ("chair", 0.7, 90, 150, 210, 320))  # IoU 0.54
+    cup_in_hand = _boxes(("person", 0.9, 100, 50, 200, 300), ("cup", 0.6, 180, 120, 200, 140))
+    bottles = _boxes(("bottle", 0.9, 100, 100, 130, 180), ("bottle", 0.5, 102, 100, 132, 180))  # NMS's job
+    for d in (seated, cup_in_hand, bottles):
+        assert one_name_per_box(d, 0.8) is d

@@ -16,7 +16,7 @@ from hiper_cli.perceive.foreground.config import (
 from hiper_cli.pipeline import parse_stage_options
 
 DETECTOR_FIELDS = {"detector", "min_detection_score", "detector_threads", "classes", "exclude_classes",
-                   "carried_classes", "carried_containment"}
+                   "carried_classes", "carried_containment", "same_box_iou"}
 
 
 def test_every_option_belongs_to_exactly_one_part_or_the_detector():

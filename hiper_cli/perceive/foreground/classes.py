@@ -13,6 +13,12 @@ detections of every frame before refinement and matching (so ``hiper perceive`` 
   house can contain; when given, every other class is dropped.
 
 A dropped detection is as if the detector had not reported it: its blob stays ``unknown``.
+
+A detector's non-maximum suppression is per class, so an object it cannot name for sure (a
+bottle or a vase, a bench or a chair) keeps two boxes of different classes in one place, and
+the frames where the second name wins can start a track of their own. ``one_name_per_box``
+keeps, of two boxes of different classes that overlap by ``same_box_iou`` (IoU), the one with
+the higher score: a person on a chair, a cup in a hand or a bottle on a table overlap far less.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ import numpy as np
 
 from hiper_cli.types import Detections
 
-__all__ = ["INDOOR_EXCLUDED", "filter_classes"]
+__all__ = ["INDOOR_EXCLUDED", "filter_classes", "one_name_per_box"]
 
 INDOOR_EXCLUDED: tuple[str, ...] = (
     "bicycle", "car", "motorcycle", "airplane", "bus", "train", "truck", "boat",
@@ -56,3 +62,25 @@ def filter_classes(
         tuple(n for n, k in zip(detections.class_names, keep, strict=True) if k),
         detections.scores[keep],
     )
+
+
+def one_name_per_box(detections: Detections, iou: float) -> Detections:
+    """``detections`` without each box that overlaps a box of another class with a higher score
+    by ``iou`` or more (1: unchanged)."""
+    n = len(detections)
+    if n < 2 or iou >= 1.0:
+        return detections
+    xyxy, scores, names = detections.xyxy, detections.scores, detections.class_names
+    lo = np.maximum(xyxy[:, None, :2], xyxy[None, :, :2])
+    hi = np.minimum(xyxy[:, None, 2:], xyxy[None, :, 2:])
+    inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
+    area = np.prod(np.clip(xyxy[:, 2:] - xyxy[:, :2], 0.0, None), axis=1)
+    overlap = inter / np.maximum(area[:, None] + area[None, :] - inter, 1e-9)
+    other = np.array(names)[:, None] != np.array(names)[None, :]
+    keep = np.ones(n, dtype=bool)
+    for i in np.argsort(-scores, kind="stable"):
+        if keep[i]:
+            keep &= ~(other[i] & (overlap[i] >= iou))  # the lower-scored namings of box i
+    if keep.all():
+        return detections
+    return Detections(xyxy[keep], tuple(n for n, k in zip(names, keep, strict=True) if k), scores[keep])

@@ -602,11 +602,15 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
     (a bag on a walker's arm, a phone at an ear) and is dropped before refinement, so the
     person's box names the blob; empty: off."""
     carried_containment: float = 0.8
+    same_box_iou: float = 0.8
+    """Two detections of different classes whose boxes overlap by this IoU are one object the
+    detector named twice (``classes.one_name_per_box``: a bottle and a vase, a bench and a
+    chair): the one with the higher score stays; 1: off."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
         _as_tuples(self, ("classes", "exclude_classes", "carried_classes"))
-        _in_unit_interval(self, ("carried_containment",))
+        _in_unit_interval(self, ("carried_containment", "same_box_iou"))
 
     @classmethod
     def from_options(cls, **options: Any) -> ForegroundConfig:

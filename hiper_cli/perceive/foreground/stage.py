@@ -35,7 +35,7 @@ from hiper_cli.perceive.foreground.amodal import (
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
 from hiper_cli.perceive.foreground.carried import drop_carried
-from hiper_cli.perceive.foreground.classes import filter_classes
+from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
@@ -308,6 +308,7 @@ class ForegroundStage:
         else:
             dets, detect_s = self._detect_timed(frame)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
+        dets = one_name_per_box(dets, cfg.same_box_iou)
         dets = drop_carried(dets, cfg.carried_classes, cfg.walker_classes, cfg.carried_containment,
                             cfg.min_detection_score)
         t_det = time.perf_counter()
