@@ -88,3 +88,11 @@ def test_objects_that_overlap_less_or_share_a_class_keep_their_boxes():
     bottles = _boxes(("bottle", 0.9, 100, 100, 130, 180), ("bottle", 0.5, 102, 100, 132, 180))  # NMS's job
     for d in (seated, cup_in_hand, bottles):
         assert one_name_per_box(d, 0.8) is d
+
+
+def test_a_person_seated_in_an_armchair_keeps_both_boxes():
+    from hiper_cli.perceive.foreground.classes import one_name_per_box
+
+    seated = _boxes(("chair", 0.8, 100, 100, 200, 260), ("person", 0.6, 102, 98, 198, 255))  # IoU 0.92
+    assert one_name_per_box(seated, 0.8, apart=("person",)) is seated
+    assert one_name_per_box(seated, 0.8).class_names == ("chair",)  # without the exception

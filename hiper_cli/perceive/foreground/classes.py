@@ -18,7 +18,8 @@ A detector's non-maximum suppression is per class, so an object it cannot name f
 bottle or a vase, a bench or a chair) keeps two boxes of different classes in one place, and
 the frames where the second name wins can start a track of their own. ``one_name_per_box``
 keeps, of two boxes of different classes that overlap by ``same_box_iou`` (IoU), the one with
-the higher score: a person on a chair, a cup in a hand or a bottle on a table overlap far less.
+the higher score: a cup in a hand or a bottle on a table overlap far less. People are left out
+(``walker_classes``): a person seated in an armchair can fill the chair's box.
 """
 
 from __future__ import annotations
@@ -64,9 +65,10 @@ def filter_classes(
     )
 
 
-def one_name_per_box(detections: Detections, iou: float) -> Detections:
+def one_name_per_box(detections: Detections, iou: float, apart: Iterable[str] = ()) -> Detections:
     """``detections`` without each box that overlaps a box of another class with a higher score
-    by ``iou`` or more (1: unchanged)."""
+    by ``iou`` or more (1: unchanged). Boxes of the classes ``apart`` (people: a person seated in
+    an armchair fills the chair's box) neither drop nor are dropped."""
     n = len(detections)
     if n < 2 or iou >= 1.0:
         return detections
@@ -76,7 +78,9 @@ def one_name_per_box(detections: Detections, iou: float) -> Detections:
     inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
     area = np.prod(np.clip(xyxy[:, 2:] - xyxy[:, :2], 0.0, None), axis=1)
     overlap = inter / np.maximum(area[:, None] + area[None, :] - inter, 1e-9)
-    other = np.array(names)[:, None] != np.array(names)[None, :]
+    left_out = frozenset(apart)
+    own = np.array([name not in left_out for name in names], dtype=bool)
+    other = (np.array(names)[:, None] != np.array(names)[None, :]) & own[:, None] & own[None, :]
     keep = np.ones(n, dtype=bool)
     for i in np.argsort(-scores, kind="stable"):
         if keep[i]:

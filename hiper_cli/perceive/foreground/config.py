@@ -605,7 +605,7 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
     same_box_iou: float = 0.8
     """Two detections of different classes whose boxes overlap by this IoU are one object the
     detector named twice (``classes.one_name_per_box``: a bottle and a vase, a bench and a
-    chair): the one with the higher score stays; 1: off."""
+    chair): the one with the higher score stays; ``walker_classes`` are left out; 1: off."""
 
     def __post_init__(self) -> None:
         super().__post_init__()

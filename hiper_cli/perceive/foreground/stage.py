@@ -308,7 +308,7 @@ class ForegroundStage:
         else:
             dets, detect_s = self._detect_timed(frame)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
-        dets = one_name_per_box(dets, cfg.same_box_iou)
+        dets = one_name_per_box(dets, cfg.same_box_iou, cfg.walker_classes)
         dets = drop_carried(dets, cfg.carried_classes, cfg.walker_classes, cfg.carried_containment,
                             cfg.min_detection_score)
         t_det = time.perf_counter()
