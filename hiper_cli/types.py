@@ -151,6 +151,11 @@ class Detections:
     def __len__(self) -> int:
         return len(self.class_names)
 
+    def subset(self, keep: NDArray[np.bool_]) -> Detections:
+        """The detections where ``keep`` (N,) is true, in their order."""
+        return Detections(self.xyxy[keep], tuple(n for n, k in zip(self.class_names, keep, strict=True) if k),
+                          self.scores[keep])
+
     @classmethod
     def empty(cls) -> Detections:
         return cls(np.zeros((0, 4)), (), np.zeros(0))

@@ -6,10 +6,27 @@ import numpy as np
 import pytest
 
 from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.amodal import complete_footprint
 from hiper_cli.perceive.foreground.seen_box import SeenBox
+from hiper_cli.perceive.runner import run_stages
+from hiper_cli.perceive.stage import World
+from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
 
 STRIP = (np.array([10.0, 4.0, 0.0]), np.array([11.0, 4.26, 0.6]))  # a bed's side, 0.26 m deep
+
+
+def _frames(*things):
+    """20 frames of ``things`` in the test room, seen from the origin along +x, 1 m high."""
+    return [make_frame([*room(), *things], pose_looking_x(), k / 30.0, k) for k in range(20)]
+
+
+def _foreground(frames, **options):
+    """The foreground instances a ``ForegroundStage`` (the frames' own detections) makes of
+    ``frames``, with ``options``."""
+    stage = ForegroundStage(detector="log", pixel_step=2, **options)
+    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+    return list(world.foreground.values())
 
 
 def _complete(cls, view, walls=()):
@@ -59,19 +76,12 @@ def test_the_seen_box_remembers_where_its_named_blobs_were_seen_from():
 
 
 def test_a_refrigerator_seen_from_the_front_is_as_deep_as_one_in_the_knowledge_base():
-    from hiper_cli.perceive.foreground import ForegroundStage
-    from hiper_cli.perceive.runner import run_stages
-    from hiper_cli.perceive.stage import World
-    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
-
     # 0.7 m deep, taller than the camera: only its front (and the handles' relief) is in view
     fridge = SceneBox(10, np.array([2.9, 0.0, 0.9]), np.array([0.7, 0.7, 1.8]), "refrigerator", relief_m=0.1)
-    frames = [make_frame([*room(), fridge], pose_looking_x(), k / 30.0, k) for k in range(20)]
+    frames = _frames(fridge)
 
     def centre_x(**options):
-        stage = ForegroundStage(detector="log", pixel_step=2, **options)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
-        (inst,) = world.foreground.values()
+        (inst,) = _foreground(frames, **options)
         assert inst.class_name == "refrigerator"
         return inst.box.center_m[0], inst.box.extent_m[0]
 
@@ -99,20 +109,13 @@ def test_a_chair_whose_top_no_view_showed_is_as_tall_as_a_chair():
 
 
 def test_a_chair_behind_a_panel_is_raised_to_a_chairs_height_in_the_knowledge_base():
-    from hiper_cli.perceive.foreground import ForegroundStage
-    from hiper_cli.perceive.runner import run_stages
-    from hiper_cli.perceive.stage import World
-    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
-
     chair = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), "chair", relief_m=0.1)
     # a desk's front, 2 m before it, from 0.6 m up: the camera (1 m high) sees the chair's legs only
     panel = SceneBox(11, np.array([2.0, 0.0, 0.9]), np.array([0.05, 2.0, 0.6]), "other")
-    frames = [make_frame([*room(), chair, panel], pose_looking_x(), k / 30.0, k) for k in range(20)]
+    frames = _frames(chair, panel)
 
     def chair_box(**options):
-        stage = ForegroundStage(detector="log", pixel_step=2, **options)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
-        (inst,) = [i for i in world.foreground.values() if i.class_name == "chair"]
+        (inst,) = [i for i in _foreground(frames, **options) if i.class_name == "chair"]
         return inst.box.center_m[2] - inst.box.extent_m[2] / 2, inst.box.extent_m[2]
 
     bottom, seen_height = chair_box(complete_footprints=False)
@@ -140,17 +143,9 @@ def test_a_chair_whose_base_no_view_showed_stands_on_the_floor():
 def _behind_a_counter(obstacle_class, **options):
     """The box (bottom, height) of an object 0.9 m tall 3.5 m before the camera (1 m high), with
     a counter's front 0.75 m high 2 m before the camera: only the object's upper part is in view."""
-    from hiper_cli.perceive.foreground import ForegroundStage
-    from hiper_cli.perceive.runner import run_stages
-    from hiper_cli.perceive.stage import World
-    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
-
     thing = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), obstacle_class, relief_m=0.1)
     counter = SceneBox(11, np.array([2.0, 0.0, 0.375]), np.array([0.05, 2.0, 0.75]), "other")
-    frames = [make_frame([*room(), thing, counter], pose_looking_x(), k / 30.0, k) for k in range(20)]
-    stage = ForegroundStage(detector="log", pixel_step=2, **options)
-    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
-    (inst,) = [i for i in world.foreground.values() if i.class_name == obstacle_class]
+    (inst,) = [i for i in _foreground(_frames(thing, counter), **options) if i.class_name == obstacle_class]
     return inst.box.center_m[2] - inst.box.extent_m[2] / 2, inst.box.extent_m[2]
 
 
@@ -168,18 +163,11 @@ def test_what_may_stand_on_a_table_keeps_the_base_it_was_seen_with():
 
 
 def test_a_chair_seen_standing_keeps_its_box():
-    from hiper_cli.perceive.foreground import ForegroundStage
-    from hiper_cli.perceive.runner import run_stages
-    from hiper_cli.perceive.stage import World
-    from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
-
     chair = SceneBox(10, np.array([3.5, 0.0, 0.45]), np.array([0.5, 0.5, 0.9]), "chair", relief_m=0.1)
-    frames = [make_frame([*room(), chair], pose_looking_x(), k / 30.0, k) for k in range(20)]
+    frames = _frames(chair)
 
     def box(**options):
-        stage = ForegroundStage(detector="log", pixel_step=2, **options)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
-        (inst,) = world.foreground.values()
+        (inst,) = _foreground(frames, **options)
         return np.concatenate([inst.box.center_m, inst.box.extent_m])
 
     assert np.allclose(box(), box(complete_footprints=False))

@@ -147,19 +147,16 @@ def test_two_things_named_side_by_side_stay_two_whatever_a_blob_spans():
     """Office 45: two chairs 0.26 m apart, named side by side in the image; a blob that joined
     them put both under one chair's footprint. Two bottles side by side, one atop the other's
     footprint by depth noise, likewise stay two."""
-    left = ([11.28, 7.41, 0.0], [11.72, 7.85, 0.92], "chair", [8, 218, 57, 330])
-    both = ([11.28, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [8, 218, 57, 330])
-    right = ([11.98, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [50, 214, 100, 323])
-    run = _Run()
-    run.frames([left], 30)
-    run.frames([both, right], 60)
-    assert len(run.instances) == 2
-    left = ([0.0, 0.0, 0.8], [0.08, 0.1, 1.1], "bottle", [100, 200, 130, 300])
-    right = ([0.04, 0.0, 0.8], [0.12, 0.1, 1.1], "bottle", [140, 200, 170, 300])
-    run = _Run()
-    run.frames([left], 30)
-    run.frames([left, right], 60)
-    assert len(run.instances) == 2
+    chair = ([11.28, 7.41, 0.0], [11.72, 7.85, 0.92], "chair", [8, 218, 57, 330])
+    both_chairs = ([11.28, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [8, 218, 57, 330])
+    other_chair = ([11.98, 7.41, 0.0], [12.42, 7.85, 0.92], "chair", [50, 214, 100, 323])
+    bottle = ([0.0, 0.0, 0.8], [0.08, 0.1, 1.1], "bottle", [100, 200, 130, 300])
+    other_bottle = ([0.04, 0.0, 0.8], [0.12, 0.1, 1.1], "bottle", [140, 200, 170, 300])
+    for first, then in (([chair], [both_chairs, other_chair]), ([bottle], [bottle, other_bottle])):
+        run = _Run()
+        run.frames(first, 30)
+        run.frames(then, 60)
+        assert len(run.instances) == 2, first
 
 
 def test_fold_keeps_time_order_and_the_earlier_first_sighting():

@@ -50,7 +50,4 @@ def drop_carried(
     drop[np.flatnonzero(is_carried)] = (share >= min_containment) & (area > 0)
     if not drop.any():
         return detections
-    keep = ~drop
-    return Detections(
-        xyxy[keep], tuple(n for n, k in zip(names, keep, strict=True) if k), detections.scores[keep]
-    )
+    return detections.subset(~drop)

@@ -28,6 +28,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.types import Detections
 
 __all__ = ["INDOOR_EXCLUDED", "filter_classes", "one_name_per_box"]
@@ -56,13 +57,7 @@ def filter_classes(
     keep = np.array(
         [(not allow or name in allow) and name not in deny for name in detections.class_names], dtype=bool
     )
-    if keep.all():
-        return detections
-    return Detections(
-        detections.xyxy[keep],
-        tuple(n for n, k in zip(detections.class_names, keep, strict=True) if k),
-        detections.scores[keep],
-    )
+    return detections if keep.all() else detections.subset(keep)
 
 
 def one_name_per_box(detections: Detections, iou: float, apart: Iterable[str] = ()) -> Detections:
@@ -72,19 +67,13 @@ def one_name_per_box(detections: Detections, iou: float, apart: Iterable[str] = 
     n = len(detections)
     if n < 2 or iou >= 1.0:
         return detections
-    xyxy, scores, names = detections.xyxy, detections.scores, detections.class_names
-    lo = np.maximum(xyxy[:, None, :2], xyxy[None, :, :2])
-    hi = np.minimum(xyxy[:, None, 2:], xyxy[None, :, 2:])
-    inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
-    area = np.prod(np.clip(xyxy[:, 2:] - xyxy[:, :2], 0.0, None), axis=1)
-    overlap = inter / np.maximum(area[:, None] + area[None, :] - inter, 1e-9)
+    names = detections.class_names
+    overlap = iou_matrix(detections.xyxy, detections.xyxy)
     left_out = frozenset(apart)
     own = np.array([name not in left_out for name in names], dtype=bool)
     other = (np.array(names)[:, None] != np.array(names)[None, :]) & own[:, None] & own[None, :]
     keep = np.ones(n, dtype=bool)
-    for i in np.argsort(-scores, kind="stable"):
+    for i in np.argsort(-detections.scores, kind="stable"):
         if keep[i]:
             keep &= ~(other[i] & (overlap[i] >= iou))  # the lower-scored namings of box i
-    if keep.all():
-        return detections
-    return Detections(xyxy[keep], tuple(n for n, k in zip(names, keep, strict=True) if k), scores[keep])
+    return detections if keep.all() else detections.subset(keep)

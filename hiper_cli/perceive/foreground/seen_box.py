@@ -107,13 +107,17 @@ class SeenBox:
     def top_seen(self) -> bool:
         """Whether views showed the object's top: at least ``SEEN_BOX_QUANTILE`` of the blobs
         the box is of (``_used``), as many as its upper quantile needs, had it in view."""
-        hidden = self._used(self.tops_hidden).astype(bool)
-        return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
+        return self._shown(self.tops_hidden)
 
     def bottom_seen(self) -> bool:
         """Whether views showed where the object stands: at least ``SEEN_BOX_QUANTILE`` of the
         blobs the box is of (``_used``), as many as its lower quantile needs, had its base in view."""
-        hidden = self._used(self.bottoms_hidden).astype(bool)
+        return self._shown(self.bottoms_hidden)
+
+    def _shown(self, hidden_per_blob: list[bool]) -> bool:
+        """Whether at least ``SEEN_BOX_QUANTILE`` of the blobs the box is of (``_used``) were not
+        hidden there (no blob: shown)."""
+        hidden = self._used(hidden_per_blob).astype(bool)
         return len(hidden) == 0 or float(np.mean(~hidden)) >= SEEN_BOX_QUANTILE
 
     def moved(self) -> bool:

@@ -631,8 +631,7 @@ def _without(
     """``dets`` without the detections ``drop``, and its usable mask, boxes and class names."""
     keep = np.ones(len(dets), dtype=bool)
     keep[drop] = False
-    kept = Detections(dets.xyxy[keep], tuple(n for n, k in zip(dets.class_names, keep, strict=True) if k),
-                      dets.scores[keep])
+    kept = dets.subset(keep)
     ok = ok[keep]
     return kept, ok, kept.xyxy[ok], [n for n, k in zip(kept.class_names, ok, strict=True) if k]
 

@@ -109,9 +109,7 @@ def top_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> boo
     rows = depth_m[max(y0 - step * OCCLUDER_RING_CELLS, 0):y0, x0:max(x1, x0 + 1):step].astype(np.float64)
     if rows.size == 0:
         return False
-    near = float(np.median(blob.points_cam[:, 2])) - OCCLUDER_MARGIN_M
-    nearer = ((rows > 0) & (rows < near)).any(axis=0)
-    return bool(nearer.mean() >= TOP_HIDDEN_SHARE)
+    return _nearer_across(rows, float(np.median(blob.points_cam[:, 2])) - OCCLUDER_MARGIN_M)
 
 
 def bottom_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> bool:
@@ -130,5 +128,11 @@ def bottom_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> 
         return False
     v = blob.pixels_uv[:, 1]
     base = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
-    nearer = ((rows > 0) & (rows < base - OCCLUDER_MARGIN_M)).any(axis=0)
+    return _nearer_across(rows, base - OCCLUDER_MARGIN_M)
+
+
+def _nearer_across(rows: NDArray[np.float64], limit_m: float) -> bool:
+    """Whether image ``rows`` (depth, m; 0: no return) show a return nearer than ``limit_m`` in
+    ``TOP_HIDDEN_SHARE`` of their columns."""
+    nearer = ((rows > 0) & (rows < limit_m)).any(axis=0)
     return bool(nearer.mean() >= TOP_HIDDEN_SHARE)
