@@ -113,6 +113,15 @@ def test_foreground_scores(tiny):
     assert fg["classified_precision"] == pytest.approx(2 / 3) and fg["unknown"] == 1
     assert fg["centre_error_mean_m"] == pytest.approx(np.hypot(0.05, 0.05), abs=1e-6)
     assert fg["walkers_matched"] == 1 and fg["walker_speed_error_mps"] == pytest.approx(0.0, abs=0.01)
+    assert fg["dynamic_instances"] == 1 and fg["state_accuracy"] == 1.0
+
+
+def test_a_walker_left_static_is_a_wrong_state(tiny):
+    insts = [i for i in _instances() if i.class_name != "person"]
+    walker = next(i for i in _instances() if i.class_name == "person")
+    walker.state = "static"  # what every walker was once its track closed
+    fg = score_scene(load_truth(tiny), load_surfaces(tiny), [*insts, walker])["foreground"]
+    assert fg["dynamic_instances"] == 0 and fg["state_accuracy"] == pytest.approx(0.5)
 
 
 def test_a_table_the_foreground_found_is_right_and_one_it_left_to_the_background_no_miss(tiny):

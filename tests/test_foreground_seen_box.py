@@ -3,8 +3,10 @@ few stray blobs; a moved object is told from one seen from different sides; a ch
 a table and its seat below stay one chair, two cups side by side stay two."""
 
 import numpy as np
+import pytest
 
 from hiper_cli.perceive.foreground.config import TrackerConfig
+from hiper_cli.perceive.foreground.moving import is_dynamic
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker, object_box
 
@@ -77,3 +79,26 @@ def test_two_cups_side_by_side_stay_two():
     right = ([0.19, 0.0, 0.75], [0.27, 0.08, 0.85], "cup")
     tracker = _static_run([[left]] * 30 + [[]] * 75 + [[right]] * 30)
     assert len({t.uuid for t in tracker.tracks + tracker.dormant}) == 2
+
+
+def test_a_blob_that_grew_went_nowhere_a_walker_went_its_way():
+    grew, walked = SeenBox(), SeenBox()
+    for k in range(40):
+        _add(grew, [0.0, 0.0, 1.0], [0.1 + 0.025 * k, 0.3, 1.3])  # more of a shelf came into view
+        _add(walked, [0.03 * k, 0.0, 0.0], [0.03 * k + 0.4, 0.3, 1.7])
+    assert grew.shift_m() == 0.0
+    assert walked.shift_m() == pytest.approx(0.9, abs=0.01)  # the quarters' medians, 30 blobs apart
+
+
+def test_an_unknown_that_walked_is_dynamic_one_that_moved_in_spells_is_not():
+    def state(xs):
+        tracker = _static_run([[([x, 0.0, 0.0], [x + 0.4, 0.3, 1.7], "unknown")] for x in xs])
+        (track,) = tracker.tracks
+        return is_dynamic(track, tracker.config)
+
+    assert state([0.05 * k for k in range(60)])  # 0.75 m/s for 4 s
+    # a blob that shifts for 0.67 s at a time, three times, as the camera passes what it is
+    spells = [0.0] * 20
+    for _ in range(3):
+        spells += [spells[-1] + 0.06 * (i + 1) for i in range(10)] + [spells[-1] + 0.6] * 20
+    assert not state(spells)

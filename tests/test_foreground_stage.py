@@ -75,6 +75,34 @@ def test_walker_becomes_one_dynamic_person_with_its_speed():
     assert np.hypot(rows[:, 4], rows[:, 5]).mean() == pytest.approx(0.6, abs=0.05)
     assert inst.box.center_m[0] == pytest.approx(2.85, abs=0.05)  # the visible front at x = 2.85
     assert len(inst.observation_uuids) == 60
+    assert inst.state == "dynamic"  # after the log ended and its track closed
+
+
+def _instances_after(frames):
+    stage = ForegroundStage(detector="log", pixel_step=2)
+    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+    return list(world.foreground.values())
+
+
+def test_a_walker_that_stopped_is_dynamic_and_a_person_standing_still_static():
+    def frames(walk_frames):  # walks 0.6 m/s for walk_frames, then stands until frame 90
+        return [make_frame([*room(), person(10, 3.0, -1.0 + 0.6 * min(k, walk_frames) / RATE_HZ)],
+                           pose_looking_x(), k / RATE_HZ, k) for k in range(90)]
+
+    (walked,) = _instances_after(frames(45))
+    assert walked.class_name == "person" and walked.state == "dynamic"
+    (stood,) = _instances_after(frames(0))
+    assert stood.class_name == "person" and stood.state == "static"
+
+
+def test_a_static_object_is_static_and_a_moving_one_dynamic():
+    still = [make_frame([*room(), chair(11, 4.0, 1.0)], pose_looking_x(), k / RATE_HZ, k) for k in range(60)]
+    (chair_inst,) = _instances_after(still)
+    assert chair_inst.class_name == "chair" and chair_inst.state == "static"
+    pushed = [make_frame([*room(), chair(11, 4.0, 1.5 - 1.5 * k / 60)], pose_looking_x(), k / RATE_HZ, k)
+              for k in range(60)]
+    states = {i.class_name: i.state for i in _instances_after(pushed)}
+    assert states == {"chair": "dynamic"}
 
 
 def test_observations_carry_the_low_level_data():
@@ -161,6 +189,23 @@ def test_eval_foreground_command_on_a_small_sim_log(tmp_path):
     assert ours["moving_people_speed_error_mps"] == pytest.approx(0.0, abs=0.05)
     assert ours["localisation_visible_m"][0] < 0.06  # a 160x120 camera: 4 cm pixels at 4 m
     assert ours["frames"] == 60 and "ablation" not in report
+
+
+def test_moving_people_are_found_after_the_log_is_perceived(tmp_path):
+    log, kb = tmp_path / "log", tmp_path / "kb.hiper"
+    write_sim_log(log, seconds=2.0)
+    runner = CliRunner()
+    result = runner.invoke(app, ["perceive", str(log), "--kb", str(kb), "--detector", "truth",
+                                 "-o", "foreground.pixel_step=2"])
+    assert result.exit_code == 0, result.output
+
+    def count(words):
+        answer = runner.invoke(app, ["query", words, "--kb", str(kb), "--json"])
+        assert answer.exit_code == 0, answer.output
+        return json.loads(answer.output)["count"]
+
+    assert count("moving people") == 1 and count("static people") == 0
+    assert count("static chairs") == 1 and count("moving objects") == 1
 
 
 def test_eval_foreground_needs_ground_truth(tmp_path):

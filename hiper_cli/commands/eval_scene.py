@@ -74,6 +74,8 @@ def show_scene_eval(data: dict[str, Any]) -> None:
               f"{_f(f['classified_precision'])} ({f['unknown']} unknown, "
               f"{_f(f['unknown_on_nothing'])} of them on no real object); person instances per person "
               f"{_f(f['persons_per_person'])}")
+    out.print(f"  static/dynamic: {f['dynamic_instances']} dynamic instances; state of the matched ones "
+              f"right {_f(f['state_accuracy'])}")
     for name, c in f["per_class"].items():
         out.print(f"  {name:<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
     out.print(f"  unmatched, by what they lie on: {f['unmatched']}")

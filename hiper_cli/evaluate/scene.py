@@ -17,6 +17,8 @@ The definitions follow the worlds' reference scorer (``gt/README.md`` of each wo
   is put down to the class of the nearest true object it would match but for its class, or to
   ``nothing`` (``unmatched``; ``unknown_on_nothing`` is the share of unknown instances that lie
   on no real object); ``persons_per_person`` = person instances per true person observed;
+  ``state_accuracy`` = share of matched instances whose state (static or dynamic) is their true
+  object's (a walker that stood still at the end is still a dynamic object);
 - localisation: centre error of matched static objects; person speed: of each person matched
   to a walker, the median filtered speed at its stamps where the walker walked, against the
   median true speed there (the worlds' walkers keep one speed; a simulated one stops for
@@ -217,6 +219,7 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
     known = [pi for pi, p in enumerate(preds) if p.class_name != "unknown"]
     known_tp = sum(pi in matched for pi in known)
     errors = [d for pi, (tid, d) in matched.items() if truth.instances[tid].state != "dynamic"]
+    same_state = [preds[pi].state == truth.instances[tid].state for pi, (tid, _) in matched.items()]
     speeds = []
     for pi, (tid, _) in matched.items():
         t = truth.instances[tid]
@@ -241,6 +244,8 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
         "unknown_on_nothing": _ratio(unmatched["unknown->nothing"], len(preds) - len(known)),
         "persons_per_person": _ratio(sum(p.class_name == "person" for p in preds),
                                      sum(t.class_name == "person" and t.observed for t in gt)),
+        "state_accuracy": _ratio(sum(same_state), len(same_state)),
+        "dynamic_instances": sum(p.state == "dynamic" for p in preds),
         "per_class": dict(sorted(per_class.items())),
         "unmatched": dict(sorted(unmatched.items())),
         "centre_error_mean_m": float(np.mean(errors)) if errors else None,

@@ -427,6 +427,14 @@ class TrackerConfig(_Part):
     moving_window_s: float = 1.0
     min_moving_span_s: float = 0.5
     """... and a track observed for less than this long is not known to move."""
+    dynamic_moving_s: float = 1.0
+    dynamic_travel_m: float = 0.5
+    """A walker's or ``unknown`` track is ``dynamic`` once it was moving (as above) and both
+    sides of its blobs' box went this far horizontally, an ``unknown`` one only after it kept
+    moving at every update for ``dynamic_moving_s`` (``moving.note_travel``); it stays so after
+    it stops or is lost: a person who walked is a dynamic object. A static blob that changes as
+    the camera passes moves in spells of a few frames, and one that grew as more of it came
+    into view went nowhere."""
     velocity_decay_s: float = 0.5
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
     velocity_prior_mps: float = 1.0
@@ -534,7 +542,8 @@ class TrackerConfig(_Part):
     smooth_closed_tracks: bool = True
     """Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
     dynamic_speed_mps: float = 0.15
-    """A track moving faster than this is ``dynamic``; slower is ``static``."""
+    """The evaluation counts a true person faster than this as walking (the moving-people speed
+    figures); an instance's state is ``moving.is_dynamic``."""
     use_learned_priors: bool = True
     """Use ``ods``/``size``/``altitude`` analyses from the knowledge base when they exist
     (``hiper analyze features``); off: the paper's C2 ablation. Each part can be switched alone:"""

@@ -1,8 +1,12 @@
-"""Whether a track is a static object or was moving when last seen.
+"""Whether a track is a static object, was moving when last seen, or is a dynamic object.
 
 A static object's filtered velocity is no evidence (partial views move a blob's centroid); its
 blobs staying where they were is (``SeenBox.moved``). An ``unknown`` track may be a person not
 named yet, so it is judged by its filter and its displacement together (``was_moving``).
+
+An instance's state says what the object is, not what it did last: a person who walked and
+then stood, or whose track ended with the log, is ``dynamic`` (``is_dynamic``), so "moving
+people" finds the people who walked after the log is perceived.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from hiper_cli.perceive.foreground.stitch import UNKNOWN
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["is_static", "was_moving"]
+__all__ = ["is_dynamic", "is_static", "note_travel", "was_moving"]
 
 
 def is_static(track: Track, config: TrackerConfig) -> bool:
@@ -45,6 +49,36 @@ def was_moving(track: Track, config: TrackerConfig) -> bool:
     moving = _moving_rows(rows, config)
     track._moving = (len(rows), moving)
     return moving
+
+
+def note_travel(track: Track, config: TrackerConfig) -> None:
+    """Mark a walker's or ``unknown`` track ``travelled`` once it is moving (``was_moving``) and
+    its blobs went ``dynamic_travel_m`` or more (``SeenBox.shift_m``: both sides of the box
+    moved; a blob that grew as more of a shelf came into view moved its centre 0.9 m but one
+    side only). An ``unknown`` must also have kept moving at every update for
+    ``dynamic_moving_s``: a static blob that changes as the camera passes moves in spells of a
+    few frames, while a person, named so, may be seen walking for a second only. Called after
+    each update, so any stretch of walking counts (a walker back where it started did go
+    somewhere); the boxes are read only while it moves."""
+    walker = track.class_name in config.walker_classes
+    if track.travelled or not (walker or track.class_name == UNKNOWN):
+        return
+    if not was_moving(track, config):
+        track.moving_since_s = None
+        return
+    stamp = track.trajectory[-1][ROW_STAMP]
+    if track.moving_since_s is None:
+        track.moving_since_s = stamp
+    if walker or stamp - track.moving_since_s >= config.dynamic_moving_s:
+        track.travelled = track.seen.shift_m() >= config.dynamic_travel_m
+
+
+def is_dynamic(track: Track, config: TrackerConfig) -> bool:
+    """Whether the object moved while seen: a walker or ``unknown`` that travelled
+    (``note_travel``), another object whose blobs moved (``SeenBox.moved``)."""
+    if track.class_name in config.walker_classes or track.class_name == UNKNOWN:
+        return track.travelled
+    return track.seen.moved()
 
 
 def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:

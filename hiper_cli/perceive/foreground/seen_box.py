@@ -133,6 +133,20 @@ class SeenBox:
             self._moved = (n, self._moved_now())
         return self._moved[1]
 
+    def shift_m(self) -> float:
+        """How far the object went, horizontally: between the (median) box of its first quarter
+        of blobs and that of its last, the lesser move of the two sides along each axis when
+        both moved the same way (0 otherwise). A blob that grew as more of it came into view
+        moved one side only; a walker moves both (0 with fewer than ``MIN_MOVED_BOXES``)."""
+        if len(self.lower_m) < MIN_MOVED_BOXES:
+            return 0.0
+        lower, upper = self._boxes()
+        k = max(len(lower) // 4, 1)
+        d_lower = np.median(lower[-k:, :2], axis=0) - np.median(lower[:k, :2], axis=0)
+        d_upper = np.median(upper[-k:, :2], axis=0) - np.median(upper[:k, :2], axis=0)
+        both = np.where(d_lower * d_upper > 0, np.minimum(np.abs(d_lower), np.abs(d_upper)), 0.0)
+        return float(np.hypot(*both))
+
     def _moved_now(self) -> bool:
         lower, upper = self._boxes()
         k = max(len(lower) // 4, 1)

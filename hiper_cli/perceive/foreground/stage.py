@@ -40,12 +40,13 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes
-from hiper_cli.perceive.foreground.moving import is_static
+from hiper_cli.perceive.foreground.moving import is_dynamic, is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
+from hiper_cli.perceive.foreground.stitch import UNKNOWN
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
@@ -462,7 +463,11 @@ class ForegroundStage:
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
 
     def _stays(self, inst: Instance) -> bool:
-        return inst.class_name not in self.tracker.config.walker_classes and inst.state == "static"
+        """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
+        chair pushed across the room stays where it was pushed)."""
+        if inst.class_name in self.tracker.config.walker_classes:
+            return False
+        return inst.class_name != UNKNOWN or inst.state == "static"
 
     def _look_for_earlier(self, frame: Frame, world: World) -> None:
         """Whether this frame saw the places of earlier sessions' static objects empty."""
@@ -542,8 +547,7 @@ class ForegroundStage:
         )
 
     def _instance(self, track: Track) -> Instance:
-        speed = float(np.hypot(*track.velocity[:2]))
-        state = "dynamic" if speed > self.config.dynamic_speed_mps and not track.closed else "static"
+        state = "dynamic" if is_dynamic(track, self.tracker.config) else "static"
         box = self._box(track)
         inst = self._instances.get(track.uuid)
         if inst is None:

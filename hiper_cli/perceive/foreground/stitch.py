@@ -239,6 +239,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     for cls, longest in new.class_longest_m.items():
         old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
     old.score_sum += new.score_sum
+    old.travelled = old.travelled or new.travelled
     old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked
     old._class_name = None
     old.standing_tops_m.extend(new.standing_tops_m)
@@ -267,6 +268,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
         new.motion.reset(x, np.array(new.motion.P, dtype=np.float64))
     old.extent_m = new.extent_m
     old.motion = new.motion
+    old.moving_since_s = new.moving_since_s
     old.hits += new.hits
     old.max_size_m = max(old.max_size_m, new.max_size_m)
     old.last_update_s = new.last_update_s

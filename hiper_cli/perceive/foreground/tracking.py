@@ -55,7 +55,7 @@ from hiper_cli.model import ROW_POSITION, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model
-from hiper_cli.perceive.foreground.moving import is_static, was_moving
+from hiper_cli.perceive.foreground.moving import is_static, note_travel, was_moving
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 from hiper_cli.perceive.foreground.same_object import (
     STAMP_DECIMALS,
@@ -203,6 +203,10 @@ class Track:
     # covariance and the process noise (q, q_vertical) used
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
+    # it kept moving and went somewhere (``moving.note_travel``): a dynamic object; since when
+    # it has been moving at every update (None: not moving)
+    travelled: bool = False
+    moving_since_s: float | None = None
     _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
     # ``moving.was_moving`` for the trajectory of this many rows (rows change only by being added)
     _moving: tuple[int, bool] | None = field(default=None, repr=False)
@@ -512,6 +516,7 @@ class Tracker:
         if m.appearance is not None and m.class_name in self.config.walker_classes:
             track.appearance = m.appearance if track.appearance is None else track.appearance + m.appearance
         track.trajectory.append([track.last_update_s, *track.position.tolist(), *track.velocity.tolist()])
+        note_travel(track, self.config)
         q = self._accel_noise(track.class_name) ** 2
         track.covariances.append(np.array(track.motion.P, dtype=np.float64))
         track.noises.append((q, self._vertical_noise(track, q)))
