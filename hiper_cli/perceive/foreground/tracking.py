@@ -203,8 +203,8 @@ class Track:
     # covariance and the process noise (q, q_vertical) used
     covariances: list[FloatArray] = field(default_factory=list)
     noises: list[tuple[float, float]] = field(default_factory=list)
-    # it kept moving and went somewhere (``moving.note_travel``): a dynamic object; since when
-    # it has been moving at every update (None: not moving)
+    # it was seen moving and went somewhere (``moving.note_travel``): a dynamic object; since
+    # when it has been moving at every update (None: not moving)
     travelled: bool = False
     moving_since_s: float | None = None
     _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
