@@ -102,3 +102,11 @@ def test_an_unknown_that_walked_is_dynamic_one_that_moved_in_spells_is_not():
     for _ in range(3):
         spells += [spells[-1] + 0.06 * (i + 1) for i in range(10)] + [spells[-1] + 0.6] * 20
     assert not state(spells)
+
+
+def test_a_cup_whose_blob_slid_a_hand_width_is_static():
+    xs = [0.0] * 12 + [0.021 * (i + 1) for i in range(10)] + [0.21] * 12
+    tracker = _static_run([[([x, 0.0, 0.8], [x + 0.08, 0.08, 0.9], "cup")] for x in xs])
+    (track,) = tracker.tracks
+    assert track.seen.moved()  # its boxes left where they were ...
+    assert not is_dynamic(track, tracker.config)  # ... by 0.21 m: not a cup that went somewhere

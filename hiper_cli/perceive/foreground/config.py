@@ -429,12 +429,12 @@ class TrackerConfig(_Part):
     """... and a track observed for less than this long is not known to move."""
     dynamic_moving_s: float = 1.0
     dynamic_travel_m: float = 0.5
-    """A walker's or ``unknown`` track is ``dynamic`` once it was moving (as above) and both
-    sides of its blobs' box went this far horizontally, an ``unknown`` one only after it kept
-    moving at every update for ``dynamic_moving_s`` (``moving.note_travel``); it stays so after
-    it stops or is lost: a person who walked is a dynamic object. A static blob that changes as
-    the camera passes moves in spells of a few frames, and one that grew as more of it came
-    into view went nowhere."""
+    """A track is ``dynamic`` once it was moving (as above) and both sides of its blobs' box
+    went this far horizontally, one not of a walker class only after it kept moving at every
+    update for ``dynamic_moving_s`` and when its blobs moved (``SeenBox.moved``; not asked of
+    ``unknown``) (``moving.is_dynamic``); it stays so after it stops or is lost: a person who
+    walked is a dynamic object. A static blob that changes as the camera passes moves in spells
+    of a few frames, and one that grew as more of it came into view went nowhere."""
     velocity_decay_s: float = 0.5
     """Time constant of the exponential decay of a track's velocity while it gets no updates."""
     velocity_prior_mps: float = 1.0

@@ -52,16 +52,15 @@ def was_moving(track: Track, config: TrackerConfig) -> bool:
 
 
 def note_travel(track: Track, config: TrackerConfig) -> None:
-    """Mark a walker's or ``unknown`` track ``travelled`` once it is moving (``was_moving``) and
-    its blobs went ``dynamic_travel_m`` or more (``SeenBox.shift_m``: both sides of the box
-    moved; a blob that grew as more of a shelf came into view moved its centre 0.9 m but one
-    side only). An ``unknown`` must also have kept moving at every update for
-    ``dynamic_moving_s``: a static blob that changes as the camera passes moves in spells of a
-    few frames, while a person, named so, may be seen walking for a second only. Called after
-    each update, so any stretch of walking counts (a walker back where it started did go
-    somewhere); the boxes are read only while it moves."""
-    walker = track.class_name in config.walker_classes
-    if track.travelled or not (walker or track.class_name == UNKNOWN):
+    """Mark ``track`` ``travelled`` once it is moving (``was_moving``) and its blobs went
+    ``dynamic_travel_m`` or more (``SeenBox.shift_m``: both sides of the box moved; a blob that
+    grew as more of a shelf came into view moved its centre 0.9 m but one side only). A track
+    not of a walker class must also have kept moving at every update for ``dynamic_moving_s``:
+    a static blob that changes as the camera passes moves in spells of a few frames, while a
+    person, named so, may be seen walking for a second only. Called after each update, so any
+    stretch of walking counts (a walker back where it started did go somewhere); the boxes are
+    read only while it moves."""
+    if track.travelled:
         return
     if not was_moving(track, config):
         track.moving_since_s = None
@@ -69,16 +68,19 @@ def note_travel(track: Track, config: TrackerConfig) -> None:
     stamp = track.trajectory[-1][ROW_STAMP]
     if track.moving_since_s is None:
         track.moving_since_s = stamp
+    walker = track.class_name in config.walker_classes
     if walker or stamp - track.moving_since_s >= config.dynamic_moving_s:
         track.travelled = track.seen.shift_m() >= config.dynamic_travel_m
 
 
 def is_dynamic(track: Track, config: TrackerConfig) -> bool:
-    """Whether the object moved while seen: a walker or ``unknown`` that travelled
-    (``note_travel``), another object whose blobs moved (``SeenBox.moved``)."""
+    """Whether the object moved while seen: it travelled (``note_travel``), and for a class
+    that does not walk its blobs moved too (``SeenBox.moved``: a TV seen in parts as the view
+    panned was also seen whole in between). An ``unknown`` may be a person not named yet: a
+    walker seen all along bridges where it was and where it went, so travelling is enough."""
     if track.class_name in config.walker_classes or track.class_name == UNKNOWN:
         return track.travelled
-    return track.seen.moved()
+    return track.travelled and track.seen.moved()
 
 
 def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:
