@@ -74,6 +74,19 @@ def test_table_output_and_one_line_errors(kb_path):
     assert "Traceback" not in bad.output
 
 
+def test_the_table_holds_one_line_per_hit_in_80_columns(kb_path):
+    hits = json.loads(runner.invoke(app, ["query", "objects", "--kb", kb_path, "--json"]).output)["hits"]
+    table = runner.invoke(app, ["query", "objects", "--kb", kb_path], env={"COLUMNS": "80"}).output
+    lines = table.splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("class "))
+    rows = [line for line in lines[header + 1 :] if line.strip()]
+    assert len(rows) == len(hits)
+    for row, hit in zip(rows, hits, strict=True):
+        tail = hit["uuid"].replace("-", "")[-8:]  # a uuid7 begins with the time: the tail tells apart
+        assert row.startswith(hit["class"]) and tail in row and hit["state"] in row
+    assert len({hit["uuid"][-8:] for hit in hits}) == len(hits)
+
+
 def test_pose_and_at_options(kb_path):
     far = runner.invoke(
         app, ["query", "chairs within 1 m of me", "--kb", kb_path, "--pose", "-50,-50,1.2,0", "--json"]

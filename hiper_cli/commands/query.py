@@ -161,18 +161,22 @@ def _print_sparql(body: bytes, as_json: bool) -> None:
 def _render_answer(answer: Any) -> None:
     from rich.table import Table
 
-    from hiper_cli.query.results import ago_text
+    from hiper_cli.query.results import ago_text, short_uuid
 
     out = console()
     out.print(f"[bold]{answer.text}[/]")
     if not answer.hits:
         return
-    table = Table("class", "uuid", "position m", "distance m", "last seen", "state", "speed m/s", "on", "obs")
+    # one line per hit in an 80-column terminal: no rules, one space between columns, only the
+    # support may be cut
+    table = Table(box=None, pad_edge=False, padding=(0, 1, 0, 0), header_style="bold underline")
+    for name in ("class", "uuid", "position m", "dist m", "seen", "state", "m/s", "on", "obs"):
+        table.add_column(name, no_wrap=name != "on")
     for h in answer.hits:
         x, y, z = h.center_map_m
         table.add_row(
             h.class_name,
-            h.uuid[:8],
+            short_uuid(h.uuid),
             f"{x:.2f} {y:.2f} {z:.2f}",
             f"{h.distance_m:.2f}",
             ago_text(h.last_seen_s, answer.now_s),

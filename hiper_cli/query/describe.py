@@ -12,7 +12,7 @@ import numpy as np
 
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query.index import instance_index
-from hiper_cli.query.results import TimeValue, ago_text, iso_time
+from hiper_cli.query.results import TimeValue, ago_text, iso_time, short_uuid
 from hiper_cli.query.templates import template
 
 __all__ = ["ClassCount", "Description", "describe"]
@@ -68,7 +68,7 @@ class Description:
             lines.append(
                 "Recent movers: "
                 + "; ".join(
-                    f"{m['class']} {m['uuid'][:8]} seen {ago_text(m['last_seen_s'], self.now_s)}"
+                    f"{m['class']} {short_uuid(m['uuid'])} seen {ago_text(m['last_seen_s'], self.now_s)}"
                     + (f" at {m['speed_mps']:.2f} m/s" if m["speed_mps"] is not None else "")
                     for m in self.movers
                 )

@@ -27,6 +27,7 @@ __all__ = [
     "Trajectory",
     "ago_text",
     "iso_time",
+    "short_uuid",
 ]
 
 SCHEMA_VERSION = 1
@@ -37,6 +38,12 @@ ANSWER_KINDS: tuple[str, ...] = ("list", "count", "yes_no", "time", "duration", 
 def iso_time(stamp_s: float) -> str:
     """The stamp as ISO 8601 UTC (a simulated log's stamps start at 1970-01-01T00:00:00Z)."""
     return datetime.fromtimestamp(stamp_s, UTC).isoformat(timespec="milliseconds").replace("+00:00", "Z")
+
+
+def short_uuid(uuid: str) -> str:
+    """The last 8 hex digits of an instance's uuid, to tell instances apart in a table: a uuid7
+    begins with its creation time, the same for every instance of one run."""
+    return uuid.replace("-", "")[-8:]
 
 
 def ago_text(stamp_s: float, now_s: float) -> str:
