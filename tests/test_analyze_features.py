@@ -198,3 +198,15 @@ def test_size_and_altitude_of_a_moving_class_ignore_tracks_that_never_move(tmp_p
     (person,) = compute_features(kb, ["person"]).classes
     assert person.ods.instances == 16 and person.altitude.instances == 12
     assert person.altitude.hi_m < 0.05 and person.size.lo_m3 > 0.3
+
+
+def test_features_table_holds_one_line_per_class_in_80_columns(tmp_path):
+    _people_kb(tmp_path).close()
+    result = CliRunner().invoke(app, ["analyze", "features", "--kb", str(tmp_path / "kb"), "--no-store"],
+                                env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert any("[c_l, c_u] m/s" in line for line in lines)  # not eaten as markup
+    person = [line for line in lines if line.startswith("person ")]
+    assert len(person) == 2  # one row in each table, unwrapped
+    assert "%" in person[0] and person[1].count("[") == 2

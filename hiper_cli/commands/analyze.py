@@ -41,6 +41,37 @@ def _fmt(v: float | None, digits: int = 3) -> str:
     return "-" if v is None else f"{v:.{digits}f}"
 
 
+def _print_features(report: Any) -> None:
+    """The features as two tables, each one line per class in an 80-column terminal: the
+    Object Dynamic Score, then size and altitude."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    def narrow(title: str, *names: str) -> Table:
+        table = Table(title=title, title_justify="left", box=None, pad_edge=False, padding=(0, 1, 0, 0),
+                      header_style="bold underline")
+        for name in names:
+            table.add_column(escape(name), no_wrap=True)
+        return table
+
+    def interval(lo: float | None, hi: float | None) -> str:
+        return escape(f"[{_fmt(lo)}, {_fmt(hi)}]")
+
+    ods = narrow(f"object dynamics, {report.window.describe()}", "class", "tracks", "rows", "dynamic",
+                 "σ m/s", "μ_v m/s", "μ_v 95 % CI", "[c_l, c_u] m/s")
+    shape = narrow(escape("size and altitude (mean [95 % CI])"), "class", "size m³", "altitude m")
+    for c in report.classes:
+        o = c.ods
+        ods.add_row(c.class_name, str(o.instances), str(o.rows), f"{100 * o.ratio:.1f} %", _fmt(o.sigma_mps),
+                    _fmt(o.mean_mps), interval(o.mean_lo_mps, o.mean_hi_mps), interval(o.cl_mps, o.cu_mps))
+        size = f"{_fmt(c.size.mean_m3)} {interval(c.size.lo_m3, c.size.hi_m3)}" if c.size else "-"
+        alt = f"{_fmt(c.altitude.mean_m)} {interval(c.altitude.lo_m, c.altitude.hi_m)}" if c.altitude else "-"
+        shape.add_row(c.class_name, size, alt)
+    out = console()
+    out.print(ods)
+    out.print(shape)
+
+
 @analyze_app.command("features")
 def features_command(
     class_name: Annotated[
@@ -81,43 +112,8 @@ def features_command(
     if as_json:
         print_json(data)
         return
-    from rich.table import Table
-
-    table = Table(
-        "class",
-        "tracks",
-        "rows",
-        "dynamic",
-        "σ / m/s",
-        "μ_v / m/s",
-        "μ_v 95 % CI",
-        "[c_l, c_u] / m/s",
-        "size / m³ [95 %]",
-        "altitude / m [95 %]",
-        title=f"features, {report.window.describe()}",
-    )
-    for c in report.classes:
-        o = c.ods
-        size = f"{_fmt(c.size.mean_m3)} [{_fmt(c.size.lo_m3)}, {_fmt(c.size.hi_m3)}]" if c.size else "-"
-        alt = (
-            f"{_fmt(c.altitude.mean_m)} [{_fmt(c.altitude.lo_m)}, {_fmt(c.altitude.hi_m)}]"
-            if c.altitude
-            else "-"
-        )
-        table.add_row(
-            c.class_name,
-            str(o.instances),
-            str(o.rows),
-            f"{100 * o.ratio:.1f} %",
-            _fmt(o.sigma_mps),
-            _fmt(o.mean_mps),
-            f"[{_fmt(o.mean_lo_mps)}, {_fmt(o.mean_hi_mps)}]",
-            f"[{_fmt(o.cl_mps)}, {_fmt(o.cu_mps)}]",
-            size,
-            alt,
-        )
+    _print_features(report)
     out = console()
-    out.print(table)
     out.print(
         f"{len(stored)} analyses stored in {kb}" + (f"; histograms in {plot_path}" if plot_path else "")
     )
