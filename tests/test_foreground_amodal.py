@@ -92,6 +92,18 @@ def test_a_refrigerator_seen_from_the_front_is_as_deep_as_one_in_the_knowledge_b
     assert x - depth / 2 == pytest.approx(seen_x - seen_depth / 2) and 2.9 - x < (2.9 - seen_x) / 2
 
 
+def _one_view_in_ten_is_noise(hidden_flag, seen):
+    """One view in ten that showed the part is noise; three in twelve are as many as the box's
+    quantile takes."""
+    box = SeenBox()
+    for k in range(10):
+        box.add(np.zeros(3), np.ones(3), named=True, **{hidden_flag: k > 0})
+    assert not seen(box)
+    for _ in range(2):
+        box.add(np.zeros(3), np.ones(3), named=True, **{hidden_flag: False})
+    assert seen(box)
+
+
 def test_a_chair_whose_top_no_view_showed_is_as_tall_as_a_chair():
     from hiper_cli.perceive.foreground.amodal import complete_height
 
@@ -99,13 +111,7 @@ def test_a_chair_whose_top_no_view_showed_is_as_tall_as_a_chair():
     assert complete_height(lower, upper, "chair", top_seen=False)[1][2] == pytest.approx(0.7)
     for cls, seen in (("chair", True), ("bed", False)):  # its top in view; a class with no height
         assert np.allclose(complete_height(lower, upper, cls, top_seen=seen)[1], upper)
-    box = SeenBox()
-    for k in range(10):
-        box.add(np.zeros(3), np.ones(3), named=True, top_hidden=k > 0)
-    assert not box.top_seen()  # one view in ten is noise
-    box.add(np.zeros(3), np.ones(3), named=True, top_hidden=False)
-    box.add(np.zeros(3), np.ones(3), named=True, top_hidden=False)
-    assert box.top_seen()  # three in twelve: as many as the box's upper quantile takes
+    _one_view_in_ten_is_noise("top_hidden", SeenBox.top_seen)
 
 
 def test_a_chair_behind_a_panel_is_raised_to_a_chairs_height_in_the_knowledge_base():
@@ -131,13 +137,7 @@ def test_a_chair_whose_base_no_view_showed_stands_on_the_floor():
     assert np.allclose(base_lower, [0.0, 0.0, 0.02]) and np.allclose(base_upper, upper)
     for cls, seen in (("chair", True), ("bottle", False)):  # its base in view; a class on tables too
         assert np.allclose(complete_base(lower, upper, cls, bottom_seen=seen, floor_z_m=0.02)[0], lower)
-    box = SeenBox()
-    for k in range(10):
-        box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=k > 0)
-    assert not box.bottom_seen()  # one view in ten is noise
-    box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=False)
-    box.add(np.zeros(3), np.ones(3), named=True, bottom_hidden=False)
-    assert box.bottom_seen()  # three in twelve: as many as the box's lower quantile takes
+    _one_view_in_ten_is_noise("bottom_hidden", SeenBox.bottom_seen)
 
 
 def _behind_a_counter(obstacle_class, **options):

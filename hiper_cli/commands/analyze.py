@@ -4,12 +4,15 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands._render import console, group, print_json
+
+if TYPE_CHECKING:
+    from hiper_cli.analyze import FeatureReport
 
 __all__ = ["analyze_app", "register"]
 
@@ -41,7 +44,7 @@ def _fmt(v: float | None, digits: int = 3) -> str:
     return "-" if v is None else f"{v:.{digits}f}"
 
 
-def _print_features(report: Any) -> None:
+def _print_features(report: FeatureReport) -> None:
     """The features as two tables, each one line per class in an 80-column terminal: the
     Object Dynamic Score, then size and altitude."""
     from rich.markup import escape

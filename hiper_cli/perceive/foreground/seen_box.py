@@ -140,18 +140,23 @@ class SeenBox:
         moved one side only; a walker moves both (0 with fewer than ``MIN_MOVED_BOXES``)."""
         if len(self.lower_m) < MIN_MOVED_BOXES:
             return 0.0
-        lower, upper = self._boxes()
-        k = max(len(lower) // 4, 1)
-        d_lower = np.median(lower[-k:, :2], axis=0) - np.median(lower[:k, :2], axis=0)
-        d_upper = np.median(upper[-k:, :2], axis=0) - np.median(upper[:k, :2], axis=0)
+        (first_lo, first_hi), (last_lo, last_hi) = self._quarters()[2:]
+        d_lower, d_upper = last_lo - first_lo, last_hi - first_hi
         both = np.where(d_lower * d_upper > 0, np.minimum(np.abs(d_lower), np.abs(d_upper)), 0.0)
         return float(np.hypot(*both))
 
-    def _moved_now(self) -> bool:
+    def _quarters(self) -> tuple[FloatArray, FloatArray, tuple[FloatArray, FloatArray],
+                                 tuple[FloatArray, FloatArray]]:
+        """The blobs' (lower, upper) corners (``_boxes``), then the horizontal (lower, upper)
+        corners of the median box of the first quarter of them and of the last quarter."""
         lower, upper = self._boxes()
         k = max(len(lower) // 4, 1)
-        first_lo, first_hi = np.median(lower[:k, :2], axis=0), np.median(upper[:k, :2], axis=0)
-        last_lo, last_hi = np.median(lower[-k:, :2], axis=0), np.median(upper[-k:, :2], axis=0)
+        first = (np.median(lower[:k, :2], axis=0), np.median(upper[:k, :2], axis=0))
+        last = (np.median(lower[-k:, :2], axis=0), np.median(upper[-k:, :2], axis=0))
+        return lower, upper, first, last
+
+    def _moved_now(self) -> bool:
+        lower, upper, (first_lo, first_hi), (last_lo, last_hi) = self._quarters()
         gap = np.maximum(last_lo - first_hi, first_lo - last_hi)
         if not np.any(gap > MOVED_MARGIN_M):
             return False
