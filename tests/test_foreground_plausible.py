@@ -1,6 +1,6 @@
 """A detector's class must fit the 3D object it names (``plausible.py``): common-sense sizes,
-plumbing fixtures against a wall or in a counter, and what people carry is part of them
-(``carried.py``)."""
+plumbing fixtures against a wall or in a counter, what people carry is part of them
+(``carried.py``), and a class no view of the whole object gave is refused (``Track.refused``)."""
 
 import numpy as np
 import pytest
@@ -9,10 +9,13 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.carried import drop_carried
 from hiper_cli.perceive.foreground.config import TrackerConfig
+from hiper_cli.perceive.foreground.match import named_within
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
+from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker, object_box
+from hiper_cli.perceive.foreground.whole import in_full_view
 from hiper_cli.perceive.stage import World
-from hiper_cli.types import Detections, Frame
+from hiper_cli.types import CameraIntrinsics, Detections, Frame
 from tests.fg_scene import SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 RATE_HZ = 15.0
@@ -180,3 +183,91 @@ def test_only_views_of_the_whole_object_show_it_too_short(doorway, expected):
     for k in range(6):
         stage.process(make_frame([*scene, bed], pose_looking_x(), k / RATE_HZ, k), world)
     assert [t.class_name for t in stage.tracker.tracks] == [expected]
+
+
+def _refused_track(full_named: int, full_views: int = 10, within: frozenset[str] = frozenset(),
+                   detected: bool = True, **options):
+    """A track named ``chair`` in 12 views cut by the border (by a detection, or by its shape
+    when not ``detected``), then seen in ``full_views`` full views of which the first
+    ``full_named`` were named ``chair`` too, and the others held detections of the classes
+    ``within`` inside the blob's box."""
+    tracker = Tracker(TrackerConfig(**options))
+    centre, extent = np.array([3.0, 0.0, 0.6]), np.array([0.8, 0.35, 1.2])
+    for k in range(12 + full_views):
+        full = k >= 12
+        named = not full or k - 12 < full_named
+        m = Measurement(centre, extent, "chair" if named else "unknown", 0.6 if named else 0.0, f"o{k}",
+                        full_view=full, named_within=frozenset() if named else within,
+                        detection_index=0 if named and detected else None)
+        tracker.step(k / RATE_HZ, [m])
+    return tracker.tracks[0]
+
+
+def test_a_class_named_only_on_cut_views_and_declined_in_full_view_is_refused():
+    """A shelf YOLOX calls ``chair`` while the border cuts it, and names nothing whenever all of
+    it shows: no chair. One full view named is enough to keep the class; so is too few full
+    views to judge."""
+    assert _refused_track(0).class_name == "unknown"
+    assert _refused_track(0).search_class == "chair"  # it still says what it was taken for
+    assert _refused_track(1).class_name == "chair"
+    assert _refused_track(0, full_views=7).class_name == "chair"
+    assert _refused_track(0, refused_min_views=0).class_name == "chair"
+    assert _refused_track(2, refused_max_share=0.25).class_name == "unknown"
+    # a chair's box inside a blob that took no class (joined with the table beside it) is a
+    # view that named the chair; a book's box on the shelf is not
+    assert _refused_track(0, within=frozenset({"chair"})).class_name == "chair"
+    assert _refused_track(0, within=frozenset({"book"})).class_name == "unknown"
+    # a class its shape gave it (a table top found without a detector) is not the detector's to refuse
+    assert _refused_track(0, detected=False).class_name == "chair"
+
+
+def test_the_classes_of_detections_inside_a_blobs_box():
+    dets = _dets(("bottle", [100, 100, 120, 160], 0.7), ("cup", [118, 140, 150, 160], 0.6),
+                 ("chair", [90, 50, 300, 400], 0.9), ("book", [105, 105, 110, 110], 0.1))
+    within = named_within(np.array([95.0, 95.0, 140.0, 165.0]), dets, min_score=0.3, min_cover=0.5)
+    assert within == {"bottle", "cup"}  # the cup's box is 69 % inside; the chair's 5 %; the book too weak
+    assert named_within(np.array([95.0, 95.0, 140.0, 165.0]), _dets(), min_score=0.3, min_cover=0.5) == set()
+
+
+@pytest.mark.parametrize(("options", "expected"), [({}, "unknown"), ({"refused_min_views": 0}, "chair")])
+def test_stage_counts_only_views_of_the_whole_blob_against_a_class(options, expected):
+    """Named ``chair`` while the camera, 1.6 m to the side, sees the box cut by the image's
+    left edge; then, straight in front, the whole box shows and the detector names nothing."""
+    shelf = SceneBox(20, np.array([2.0, 0.0, 0.6]), np.array([0.35, 0.8, 1.2]), "chair")
+    world = World(background=background_instances(room()))
+    stage = ForegroundStage(detector="log", pixel_step=2, **options)
+    for k in range(20):
+        cut = k < 10
+        frame = make_frame([*room(), shelf], pose_looking_x(y=-1.6 if cut else 0.0), k / RATE_HZ, k)
+        if not cut:
+            frame = Frame(frame.stamp_s, frame.rgb, frame.depth_m, frame.camera, frame.T_map_cam, k,
+                          detections=_dets())
+        stage.process(frame, world)
+    track = stage.tracker.tracks[0]
+    assert track.class_counts["chair"] == 10 and track.full_named.get("chair", 0) == 0
+    assert track.full_views == (10 if options == {} else 0)  # not looked for when off
+    assert track.class_name == expected
+
+
+def test_a_full_view_shows_all_of_the_object_large_enough_to_name():
+    """Inside the image, at least 32 x 32 px, nothing nearer around, above or below it: the back
+    of a chair over a counter's top in front is a part, and so is a blob cut by the border."""
+    camera = CameraIntrinsics(width=640, height=480, fx=525.0, fy=525.0, cx=319.5, cy=239.5)
+
+    def blob_at(v0, v1, u0, u1):
+        v, u = np.mgrid[v0:v1:2, u0:u1:2]
+        uv = np.stack([u.ravel(), v.ravel()], axis=1).astype(np.int32)
+        points = np.column_stack([np.zeros(len(uv)), np.zeros(len(uv)), np.full(len(uv), 3.5)])
+        return Blob(points, points.copy(), uv, np.array([u0 - 1.0, v0 - 1.0, u1 + 1.0, v1 + 1.0]))
+
+    def full(blob, depth):
+        return in_full_view(blob, depth, camera, np.eye(4), 2, 1024.0)
+
+    depth = np.zeros((480, 640), np.float32)
+    depth[100:200, 300:340] = 3.5
+    depth[200:, :] = 3.45  # the floor it stands on
+    assert full(blob_at(100, 200, 300, 340), depth)
+    assert not full(blob_at(100, 120, 300, 320), depth)  # 22 x 22 px: too small to name
+    depth[200:, :] = 2.0  # a counter's front 1.5 m before it hides its lower part
+    assert not full(blob_at(100, 200, 300, 340), depth)
+    assert not full(blob_at(100, 200, 0, 40), np.zeros((480, 640), np.float32))  # cut by the border

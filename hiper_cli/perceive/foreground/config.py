@@ -375,6 +375,19 @@ class TrackerConfig(_Part):
     """... and when that class holds at least this share of the track's (score-weighted)
     known-class votes: a track whose detections keep swapping between two classes (a person
     half of the time taken for a teddy bear) stays ``unknown`` instead of guessing."""
+    refused_min_views: int = 8
+    """A track cannot take a class that detections gave it in at most ``refused_max_share`` of
+    its full views (``whole.in_full_view``: inside the image, not hidden in part, large enough)
+    once it has this many (0: off): a shelf named ``chair`` only while the image's border cut
+    it, and named nothing in every view that showed all of it, is no chair ..."""
+    refused_max_share: float = 0.0
+    full_view_min_px2: float = 1024.0
+    """... where a full view's image box covers at least this many pixels (32 x 32; smaller, a
+    detector may miss what it names up close) ..."""
+    full_view_cover: float = 0.5
+    """... and a full view counts for every class of a detection lying (this share of its box's
+    area) inside the blob's image box, named for the blob or not (``match.named_within``): a
+    bottle joined with the cup beside it in one blob was still named a bottle."""
     class_sizes: bool = True
     """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): an observation
     whose blob is longer than the largest instance of the class it was named is ``unknown``,
@@ -569,8 +582,9 @@ class TrackerConfig(_Part):
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m",
                             "stitch_pace_factor", "stitch_min_pace_mps", "search_max_footprint_m",
-                            "reidentify_moved_m"))
-        _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance"))
+                            "reidentify_moved_m", "refused_min_views", "full_view_min_px2"))
+        _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance", "refused_max_share",
+                                 "full_view_cover"))
 
 
 def _own(cls: type, base: type | None) -> frozenset[str]:

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.types import Detections
 
-__all__ = ["Match", "assign_classes", "iou_matrix"]
+__all__ = ["Match", "assign_classes", "iou_matrix", "named_within"]
 
 
 @dataclass(frozen=True)
@@ -77,3 +77,21 @@ def assign_classes(
         k = int(usable[j])
         out.append(Match(detections.class_names[k], float(detections.scores[k]), k, best))
     return out
+
+
+def named_within(
+    blob_box_xyxy: NDArray[np.float64], detections: Detections, *, min_score: float, min_cover: float
+) -> frozenset[str]:
+    """The classes of the detections (score at least ``min_score``) that lie mostly inside one
+    blob's image box: at least ``min_cover`` of a detection box's area. A blob that took no
+    class, or another one, may still hold a detection of a class (a bottle joined with the cup
+    beside it is no match for the bottle's box, yet the detector named the bottle there)."""
+    if len(detections) == 0:
+        return frozenset()
+    b = np.asarray(blob_box_xyxy, dtype=np.float64).reshape(4)
+    d = detections.xyxy
+    iw = np.clip(np.minimum(d[:, 2], b[2]) - np.maximum(d[:, 0], b[0]), 0, None)
+    ih = np.clip(np.minimum(d[:, 3], b[3]) - np.maximum(d[:, 1], b[1]), 0, None)
+    area = (d[:, 2] - d[:, 0]) * (d[:, 3] - d[:, 1])
+    inside = (area > 0) & (iw * ih >= min_cover * area) & (detections.scores >= min_score)
+    return frozenset(detections.class_names[k] for k in np.flatnonzero(inside))

@@ -39,7 +39,7 @@ from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_b
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
-from hiper_cli.perceive.foreground.match import Match, assign_classes
+from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import is_dynamic, is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
@@ -58,7 +58,14 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     withdraw_mapped,
 )
 from hiper_cli.perceive.foreground.vacated import EmptyPlaces
-from hiper_cli.perceive.foreground.whole import bottom_hidden, inside_image, occluded, seen_whole, top_hidden
+from hiper_cli.perceive.foreground.whole import (
+    bottom_hidden,
+    in_full_view,
+    inside_image,
+    occluded,
+    seen_whole,
+    top_hidden,
+)
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Detections, Frame
 
@@ -372,6 +379,9 @@ class ForegroundStage:
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
+            full = cfg.refused_min_views > 0 and in_full_view(
+                blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, cfg.full_view_min_px2
+            )
             walker = match.class_name in cfg.walker_classes
             named_px = None if match.detection_index is None else dets.xyxy[match.detection_index]
             observations.append(obs)
@@ -392,6 +402,11 @@ class ForegroundStage:
                     and top_hidden(blob, frame.depth_m, cfg.pixel_step),
                     bottom_hidden=cfg.complete_footprints and match.class_name in FLOOR_STANDING
                     and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
+                    full_view=full,
+                    named_within=named_within(
+                        blob.image_box_xyxy, dets, min_score=cfg.min_detection_score,
+                        min_cover=cfg.full_view_cover,
+                    ) if full else frozenset(),
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:

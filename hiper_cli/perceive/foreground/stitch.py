@@ -238,6 +238,10 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
         old.class_counts[cls] = old.class_counts.get(cls, 0) + count
     for cls, longest in new.class_longest_m.items():
         old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
+    old.full_views += new.full_views
+    old.detected_classes |= new.detected_classes
+    for cls, count in new.full_named.items():
+        old.full_named[cls] = old.full_named.get(cls, 0) + count
     old.score_sum += new.score_sum
     old.travelled = old.travelled or new.travelled
     old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked

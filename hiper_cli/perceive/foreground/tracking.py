@@ -135,6 +135,12 @@ class Measurement:
     """The view did not show the object's top (``whole.top_hidden``; ``amodal``)."""
     bottom_hidden: bool = False
     """The view did not show where the object stands (``whole.bottom_hidden``; ``amodal``)."""
+    full_view: bool = False
+    """The view showed all of the blob, large enough to name (``whole.in_full_view``): one in
+    which a detector named a class neither for the blob nor inside its box (``named_within``)
+    counts against that class (``Track.refused``)."""
+    named_within: frozenset[str] = frozenset()
+    """Classes of detections lying inside the blob's image box (``match.named_within``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -192,6 +198,12 @@ class Track:
     class_counts: dict[str, int] = field(default_factory=dict)
     # per known class, the longest of its blobs seen inside the image (``Measurement.longest_m``)
     class_longest_m: dict[str, float] = field(default_factory=dict)
+    # full views (``Measurement.full_view``) in all, and per known class those named it
+    full_views: int = 0
+    full_named: dict[str, int] = field(default_factory=dict)
+    detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
+    refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
+    refused_max_share: float = 0.0
     min_class_observations: int = 1
     min_class_share: float = 0.0
     size_tolerance: float | None = None  # ``class_size_tolerance`` when ``class_sizes`` is on
@@ -240,6 +252,7 @@ class Track:
         eligible = [
             k for k in sorted(known)
             if self.class_counts.get(k, 0) >= self.min_class_observations and self._long_enough(k)
+            and not self.refused(k)
         ]
         if not eligible:
             return UNKNOWN
@@ -270,6 +283,17 @@ class Track:
         if self.size_tolerance is None or seen is None:
             return True
         return seen >= min_longest_m(class_name, self.size_tolerance)
+
+    def refused(self, class_name: str) -> bool:
+        """Whether detections named ``class_name`` in at most ``refused_max_share`` of the track's
+        full views, once it has ``refused_min_views`` of them: a detector that gives a class
+        only to views cut by the image's border or hidden in part, and declines it whenever the
+        whole object shows, was naming a part that looks like something else."""
+        if self.refused_min_views <= 0 or self.full_views < self.refused_min_views:
+            return False
+        if class_name not in self.detected_classes:
+            return False  # named by its shape (a table top), not by a detector that could decline
+        return self.full_named.get(class_name, 0) <= self.refused_max_share * self.full_views
 
     @property
     def confidence(self) -> float:
@@ -504,9 +528,14 @@ class Tracker:
         if m.longest_m is not None and m.class_name != UNKNOWN:
             seen = track.class_longest_m.get(m.class_name, 0.0)
             track.class_longest_m[m.class_name] = max(seen, m.longest_m)
+        if m.full_view:
+            track.full_views += 1
+            for cls in (m.named_within | {m.class_name}) - {UNKNOWN}:
+                track.full_named[cls] = track.full_named.get(cls, 0) + 1
         track._class_name = None
         track.score_sum += m.score
         if m.detection_index is not None:
+            track.detected_classes.add(m.class_name)
             stamp = round(track.last_update_s, STAMP_DECIMALS)
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         if m.whole:
@@ -769,6 +798,8 @@ class Tracker:
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
             size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
+            refused_min_views=self.config.refused_min_views,
+            refused_max_share=self.config.refused_max_share,
         )
         track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
                        m.bottom_hidden)

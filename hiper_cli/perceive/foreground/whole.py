@@ -23,7 +23,15 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["bottom_hidden", "inside_image", "occluded", "seen_whole", "thickness_m", "top_hidden"]
+__all__ = [
+    "bottom_hidden",
+    "in_full_view",
+    "inside_image",
+    "occluded",
+    "seen_whole",
+    "thickness_m",
+    "top_hidden",
+]
 
 OCCLUDER_MARGIN_M = 0.15  # a surface this much nearer than the blob beside it stands in front
 OCCLUDER_RING_CELLS = 2  # ... within this many samples of the blob's outline
@@ -95,6 +103,25 @@ def occluded(
         base = float(blob.bounds_map[0][2])
         nearer[rows, cols] = height > base + OCCLUDER_MARGIN_M
     return bool(nearer.sum() >= OCCLUDED_SHARE * ring.sum())
+
+
+def in_full_view(
+    blob: Blob, depth_m: NDArray[np.float32], camera: CameraIntrinsics, T_map_cam: NDArray[np.float64],
+    pixel_step: int, min_area_px2: float,
+) -> bool:
+    """Whether ``blob`` showed its whole object, large enough for a detector to name it: inside
+    the image, its image box at least ``min_area_px2`` in area, not hidden in part by something
+    nearer around it (``occluded``), above it or below it (``top_hidden``, ``bottom_hidden``: the
+    back of a chair over the table's top in front is a part). A view a detector declines to
+    name then counts against a class it gave the object elsewhere (``Track.refused``)."""
+    x0, y0, x1, y1 = (float(v) for v in blob.image_box_xyxy)
+    if (x1 - x0) * (y1 - y0) < min_area_px2 or not inside_image(blob, pixel_step, camera):
+        return False
+    return not (
+        top_hidden(blob, depth_m, pixel_step)
+        or bottom_hidden(blob, depth_m, pixel_step)
+        or occluded(blob, depth_m, camera, T_map_cam, pixel_step)  # the costliest last
+    )
 
 
 def top_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> bool:
