@@ -1,6 +1,6 @@
 """A detector's class must fit the 3D object it names (``plausible.py``): common-sense sizes,
 plumbing fixtures against a wall or in a counter, what people carry is part of them
-(``carried.py``), and a class no view of the whole object gave is refused (``Track.refused``)."""
+(``carried.py``), and a class no view of the whole object gave is refused (``class_vote``)."""
 
 import numpy as np
 import pytest

@@ -38,13 +38,20 @@ def iou_matrix(a_xyxy: NDArray[np.float64], b_xyxy: NDArray[np.float64]) -> NDAr
     b = np.asarray(b_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(a) == 0 or len(b) == 0:
         return np.zeros((len(a), len(b)))
+    inter = _intersections(a, b)
+    union = _areas(a)[:, None] + _areas(b)[None, :] - inter
+    return np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)
+
+
+def _intersections(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Intersection area of every box in ``a`` (N, 4) with every box in ``b`` (M, 4)."""
     iw = np.clip(np.minimum(a[:, None, 2], b[None, :, 2]) - np.maximum(a[:, None, 0], b[None, :, 0]), 0, None)
     ih = np.clip(np.minimum(a[:, None, 3], b[None, :, 3]) - np.maximum(a[:, None, 1], b[None, :, 1]), 0, None)
-    inter = iw * ih
-    area_a = (a[:, 2] - a[:, 0]) * (a[:, 3] - a[:, 1])
-    area_b = (b[:, 2] - b[:, 0]) * (b[:, 3] - b[:, 1])
-    union = area_a[:, None] + area_b[None, :] - inter
-    return np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)
+    return np.asarray(iw * ih, dtype=np.float64)
+
+
+def _areas(boxes: NDArray[np.float64]) -> NDArray[np.float64]:
+    return (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
 
 
 def assign_classes(
@@ -88,10 +95,8 @@ def named_within(
     beside it is no match for the bottle's box, yet the detector named the bottle there)."""
     if len(detections) == 0:
         return frozenset()
-    b = np.asarray(blob_box_xyxy, dtype=np.float64).reshape(4)
-    d = detections.xyxy
-    iw = np.clip(np.minimum(d[:, 2], b[2]) - np.maximum(d[:, 0], b[0]), 0, None)
-    ih = np.clip(np.minimum(d[:, 3], b[3]) - np.maximum(d[:, 1], b[1]), 0, None)
-    area = (d[:, 2] - d[:, 0]) * (d[:, 3] - d[:, 1])
-    inside = (area > 0) & (iw * ih >= min_cover * area) & (detections.scores >= min_score)
+    d = np.asarray(detections.xyxy, dtype=np.float64).reshape(-1, 4)
+    inter = _intersections(np.asarray(blob_box_xyxy, dtype=np.float64).reshape(1, 4), d)[0]
+    area = _areas(d)
+    inside = (area > 0) & (inter >= min_cover * area) & (detections.scores >= min_score)
     return frozenset(detections.class_names[k] for k in np.flatnonzero(inside))

@@ -15,8 +15,8 @@ import math
 from typing import TYPE_CHECKING
 
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_VELOCITY
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.config import TrackerConfig
-from hiper_cli.perceive.foreground.stitch import UNKNOWN
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.tracking import Track

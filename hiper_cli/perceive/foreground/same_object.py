@@ -33,10 +33,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import ROW_STAMP
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.stitch import (
     REVISIT,
-    UNKNOWN,
     absorb,
     find_target,
     footprint_share,

@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_VELOCITY
 from hiper_cli.perceive.foreground.appearance import similarity
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, absorb_votes
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
@@ -43,7 +44,6 @@ __all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "common_distance_m", "fin
 
 FloatArray = NDArray[np.float64]
 RESUME, DUPLICATE, REVISIT = "resume", "duplicate", "revisit"
-UNKNOWN = "unknown"
 STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
 INTERPOLATE_MAX_S = 0.5  # a track's position between two of its rows at most this far apart
 MAX_RESUME_ROWS = 300  # rows of the old track a resume looks back over (10 s at 30 Hz)
@@ -232,20 +232,10 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     of both positions)."""
     old.observation_uuids.extend(new.observation_uuids)
     old.seen.extend(new.seen)
-    for cls, votes in new.class_votes.items():
-        old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
-    for cls, count in new.class_counts.items():
-        old.class_counts[cls] = old.class_counts.get(cls, 0) + count
-    for cls, longest in new.class_longest_m.items():
-        old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
-    old.full_views += new.full_views
-    old.detected_classes |= new.detected_classes
-    for cls, count in new.full_named.items():
-        old.full_named[cls] = old.full_named.get(cls, 0) + count
+    absorb_votes(old, new)
     old.score_sum += new.score_sum
     old.travelled = old.travelled or new.travelled
     old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked
-    old._class_name = None
     old.standing_tops_m.extend(new.standing_tops_m)
     old.floor_z_m = new.floor_z_m if new.floor_z_m is not None else old.floor_z_m
     if new.appearance is not None:

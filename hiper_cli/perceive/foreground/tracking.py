@@ -28,6 +28,7 @@
   detection does not bias a moving track. A track only ages while its predicted centre is
   visible to the camera (in the image, not hidden behind nearer depth): a person who walks out
   of view keeps the identity for ``lost_max_s``.
+- Class: a vote over its observations' classes, with minimum evidence (``class_vote.py``).
 - Closed tracks: their trajectory is refined by a Rauch-Tung-Striebel smoother
   (``smoother.py``: every row then uses all observations of the track).
 - Life cycle: tentative → confirmed after ``confirm_hits`` observations (an ``unknown`` one
@@ -53,10 +54,10 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import ROW_POSITION, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, record, search_class, winner
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, MotionModel, make_motion_model
 from hiper_cli.perceive.foreground.moving import is_static, note_travel, was_moving
-from hiper_cli.perceive.foreground.plausible import min_longest_m
 from hiper_cli.perceive.foreground.same_object import (
     STAMP_DECIMALS,
     NamedBlob,
@@ -82,7 +83,6 @@ from hiper_cli.perceive.foreground.stitch import (
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "object_box"]
 
 FloatArray = NDArray[np.float64]
-UNKNOWN = "unknown"
 
 # Named constants of the tracker (not the paper's; chosen by measurement, see docs/foreground.md).
 MIN_PRIOR_SIGMA_MPS = 0.05  # a learned speed spread below this would freeze a class's filter
@@ -90,7 +90,6 @@ DECAY_GRACE_FRAMES = 1.5  # the decay grace covers at least one missed frame at 
 LOST_AFTER_FRAMES = 2.5  # a track is lost after more than one missed frame (gap of 2 frames)
 EXTENT_GAIN = 0.2  # exponential smoothing of a track's box extent by each new observation
 MIN_VELOCITY_INIT_DT_S = 1e-6  # two observations closer in time give no velocity
-MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
 WALKER_VZ_VAR = 1e-4  # (m/s)²: a walker's vertical velocity held at zero (``walker_level``)
 # A walker's height: this quantile of its blobs' tops above the floor. A high one, since blobs
 # of a person are often only a part (legs under a table, a body cut at the image's lower edge).
@@ -138,7 +137,7 @@ class Measurement:
     full_view: bool = False
     """The view showed all of the blob, large enough to name (``whole.in_full_view``): one in
     which a detector named a class neither for the blob nor inside its box (``named_within``)
-    counts against that class (``Track.refused``)."""
+    counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
 
@@ -219,7 +218,7 @@ class Track:
     # when it has been moving at every update (None: not moving)
     travelled: bool = False
     moving_since_s: float | None = None
-    _class_name: str | None = field(default=None, repr=False)  # cache; ``_vote`` clears it
+    _class_name: str | None = field(default=None, repr=False)  # cache; ``class_vote`` clears it
     # ``moving.was_moving`` for the trajectory of this many rows (rows change only by being added)
     _moving: tuple[int, bool] | None = field(default=None, repr=False)
 
@@ -239,61 +238,16 @@ class Track:
 
     @property
     def class_name(self) -> str:
-        """The vote winner among the known classes seen at least ``min_class_observations``
-        times (and not too short for the class, ``_long_enough``), when it holds at least
-        ``min_class_share`` of all known-class votes (two classes that keep swapping leave the
-        track ``unknown``) and outweighs ``unknown``."""
+        """The class its observations voted for, with minimum evidence (``class_vote.winner``)."""
         if self._class_name is None:
-            self._class_name = self._vote_winner()
+            self._class_name = winner(self)
         return self._class_name
-
-    def _vote_winner(self) -> str:
-        known = {k: v for k, v in self.class_votes.items() if k != UNKNOWN}
-        eligible = [
-            k for k in sorted(known)
-            if self.class_counts.get(k, 0) >= self.min_class_observations and self._long_enough(k)
-            and not self.refused(k)
-        ]
-        if not eligible:
-            return UNKNOWN
-        best = max(eligible, key=lambda k: known[k])
-        if known[best] < self.min_class_share * sum(known.values()):
-            return UNKNOWN
-        if self.class_votes.get(UNKNOWN, 0.0) > known[best]:
-            return UNKNOWN
-        return best
 
     @property
     def search_class(self) -> str:
-        """The class that decides whether the track searches when lost (``search_classes``):
-        its class, or while ``unknown`` the known class detections named most when they named
-        it at least ``min_class_observations`` times (a class the vote turned down for its
-        share or its size still says what kind of thing it is: a book display taken for a bed
-        does not walk away)."""
-        name = self.class_name
-        if name != UNKNOWN:
-            return name
-        named = [k for k, n in self.class_counts.items() if k != UNKNOWN and n >= self.min_class_observations]
-        return max(sorted(named), key=lambda k: self.class_votes[k]) if named else UNKNOWN
-
-    def _long_enough(self, class_name: str) -> bool:
-        """False when every view that named the track ``class_name`` with its blob seen whole
-        showed an object shorter than the class's smallest instance (``class_sizes``)."""
-        seen = self.class_longest_m.get(class_name)
-        if self.size_tolerance is None or seen is None:
-            return True
-        return seen >= min_longest_m(class_name, self.size_tolerance)
-
-    def refused(self, class_name: str) -> bool:
-        """Whether detections named ``class_name`` in at most ``refused_max_share`` of the track's
-        full views, once it has ``refused_min_views`` of them: a detector that gives a class
-        only to views cut by the image's border or hidden in part, and declines it whenever the
-        whole object shows, was naming a part that looks like something else."""
-        if self.refused_min_views <= 0 or self.full_views < self.refused_min_views:
-            return False
-        if class_name not in self.detected_classes:
-            return False  # named by its shape (a table top), not by a detector that could decline
-        return self.full_named.get(class_name, 0) <= self.refused_max_share * self.full_views
+        """The class that decides whether the track searches when lost (``search_classes``;
+        ``class_vote.search_class``): a book display taken for a bed does not walk away."""
+        return search_class(self)
 
     @property
     def confidence(self) -> float:
@@ -522,20 +476,9 @@ class Tracker:
         )
 
     def _vote(self, track: Track, m: Measurement) -> None:
-        weight = self.config.unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
-        track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
-        track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
-        if m.longest_m is not None and m.class_name != UNKNOWN:
-            seen = track.class_longest_m.get(m.class_name, 0.0)
-            track.class_longest_m[m.class_name] = max(seen, m.longest_m)
-        if m.full_view:
-            track.full_views += 1
-            for cls in (m.named_within | {m.class_name}) - {UNKNOWN}:
-                track.full_named[cls] = track.full_named.get(cls, 0) + 1
-        track._class_name = None
+        record(track, m, self.config.unknown_vote_weight)
         track.score_sum += m.score
         if m.detection_index is not None:
-            track.detected_classes.add(m.class_name)
             stamp = round(track.last_update_s, STAMP_DECIMALS)
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         if m.whole:

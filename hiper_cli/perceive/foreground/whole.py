@@ -113,7 +113,7 @@ def in_full_view(
     the image, its image box at least ``min_area_px2`` in area, not hidden in part by something
     nearer around it (``occluded``), above it or below it (``top_hidden``, ``bottom_hidden``: the
     back of a chair over the table's top in front is a part). A view a detector declines to
-    name then counts against a class it gave the object elsewhere (``Track.refused``)."""
+    name then counts against a class it gave the object elsewhere (``class_vote``)."""
     x0, y0, x1, y1 = (float(v) for v in blob.image_box_xyxy)
     if (x1 - x0) * (y1 - y0) < min_area_px2 or not inside_image(blob, pixel_step, camera):
         return False

@@ -1,0 +1,115 @@
+"""The class a track takes: a vote over the classes its observations were given.
+
+Each observation votes for its class with its detection score (``unknown`` with
+``unknown_vote_weight``). A known class wins only with minimum evidence:
+
+- at least ``min_class_observations`` observations of it, and ``min_class_share`` of the
+  known-class votes (two classes that keep swapping leave the track ``unknown``), outweighing
+  ``unknown``;
+- not too short for the class (``class_sizes``): some view that named it, with its blob seen
+  whole, showed an object at least as long as the class's smallest instance;
+- not refused (``refused_min_views``): once the track has enough *full views* (the whole object
+  in the image, large enough to name: ``whole.in_full_view``), a class a detection gave it must
+  have been named in more than ``refused_max_share`` of them, for the blob or inside its box. A
+  detector that names a class only where the border cut the object or something hid a part was
+  naming a part that looks like something else (a shelf's side taken for a chair's back).
+
+The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
+record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
+``absorb_votes`` clear it.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from hiper_cli.perceive.foreground.plausible import min_longest_m
+
+if TYPE_CHECKING:
+    from hiper_cli.perceive.foreground.tracking import Measurement, Track
+
+__all__ = ["UNKNOWN", "absorb_votes", "record", "search_class", "winner"]
+
+UNKNOWN = "unknown"
+MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
+
+
+def record(track: Track, m: Measurement, unknown_vote_weight: float) -> None:
+    """Count ``m``'s class in the track's tallies."""
+    weight = unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
+    track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
+    track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
+    if m.longest_m is not None and m.class_name != UNKNOWN:
+        seen = track.class_longest_m.get(m.class_name, 0.0)
+        track.class_longest_m[m.class_name] = max(seen, m.longest_m)
+    if m.full_view:
+        track.full_views += 1
+        for cls in (m.named_within | {m.class_name}) - {UNKNOWN}:
+            track.full_named[cls] = track.full_named.get(cls, 0) + 1
+    if m.detection_index is not None:
+        track.detected_classes.add(m.class_name)
+    track._class_name = None
+
+
+def absorb_votes(old: Track, new: Track) -> None:
+    """Add ``new``'s tallies to ``old``'s (``stitch.absorb``: two tracks of one object)."""
+    for cls, votes in new.class_votes.items():
+        old.class_votes[cls] = old.class_votes.get(cls, 0.0) + votes
+    for cls, count in new.class_counts.items():
+        old.class_counts[cls] = old.class_counts.get(cls, 0) + count
+    for cls, longest in new.class_longest_m.items():
+        old.class_longest_m[cls] = max(old.class_longest_m.get(cls, 0.0), longest)
+    old.full_views += new.full_views
+    for cls, count in new.full_named.items():
+        old.full_named[cls] = old.full_named.get(cls, 0) + count
+    old.detected_classes |= new.detected_classes
+    old._class_name = None
+
+
+def winner(track: Track) -> str:
+    """The vote's winner, or ``unknown`` without the evidence (see the module docstring)."""
+    known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
+    eligible = [
+        k for k in sorted(known)
+        if track.class_counts.get(k, 0) >= track.min_class_observations and _long_enough(track, k)
+        and not _refused(track, k)
+    ]
+    if not eligible:
+        return UNKNOWN
+    best = max(eligible, key=lambda k: known[k])
+    if known[best] < track.min_class_share * sum(known.values()):
+        return UNKNOWN
+    if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
+        return UNKNOWN
+    return best
+
+
+def search_class(track: Track) -> str:
+    """The track's class, or while ``unknown`` the known class detections named most when they
+    named it at least ``min_class_observations`` times (a class the vote turned down for its
+    share, size or refusal still says what kind of thing it is)."""
+    name = track.class_name
+    if name != UNKNOWN:
+        return name
+    named = [k for k, n in track.class_counts.items() if k != UNKNOWN and n >= track.min_class_observations]
+    return max(sorted(named), key=lambda k: track.class_votes[k]) if named else UNKNOWN
+
+
+def _long_enough(track: Track, class_name: str) -> bool:
+    """False when every view that named the track ``class_name`` with its blob seen whole
+    showed an object shorter than the class's smallest instance (``class_sizes``)."""
+    seen = track.class_longest_m.get(class_name)
+    if track.size_tolerance is None or seen is None:
+        return True
+    return seen >= min_longest_m(class_name, track.size_tolerance)
+
+
+def _refused(track: Track, class_name: str) -> bool:
+    """Whether detections named ``class_name`` in at most ``refused_max_share`` of the track's
+    full views, once it has ``refused_min_views`` of them. A class found by its shape (a table
+    top), not by a detector that could decline it, is not judged."""
+    if track.refused_min_views <= 0 or track.full_views < track.refused_min_views:
+        return False
+    if class_name not in track.detected_classes:
+        return False
+    return track.full_named.get(class_name, 0) <= track.refused_max_share * track.full_views
