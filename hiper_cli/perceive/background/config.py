@@ -73,6 +73,9 @@ class BackgroundConfig:
     # a table top stands on legs: below its near edge the camera sees under it, not a solid
     # front (a box stack, a cabinet, a bed; ``under.py``)
     table_needs_legs: bool = True
+    # a top goes on behind what stands on it or in front of it (``hidden.py``): plane points
+    # this far beyond a top's seen edge that something nearer hid join two pieces of it (0: off)
+    table_bridge_m: float = 0.2
     wall_min_height_m: float = 1.2  # a standing person is ~1.8 m tall but narrow and not flat
     wall_min_width_m: float = 1.0
     wall_min_area_m2: float = 1.0

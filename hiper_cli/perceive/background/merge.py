@@ -3,8 +3,10 @@
 An observation, moved into the map frame with its pose, is tested against every live
 instance with criteria of increasing cost: class, alignment (normal angle and plane offset),
 box overlap (with a margin) and contour overlap (shapely polygons in the instance's plane,
-with a margin). No match makes a new instance, one match merges, several matches merge all
-of them into the oldest and delete the others.
+with a margin). A table top's observation also reaches on behind what hid its plane
+(``hidden.py``): the pieces of a desk a chair's back or a row of bottles cut apart are one
+top, and the instance's contour fills the gap between them. No match makes a new instance,
+one match merges, several matches merge all of them into the oldest and delete the others.
 
 An instance's geometry is a pure fold of its observations in time order (area-weighted
 normal and centroid, union of contours), so ``reanchor`` can recompute it from the
@@ -17,7 +19,7 @@ centroid sum) that makes merging incremental.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -56,6 +58,8 @@ class MapObservation:
     contour_map: FloatArray
     centroid_map: FloatArray
     weight: float
+    # points of the plane beyond the contour that something nearer hid (``hidden.py``)
+    hidden_map: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 def to_map(obs: Observation, T_map_cam: FloatArray) -> MapObservation:
@@ -68,6 +72,7 @@ def to_map(obs: Observation, T_map_cam: FloatArray) -> MapObservation:
         transform_points(np.asarray(data["contour_cam"], dtype=np.float64), T_map_cam),
         transform_points(centroid, T_map_cam)[0],
         float(data.get("area_m2", 1.0)),
+        transform_points(np.asarray(data.get("hidden_cam", []), dtype=np.float64), T_map_cam),
     )
 
 
@@ -148,7 +153,10 @@ def merge_into(target: Instance, others: Sequence[Instance], mo: MapObservation 
         "c": np.sum([np.asarray(f["c"], dtype=np.float64) for f in fits], axis=0).tolist(),
     }
     frame = PlaneFrame(_plane_of(fit))
-    polygon = _union([to_polygon(r, frame) for r in rings], cfg.merge_contour_margin_m / 2.0)
+    polygons = [to_polygon(r, frame) for r in rings]
+    if mo is not None and len(mo.hidden_map):
+        polygons.append(_bridge(polygons[-1], mo.hidden_map, polygons[:-1], frame, cfg))
+    polygon = _union(polygons, cfg.merge_contour_margin_m / 2.0)
     _set_geometry(target, fit, polygon, frame)
     for other in others:
         known = set(target.observation_uuids)
@@ -163,8 +171,28 @@ def merge_into(target: Instance, others: Sequence[Instance], mo: MapObservation 
     return target
 
 
+def _reach(seen: Any, hidden_map: FloatArray, frame: PlaneFrame, cfg: BackgroundConfig) -> Any:
+    """``seen`` and the hidden plane points joined to it (each grown by half the contour
+    margin, so points that close chain up): how far the surface may go on behind occluders."""
+    from shapely import MultiPoint, union_all
+
+    grown = MultiPoint(frame.to_2d(hidden_map)).buffer(cfg.merge_contour_margin_m / 2.0, quad_segs=2)
+    joined = union_all([seen, grown])
+    parts = getattr(joined, "geoms", [joined])
+    return union_all([p for p in parts if p.intersects(seen)] or [seen])
+
+
+def _bridge(seen: Any, hidden_map: FloatArray, known: Sequence[Any], frame: PlaneFrame,
+            cfg: BackgroundConfig) -> Any:
+    """The hidden part of the plane between an observation's ``seen`` polygon and the
+    instances it joins (``known``): its reach within the convex hull of them all."""
+    from shapely import union_all
+
+    return _reach(seen, hidden_map, frame, cfg).intersection(union_all([seen, *known]).convex_hull)
+
+
 def _matches(class_name: str, plane: FloatArray, contour: FloatArray, centroid: FloatArray,
-             inst: Instance, cfg: BackgroundConfig) -> bool:
+             inst: Instance, cfg: BackgroundConfig, hidden: FloatArray | None = None) -> bool:
     # 1. class
     if inst.class_name != class_name:
         return False
@@ -180,14 +208,20 @@ def _matches(class_name: str, plane: FloatArray, contour: FloatArray, centroid: 
     if len(contour_i) < 3 or len(contour) < 3:
         return False
     m = cfg.merge_box_margin_m
-    if np.any(contour.min(axis=0) - m > contour_i.max(axis=0)) or np.any(
-        contour_i.min(axis=0) - m > contour.max(axis=0)
+    reach = contour if hidden is None or not len(hidden) else np.vstack([contour, hidden])
+    if np.any(reach.min(axis=0) - m > contour_i.max(axis=0)) or np.any(
+        contour_i.min(axis=0) - m > reach.max(axis=0)
     ):
         return False
-    # 4. contours overlap in the instance's plane, with a margin
+    # 4. contours overlap in the instance's plane, with a margin (the observation's reaching
+    # on behind what hid its plane, ``hidden.py``)
     frame = PlaneFrame(plane_i)
-    gap_m = to_polygon(contour, frame).distance(to_polygon(contour_i, frame))
-    return bool(gap_m <= cfg.merge_contour_margin_m)
+    seen, known = to_polygon(contour, frame), to_polygon(contour_i, frame)
+    if seen.distance(known) <= cfg.merge_contour_margin_m:
+        return True
+    if hidden is None or not len(hidden):
+        return False
+    return bool(_reach(seen, hidden, frame, cfg).distance(known) <= cfg.merge_contour_margin_m)
 
 
 def match_instances(mo: MapObservation, instances: Sequence[Instance],
@@ -195,7 +229,8 @@ def match_instances(mo: MapObservation, instances: Sequence[Instance],
     """The instances ``mo`` belongs to, oldest first."""
     found = [
         inst for inst in instances
-        if _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map, inst, cfg)
+        if _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map, inst, cfg,
+                    mo.hidden_map)
     ]
     return sorted(found, key=lambda i: (i.first_seen_s, i.uuid))
 

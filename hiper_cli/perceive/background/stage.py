@@ -21,6 +21,7 @@ from hiper_cli.perceive.background.contour import (
     transform_points,
 )
 from hiper_cli.perceive.background.fronts import deep_sides, front_sides, segment_labels
+from hiper_cli.perceive.background.hidden import hidden_points
 from hiper_cli.perceive.background.merge import (
     MapObservation,
     match_instances,
@@ -70,6 +71,8 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
     edges = edge_evidence(grid, frame.camera, seg, cfg) if class_name == "wall" and cfg.wall_bounds else None
     # a table top on legs, or the top of a box stack, a cabinet or a bed (``under.py``)
     under = under_evidence(grid, seg, cfg) if class_name == "table" and cfg.table_needs_legs else None
+    # where the top goes on behind something nearer (``hidden.py``)
+    hidden = hidden_points(grid, frame.camera, seg, cfg) if class_name == "table" else np.zeros((0, 3))
     if edges is not None and cfg.wall_fronts:
         for side in front_sides(grid, frame.camera, seg, segments, labels, cfg):
             edges[side] = "front"  # a furniture front before a wall
@@ -100,6 +103,7 @@ def _observation(seg: PlaneSegment, grid: SampleGrid, frame: Frame, cfg: Backgro
             "method": cfg.method,
             **({"edges": edges} if edges is not None else {}),
             **({"under": under} if under is not None else {}),
+            **({"hidden_cam": np.round(hidden, 4).tolist()} if len(hidden) else {}),
         },
     )
 
