@@ -110,3 +110,30 @@ def test_a_cup_whose_blob_slid_a_hand_width_is_static():
     (track,) = tracker.tracks
     assert track.seen.moved()  # its boxes left where they were ...
     assert not is_dynamic(track, tracker.config)  # ... by 0.21 m: not a cup that went somewhere
+
+
+def test_the_top_of_a_class_is_that_of_the_blobs_views_named_it():
+    box = SeenBox()
+    for _ in range(20):
+        box.add(np.array([0.8, 0.1, 0.0]), np.array([2.0, 0.8, 0.76]), True, class_name="table")
+    for _ in range(10):  # the bottles on it, named before the top was found
+        box.add(np.array([1.1, 0.4, 0.0]), np.array([1.5, 0.7, 1.01]), True, class_name="bottle")
+    assert box.corners()[1][2] > 1.0  # the union reaches the bottles' tops
+    assert abs(box.top_of("table") - 0.76) < 1e-9
+    assert box.top_of("chair") is None
+
+
+def test_a_table_with_bottles_named_on_it_is_the_table_the_background_mapped():
+    """Office 62: a desk's blob was named ``bottle`` in 12 views, then found a table by its top;
+    its box reached the bottles' tops (1.01 m) and it stayed beside the mapped top at 0.76 m."""
+    from hiper_cli.model import Box3D
+    from hiper_cli.perceive.foreground.unmapped_tables import withdraw_mapped
+
+    with_bottles = ([0.8, 0.1, 0.0], [2.0, 0.8, 1.01], "bottle")
+    table = ([0.8, 0.1, 0.0], [1.95, 0.8, 0.77], "table")
+    tracker = _static_run([[with_bottles]] * 12 + [[table]] * 20)
+    (track,) = tracker.tracks
+    assert track.class_name == "table" and track.seen.corners()[1][2] > 1.0
+    mapped = Box3D(np.array([1.86, 0.41, 0.76]), np.array([1.09, 0.8, 0.02]))
+    assert withdraw_mapped(tracker, [mapped], 0.1) == [track.uuid]
+    assert tracker.tracks == []

@@ -47,6 +47,7 @@ class SeenBox:
     viewpoints_m: list[FloatArray] = field(default_factory=list)
     tops_hidden: list[bool] = field(default_factory=list)  # per blob: its top was not in view
     bottoms_hidden: list[bool] = field(default_factory=list)  # per blob: its base was not in view
+    classes: list[str] = field(default_factory=list)  # per blob: the class its view gave it
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
     _moved: tuple[int, bool] | None = field(default=None, repr=False)
 
@@ -58,6 +59,7 @@ class SeenBox:
         viewpoint_m: FloatArray | None = None,
         top_hidden: bool = False,
         bottom_hidden: bool = False,
+        class_name: str = "",
     ) -> None:
         self.lower_m.append(np.asarray(lower_m, dtype=np.float64))
         self.upper_m.append(np.asarray(upper_m, dtype=np.float64))
@@ -66,6 +68,7 @@ class SeenBox:
         self.viewpoints_m.append(view)
         self.tops_hidden.append(bool(top_hidden))
         self.bottoms_hidden.append(bool(bottom_hidden))
+        self.classes.append(class_name)
         if len(self.lower_m) > 2 * MAX_SEEN_BOXES:  # trimmed in batches: amortised O(1)
             del self.lower_m[:-MAX_SEEN_BOXES]
             del self.upper_m[:-MAX_SEEN_BOXES]
@@ -73,13 +76,14 @@ class SeenBox:
             del self.viewpoints_m[:-MAX_SEEN_BOXES]
             del self.tops_hidden[:-MAX_SEEN_BOXES]
             del self.bottoms_hidden[:-MAX_SEEN_BOXES]
+            del self.classes[:-MAX_SEEN_BOXES]
         self._cache = None
         self._moved = None
 
     def extend(self, other: SeenBox) -> None:
         """Add the blobs of ``other`` (a track this one absorbed)."""
         for blob in zip(other.lower_m, other.upper_m, other.named, other.viewpoints_m, other.tops_hidden,
-                        other.bottoms_hidden, strict=True):
+                        other.bottoms_hidden, other.classes, strict=True):
             self.add(*blob)
 
     def __len__(self) -> int:
@@ -177,6 +181,15 @@ class SeenBox:
         hi = np.maximum(hi, lo)
         self._cache = (n, lo, hi)
         return lo, hi
+
+    def top_of(self, class_name: str) -> float | None:
+        """The height (m, map frame) of the top of the blobs views named ``class_name``, as the
+        union takes it (its upper quantile); None when no kept blob was. A table found by its
+        shape is as high as its top, whatever stood on it when a detector named the blob."""
+        start = max(len(self.classes) - MAX_SEEN_BOXES, 0)
+        kept = zip(self.upper_m[start:], self.classes[start:], strict=True)
+        tops = [upper[2] for upper, named in kept if named == class_name]
+        return float(np.quantile(tops, 1.0 - SEEN_BOX_QUANTILE)) if tops else None
 
     def box(self) -> tuple[FloatArray, FloatArray] | None:
         """(centre, extent) of the union; None before any blob."""

@@ -430,7 +430,7 @@ class Tracker:
         track.unseen_in_view_s = 0.0
         track.extent_m = (1.0 - EXTENT_GAIN) * track.extent_m + EXTENT_GAIN * extent
         track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
-                       m.bottom_hidden)
+                       m.bottom_hidden, m.class_name)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)
@@ -745,7 +745,7 @@ class Tracker:
             refused_max_share=self.config.refused_max_share,
         )
         track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
-                       m.bottom_hidden)
+                       m.bottom_hidden, m.class_name)
         if walks:
             _record_standing(track, m)
             self._hold_level(track)

@@ -45,14 +45,16 @@ def table_match() -> Match:
 def _same_table(track: Track, table: Box3D, reach_m: float) -> bool:
     """Whether the track's seen box and the mapped ``table`` are one table: their footprints,
     grown by ``reach_m``, touch, and their tops lie within ``reach_m`` of one height (the
-    background layer often maps a part of a top, a piece 0.4 m wide of a 1.6 m desk)."""
+    background layer often maps a part of a top, a piece 0.4 m wide of a 1.6 m desk). The
+    track's top is that of its views as a table, where it has them (``SeenBox.top_of``)."""
     found = track.seen.corners()
     if found is None:
         return False
     lo, hi = found
     t_lo, t_hi = table.aabb()
     touch = bool(np.all(lo[:2] <= t_hi[:2] + reach_m) and np.all(hi[:2] >= t_lo[:2] - reach_m))
-    return touch and abs(float(hi[2]) - float(t_hi[2])) <= reach_m
+    top = track.seen.top_of(TABLE_CLASS)  # not the bottles a detector named on it
+    return touch and abs(float(hi[2] if top is None else top) - float(t_hi[2])) <= reach_m
 
 
 def withdraw_mapped(tracker: Tracker, mapped: Sequence[Box3D], reach_m: float) -> list[str]:
