@@ -31,7 +31,8 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 f = lambda v, p: "-" if v is None else format(v, p)
 print(f"{sys.argv[2]:<14} questions {d['questions']:>3}  binary {f(d['binary_accuracy'], '.3f')}"
-      f"  count {f(d['count_accuracy'], '.3f')}  position {f(d['position_error_median_m'], '.3f')} m"
+      f"  count {f(d['count_accuracy'], '.3f')} ({f(d.get('count_accuracy_glimpses_optional'), '.3f')} glimpses optional)"
+      f"  position {f(d['position_error_median_m'], '.3f')} m"
       f"  time {f(d['time_error_median_s'], '.2f')} s  duration {f(d['duration_error_median_s'], '.2f')} s")
 PY
 done | tee "$out/summary.txt"

@@ -104,3 +104,33 @@ def test_after_and_before_answers_hold_for_the_time_the_question_names():
             assert q.answer == truth, q.text
             asked += 1
     assert asked > 50
+
+
+def test_a_count_missing_only_glimpsed_instances_is_right_with_glimpses_optional():
+    """A cup in view for two frames is in the truth's count; a perceiver that confirms what it
+    sees cannot count it. The strict score says wrong, the one with glimpses optional right; a
+    count missing a cup in view for long is wrong both ways."""
+    from dataclasses import replace
+
+    from hiper_cli.graph import open_kb_for_reading
+    from hiper_cli.qa.score import answer_question, summarise
+
+    k = house_truth_kb()
+    log = k.path.parent / "log"
+    scene = load_scene_truth(log, min_pixel_fraction=FRACTION)
+    counts = [q for q in generate_questions(scene, glimpse_s=0.0) if q.kind == "count"]
+    assert counts and all(q.glimpsed == 0 for q in counts)
+    every = [q for q in generate_questions(scene, glimpse_s=1e9) if q.kind == "count"]
+    assert all(q.glimpsed == q.answer for q in every)  # nothing is in view that long
+    q = next(q for q in counts if q.answer > 0)
+    with open_kb_for_reading(str(k.path)) as kb:
+        right = answer_question(kb, q)
+        one_more_glimpsed = answer_question(kb, replace(q, answer=q.answer + 1, glimpsed=1))
+        one_more_seen = answer_question(kb, replace(q, answer=q.answer + 1))
+    assert right.correct and right.right_but_glimpses
+    assert not one_more_glimpsed.correct and one_more_glimpsed.right_but_glimpses
+    assert not one_more_seen.correct and not one_more_seen.right_but_glimpses
+    figures = summarise([right, one_more_glimpsed, one_more_seen])
+    assert figures["count_accuracy"] == pytest.approx(1 / 3)
+    assert figures["count_accuracy_glimpses_optional"] == pytest.approx(2 / 3)
+    assert one_more_glimpsed.to_dict()["glimpsed"] == 1

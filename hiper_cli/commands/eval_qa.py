@@ -39,6 +39,10 @@ def qa(
         float, typer.Option("--short-s", help="The short horizon: the last this many seconds.")
     ] = 15.0,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the generated question times.")] = 0,
+    glimpse_s: Annotated[
+        float, typer.Option("--glimpse-s", help="An instance in view less than this many seconds is a "
+                            "glimpse: counts are also scored with glimpses optional.")
+    ] = 0.5,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """NaVQA-style questions (yes/no, count, position, time, duration; short and long
@@ -52,7 +56,7 @@ def qa(
 
     with frame_progress("perceive", console(), enabled=not as_json and kb is None) as bar:
         report = evaluate_qa(log, kb=kb, detector=detector, out_dir=out_dir, short_s=short_s, seed=seed,
-                             progress=None if bar is None else bar.update)
+                             glimpse_s=glimpse_s, progress=None if bar is None else bar.update)
     data = report.to_dict()
     if as_json:
         print_json(data)
@@ -73,12 +77,19 @@ def qa(
                 value = _fmt(f.get("accuracy"))
             else:  # None: more than half unanswered, an infinite median
                 value = ("inf" if f.get("median_error") is None else _fmt(f["median_error"])) + unit
-            note = (f"yes {_fmt(f.get('accuracy_on_yes'))} / no {_fmt(f.get('accuracy_on_no'))}"
-                    if kind == "yes_no" else f"answered: median {_fmt(f.get('median_error_answered'))}{unit}")
+            if kind == "yes_no":
+                note = f"yes {_fmt(f.get('accuracy_on_yes'))} / no {_fmt(f.get('accuracy_on_no'))}"
+            elif kind == "count":
+                note = (f"{_fmt(f.get('accuracy_glimpses_optional'))} with {f.get('glimpsed')} glimpsed "
+                        "instances optional")
+            else:
+                note = f"answered: median {_fmt(f.get('median_error_answered'))}{unit}"
             table.add_row(kind, horizon, str(f["n"]), str(f["answered"]), value, note)
     out.print(table)
     out.print(
-        f"binary accuracy {_fmt(data['binary_accuracy'])}, count accuracy {_fmt(data['count_accuracy'])}, "
+        f"binary accuracy {_fmt(data['binary_accuracy'])}, count accuracy {_fmt(data['count_accuracy'])} "
+        f"({_fmt(data['count_accuracy_glimpses_optional'])} with instances in view < {glimpse_s:g} s "
+        "optional), "
         f"position error {_err(data['position_error_median_m'])} m, time error "
         f"{_err(data['time_error_median_s'])} s, duration error {_err(data['duration_error_median_s'])} s "
         f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); questions in {data['files']['questions']}"

@@ -1,7 +1,13 @@
 """Questions in the NaVQA style generated from a log's truth, each with its true answer and
 the plain words the query layer reads. Kinds: ``yes_no``, ``count``, ``position``, ``time``,
 ``duration``; horizons: ``short`` (the last ``short_s`` seconds) and ``long`` (the whole log).
-Deterministic for a seed (the seed draws the times of "after T"/"before T" questions)."""
+Deterministic for a seed (the seed draws the times of "after T"/"before T" questions).
+
+A count's true answer holds every instance in view in the horizon, however briefly; the
+question also says how many of them were in view less than ``glimpse_s`` (``glimpsed``: a cup
+seen in two frames as the camera turned, a person who came into range in the log's last
+0.2 s), which no perceiver that confirms what it sees can count. The score reports the count
+accuracy both ways (``score.py``)."""
 
 from __future__ import annotations
 
@@ -40,6 +46,9 @@ class Question:
     # Whether the perceiver can name the class (its detector's vocabulary, or a background
     # class); the headline figures are over these, the others are reported apart.
     named: bool = True
+    # Count questions: how many of the ``answer`` instances were in view less than the
+    # generator's ``glimpse_s`` in the horizon.
+    glimpsed: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         return {"format": QUESTION_FORMAT, "version": 1, **asdict(self),
@@ -79,17 +88,19 @@ class _Builder:
         seed: int,
         view_gap_s: float,
         vocabulary: frozenset[str] | None,
+        glimpse_s: float,
     ) -> None:
         self.scene, self.short_s, self.gap, self.vocabulary = scene, short_s, view_gap_s, vocabulary
+        self.glimpse_s = glimpse_s
         self.rng = np.random.default_rng(seed)
         self.out: list[Question] = []
         self.since = scene.now_s - short_s
 
-    def add(self, kind: str, horizon: str, text: str, answer: Any, cls: str) -> None:
+    def add(self, kind: str, horizon: str, text: str, answer: Any, cls: str, glimpsed: int = 0) -> None:
         qid = f"q{len(self.out):04d}"
         named = self.vocabulary is None or cls in self.vocabulary
         self.out.append(Question(qid, kind, horizon, text, answer, self.scene.now_s, self.scene.pose, cls,
-                                 named))
+                                 named, glimpsed))
 
     def seen_in(self, cls: str, lo: float, hi: float) -> list[int]:
         """Instances of ``cls`` seen at some stamp in [lo, hi]."""
@@ -112,13 +123,23 @@ class _Builder:
             self.add("yes_no", "long", f"was there a {cls} before {_clock(t)}",
                      bool(self.seen_in(cls, s.start_s, t)), cls)
 
+    def glimpsed(self, ids: list[int], lo: float, hi: float) -> int:
+        """How many of ``ids`` were in view less than ``glimpse_s`` within [lo, hi]."""
+        def in_view_s(i: int) -> float:
+            stamps = self.scene.seen[i]
+            return _in_view_s(stamps[(stamps >= lo - 1e-6) & (stamps <= hi + 1e-6)], self.gap)
+
+        return sum(in_view_s(i) < self.glimpse_s for i in ids)
+
     def counts(self, classes: list[str]) -> None:
         s = self.scene
         for cls in classes:
-            n = len(self.seen_in(cls, s.start_s, s.now_s))
-            self.add("count", "long", f"how many {_plural(cls)}", n, cls)
+            ids = self.seen_in(cls, s.start_s, s.now_s)
+            self.add("count", "long", f"how many {_plural(cls)}", len(ids), cls,
+                     self.glimpsed(ids, s.start_s, s.now_s))
+            ids = self.seen_in(cls, self.since, s.now_s)
             self.add("count", "short", f"how many {_plural(cls)} in the last {self.short_s:g} seconds",
-                     len(self.seen_in(cls, self.since, s.now_s)), cls)
+                     len(ids), cls, self.glimpsed(ids, self.since, s.now_s))
 
     def positions(self, classes: list[str]) -> None:
         s = self.scene
@@ -169,15 +190,17 @@ def generate_questions(
     seed: int = 0,
     view_gap_s: float = 1.0,
     vocabulary: frozenset[str] | None = None,
+    glimpse_s: float = 0.5,
 ) -> list[Question]:
     """Every question of every kind about the classes the log shows (and, for yes/no, common
     indoor classes it may not show); ``view_gap_s`` as the query layer's ``QueryConfig``;
     ``vocabulary``: the classes the perceiver can name (None: all), which marks each question
-    ``named`` or not."""
+    ``named`` or not; ``glimpse_s``: a count question's ``glimpsed`` instances were in view
+    less than this."""
     from hiper_cli.query.vocabulary import resolve_class
 
     present = [c for c in scene.classes() if resolve_class(c) == c]
-    b = _Builder(scene, short_s, seed, view_gap_s, vocabulary)
+    b = _Builder(scene, short_s, seed, view_gap_s, vocabulary, glimpse_s)
     b.yes_no(sorted(set(present) | set(COMMON_CLASSES)))
     b.counts(present)
     b.positions(present)

@@ -88,6 +88,7 @@ def evaluate_qa(
     short_s: float = 15.0,
     seed: int = 0,
     min_pixel_fraction: float | None = None,
+    glimpse_s: float = 0.5,
     progress: Callable[[int, int], None] | None = None,
 ) -> QaReport:
     """Generate the questions of ``log``, answer them from ``kb`` (default: perceive the log
@@ -95,20 +96,24 @@ def evaluate_qa(
     (questions with true answers) and ``OUT/answers.jsonl`` (hiper's answers, scored).
     ``min_pixel_fraction``: how much of the image an instance must cover to count as seen
     (default: the sim truth detector's threshold, else 0.1 %). ``detector`` also says which
-    classes the perceiver can name when ``kb`` is given. ``progress(done, total)`` after each
-    frame perceived."""
+    classes the perceiver can name when ``kb`` is given. ``glimpse_s``: an instance in view less
+    than this is a glimpse, which a count may leave out (``count_accuracy_glimpses_optional``).
+    ``progress(done, total)`` after each frame perceived."""
     from hiper_cli.graph import open_kb_for_reading
 
     log = Path(log)
     if not short_s > 0:
         raise ConfigError(f"--short-s {short_s}: expected a positive number of seconds")
+    if not glimpse_s >= 0:
+        raise ConfigError(f"--glimpse-s {glimpse_s}: expected zero or a positive number of seconds")
     out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="hiper-qa-"))
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     fraction = seen_fraction(log, 0.001) if min_pixel_fraction is None else min_pixel_fraction
     scene = load_scene_truth(log, min_pixel_fraction=fraction)
     used = pick_detector(log, detector)
-    questions = generate_questions(scene, short_s=short_s, seed=seed, vocabulary=vocabulary_of(log, used))
+    questions = generate_questions(scene, short_s=short_s, seed=seed, vocabulary=vocabulary_of(log, used),
+                                   glimpse_s=glimpse_s)
     seconds = {"questions": time.perf_counter() - t0}
     if kb is None:
         kb = str(out / "kb.hiper")
@@ -122,6 +127,6 @@ def evaluate_qa(
     files = {"questions": str(out / "questions.jsonl"), "answers": str(out / "answers.jsonl")}
     Path(files["questions"]).write_text("".join(json.dumps(q.to_dict()) + "\n" for q in questions))
     Path(files["answers"]).write_text("".join(json.dumps(s.to_dict()) + "\n" for s in scored))
-    figures = summarise(scored) | {"seen_min_pixels": scene.min_pixels}
+    figures = summarise(scored) | {"seen_min_pixels": scene.min_pixels, "glimpse_s": glimpse_s}
     return QaReport(str(log), kb, used, short_s, seed, figures, scored, files,
                     {k: round(v, 2) for k, v in seconds.items()})

@@ -1,6 +1,11 @@
 """Ask each question through the query layer and score its answer against the truth: binary
 accuracy (yes/no), count accuracy, position error (m), time error (s), duration error (s), per
-kind and horizon. A question the layer cannot answer scores as wrong (an infinite error)."""
+kind and horizon. A question the layer cannot answer scores as wrong (an infinite error).
+
+A count is right when it equals the truth (``count_accuracy``, the headline); beside it,
+``count_accuracy_glimpses_optional`` takes a count as right when it lies between the truth less
+its glimpsed instances and the truth (``Question.glimpsed``): what is left is what the perceiver
+missed or doubled among the things it had time to see."""
 
 from __future__ import annotations
 
@@ -30,6 +35,8 @@ class Scored:
     error: float | None
     text: str
     error_3d: float | None = None
+    # count questions: right with the glimpsed instances counted or not
+    right_but_glimpses: bool | None = None
 
     def to_dict(self) -> dict[str, Any]:
         err = None if self.error is None or math.isinf(self.error) else self.error
@@ -37,7 +44,9 @@ class Scored:
                 "question": self.question.text, "truth": self.question.answer, "predicted": self.predicted,
                 "correct": self.correct, "error": err, "error_3d": self.error_3d,
                 "answered": self.predicted is not None, "named": self.question.named,
-                "hiper_text": self.text}
+                "hiper_text": self.text,
+                **({"glimpsed": self.question.glimpsed, "right_but_glimpses": self.right_but_glimpses}
+                   if self.question.kind == "count" else {})}
 
 
 def _predicted(q: Question, a: Answer) -> Any:
@@ -58,10 +67,14 @@ def answer_question(kb: KnowledgeBase, q: Question) -> Scored:
         a = ask(kb, q.text, pose=q.pose, now_s=q.now_s)
     except HiperError as failure:
         binary = q.kind in ("yes_no", "count")
-        return Scored(q, None, False if binary else None, None if binary else math.inf, f"error: {failure}")
+        return Scored(q, None, False if binary else None, None if binary else math.inf, f"error: {failure}",
+                      right_but_glimpses=False if q.kind == "count" else None)
     p = _predicted(q, a)
-    if q.kind in ("yes_no", "count"):
+    if q.kind == "yes_no":
         return Scored(q, p, p is not None and p == q.answer, None, a.text)
+    if q.kind == "count":
+        within = p is not None and q.answer - q.glimpsed <= p <= q.answer
+        return Scored(q, p, p is not None and p == q.answer, None, a.text, right_but_glimpses=within)
     if p is None:
         return Scored(q, None, None, math.inf, a.text)
     if q.kind == "position":
@@ -76,6 +89,9 @@ def _figures(rows: list[Scored]) -> dict[str, Any]:
         return out
     if rows[0].question.kind in ("yes_no", "count"):
         out["accuracy"] = sum(bool(r.correct) for r in rows) / len(rows)
+    if rows[0].question.kind == "count":
+        out["accuracy_glimpses_optional"] = sum(bool(r.right_but_glimpses) for r in rows) / len(rows)
+        out["glimpsed"] = sum(r.question.glimpsed for r in rows)
     else:
         errs = np.array([r.error for r in rows], dtype=np.float64)
         out["median_error"] = float(np.median(errs))
@@ -120,6 +136,7 @@ def _summary(scored: list[Scored]) -> dict[str, Any]:
         "questions": len(scored),
         "binary_accuracy": get("yes_no", "accuracy"),
         "count_accuracy": get("count", "accuracy"),
+        "count_accuracy_glimpses_optional": get("count", "accuracy_glimpses_optional"),
         "position_error_median_m": finite(get("position", "median_error")),
         "position_error_3d_median_m": finite(get("position", "median_error_3d")),
         "time_error_median_s": finite(get("time", "median_error")),
