@@ -7,9 +7,10 @@ saw something nearer there, so the top may go on behind it. Two desks that stand
 the opposite: through the gap the camera sees past the plane (the floor, a desk's side).
 
 ``hidden_points`` returns, for one top seen in one image, the points of its plane within
-``table_bridge_m`` of its seen edge that something nearer hid: samples around the segment whose
-depth lies in front of the plane, moved along their viewing ray onto it. Merging treats them
-as plane evidence for the test of whether a top continues a known one (``merge._matches``),
+``table_bridge_m`` of its seen edge where it may go on: samples around the segment that lie on
+the plane but were left out of it (the strips between bottles), and samples nearer than the
+plane on their viewing ray (what hid it), moved along the ray onto it. Merging takes them as
+evidence of the plane when it tests whether a top continues a known one (``merge._matches``),
 and fills with them the gap between the two pieces it joins (``merge.merge_into``).
 """
 
