@@ -52,9 +52,10 @@ def _same_table(track: Track, table: Box3D, reach_m: float) -> bool:
         return False
     lo, hi = found
     t_lo, t_hi = table.aabb()
-    touch = bool(np.all(lo[:2] <= t_hi[:2] + reach_m) and np.all(hi[:2] >= t_lo[:2] - reach_m))
+    if not (np.all(lo[:2] <= t_hi[:2] + reach_m) and np.all(hi[:2] >= t_lo[:2] - reach_m)):
+        return False  # the footprints do not touch
     top = track.seen.top_of(TABLE_CLASS)  # not the bottles a detector named on it
-    return touch and abs(float(hi[2] if top is None else top) - float(t_hi[2])) <= reach_m
+    return abs(float(hi[2] if top is None else top) - float(t_hi[2])) <= reach_m
 
 
 def withdraw_mapped(tracker: Tracker, mapped: Sequence[Box3D], reach_m: float) -> list[str]:
