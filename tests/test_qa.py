@@ -70,8 +70,11 @@ def test_cli_json_and_errors(tmp_path):
     result = runner.invoke(app, ["eval", "qa", str(k.path.parent / "log"), "--kb", str(k.path),
                                  "-o", str(tmp_path), "--json"])
     assert result.exit_code == 0, result.output
-    data = json.loads(result.output)
+    data = json.loads(result.output, parse_constant=lambda c: pytest.fail(f"not JSON: {c}"))
     assert data["format"] == "hiper-eval-qa" and data["questions"] > 50
+    yes_no, count = data["by_kind"]["yes_no"]["all"], data["by_kind"]["count"]["all"]
+    assert "median_error" not in yes_no and "median_error" not in count
+    assert {"accuracy_glimpses_optional", "glimpsed"} <= set(count)
     result = runner.invoke(app, ["eval", "qa", str(tmp_path / "nothing")])
     assert result.exit_code != 0 and "not found" in result.output and "Traceback" not in result.output
     result = runner.invoke(app, ["eval", "qa", str(tmp_path), "--short-s", "0"])

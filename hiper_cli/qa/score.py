@@ -89,9 +89,9 @@ def _figures(rows: list[Scored]) -> dict[str, Any]:
         return out
     if rows[0].question.kind in ("yes_no", "count"):
         out["accuracy"] = sum(bool(r.correct) for r in rows) / len(rows)
-    if rows[0].question.kind == "count":
-        out["accuracy_glimpses_optional"] = sum(bool(r.right_but_glimpses) for r in rows) / len(rows)
-        out["glimpsed"] = sum(r.question.glimpsed for r in rows)
+        if rows[0].question.kind == "count":
+            out["accuracy_glimpses_optional"] = sum(bool(r.right_but_glimpses) for r in rows) / len(rows)
+            out["glimpsed"] = sum(r.question.glimpsed for r in rows)
     else:
         errs = np.array([r.error for r in rows], dtype=np.float64)
         out["median_error"] = float(np.median(errs))
