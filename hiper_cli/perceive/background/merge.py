@@ -174,7 +174,7 @@ def merge_into(target: Instance, others: Sequence[Instance], mo: MapObservation 
 def _reach(seen: Any, hidden_map: FloatArray, frame: PlaneFrame, cfg: BackgroundConfig) -> Any:
     """``seen`` and the hidden plane points joined to it: how far the surface may go on behind
     occluders. The points count by the cells, half the contour margin wide, that hold them, each
-    grown by half a cell, so points that close chain up (buffering each point costs 40 ms)."""
+    grown by half a cell, so points that close chain up (far cheaper than buffering each point)."""
     import shapely
 
     cell = cfg.merge_contour_margin_m / 2.0
