@@ -407,6 +407,7 @@ class ForegroundStage:
                         blob.image_box_xyxy, dets, min_score=cfg.min_detection_score,
                         min_cover=cfg.full_view_cover,
                     ) if full else frozenset(),
+                    cut_from_table_m=blob.cut_from_table_m,
                 )
             )
         for blob in found_tables if cfg.unseen_table_instances else []:

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import Box3D
+from hiper_cli.model import Box3D, point_bounds
 from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
 from hiper_cli.perceive.foreground.legs import leg_points, standing_on
 from hiper_cli.perceive.foreground.match import iou_matrix
@@ -169,10 +169,12 @@ def split_unseen_tables(
         on_table = table_points(blob.points_map, top, config)
         if np.count_nonzero(on_table) >= config.min_cluster_points:
             tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
+        table_box = point_bounds(blob.points_map[on_table]) if on_table.any() else None
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
                 out.append(_part(blob, rest[part], top, config, width, height))
+                out[-1].cut_from_table_m = table_box
     return out, tables, lookalikes
 
 

@@ -69,6 +69,7 @@ from hiper_cli.perceive.foreground.same_object import (
 )
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.smoother import smooth_trajectory
+from hiper_cli.perceive.foreground.split_parts import held_tables, last_box
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
@@ -140,6 +141,9 @@ class Measurement:
     counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
+    cut_from_table_m: tuple[FloatArray, FloatArray] | None = None
+    """(lower, upper) corners of the table found in the blob this one was cut from
+    (``Blob.cut_from_table_m``; ``split_parts``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -578,6 +582,9 @@ class Tracker:
                 person_sized &= footprints <= cfg.search_max_footprint_m
                 person_sized &= stamp_s - t.last_update_s <= cfg.search_unknown_max_s
                 allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
+        cut = [m.cut_from_table_m for m in measurements]
+        if any(box is not None for box in cut):  # not the unnamed track of the blob it was cut from
+            allowed &= ~held_tables([last_box(t) for t in self.tracks], cut)
         return self._assign(cost, allowed)
 
     # --- one step ---------------------------------------------------------------------------
