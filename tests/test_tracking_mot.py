@@ -330,6 +330,25 @@ def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate():
     assert joined == [track.uuid]
 
 
+def test_a_person_lost_for_long_takes_no_unnamed_blob_even_inside_its_grown_filter_gate():
+    """Hospital 46: a person's track lost for 11.4 s took an unnamed blob 0.9 m from where it
+    was lost, inside the gate its filter's uncertainty had grown to: another person, who came
+    into view there, and two people were one."""
+    cfg = ForegroundConfig()
+    for named, joins in (("unknown", False), ("person", True)):
+        tracker = Tracker(cfg)
+        for k in range(30):
+            tracker.step(k / RATE_HZ, [meas([1.0 + 0.8 * k / RATE_HZ, 0, 0.9], k=k)])
+        (track,) = tracker.tracks
+        lost_s = 1.0 + cfg.search_unknown_max_s + 5.0
+        tracker.step(lost_s - 0.5, [], lambda pts: np.zeros(len(pts), bool))
+        tracker._predict(track, lost_s)
+        near = track.position + np.array([0.3, 0.0, 0.0])
+        assert np.linalg.norm(near - track.position) < tracker._gate(track, lost_s)[0]
+        _, joined = tracker.step(lost_s, [meas(near, named, k=99)])
+        assert (joined == [track.uuid]) is joins, named
+
+
 @pytest.mark.parametrize(("max_footprint_m", "couch_joins"), [(1.2, False), (5.0, True)])
 def test_a_lost_person_track_does_not_take_a_couch(max_footprint_m, couch_joins):
     """An unmatched blob beyond the normal gate, as tall as half the person but 1.0 by 1.7 m

@@ -427,8 +427,9 @@ class TrackerConfig(_Part):
     back cut by the image border, unmatched; 0.75 split the fixture's person; above 1: never) ..."""
     search_unknown_max_s: float = 3.0
     """... and that only within this long of its last update: a person comes back through the
-    border soon after leaving it, while after longer only a detection says a blob is the person
-    (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m away) ..."""
+    border soon after leaving it, while after longer only a detection says a blob is the person,
+    inside the normal gate too (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m
+    away; one lost for 11 s, another person's unnamed blob 0.9 m away) ..."""
     search_max_footprint_m: float = 1.2
     """... and no wider than this seen from above (the diagonal of its box's footprint): a
     person is about a metre across at most; a lost person's track took a couch's blob, 1.0 by

@@ -581,7 +581,9 @@ class Tracker:
                 person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
                 person_sized &= footprints <= cfg.search_max_footprint_m
                 person_sized &= stamp_s - t.last_update_s <= cfg.search_unknown_max_s
-                allowed[i] &= ~(searched[i] & (classes != cls) & ~person_sized)
+                # past that, also inside the base gate its filter's uncertainty grew to
+                judged = searched[i] | (stamp_s - t.last_update_s > cfg.search_unknown_max_s)
+                allowed[i] &= ~(judged & (classes != cls) & ~person_sized)
         cut = [m.cut_from_table_m for m in measurements]
         if any(box is not None for box in cut):  # not the unnamed track of the blob it was cut from
             allowed &= ~held_tables([last_box(t) for t in self.tracks], cut)
