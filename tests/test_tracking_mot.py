@@ -97,6 +97,20 @@ def test_kalman_speed_of_a_constant_velocity_walker(speed):
     assert speeds[-30:].mean() == pytest.approx(speed, abs=0.03)
 
 
+def test_a_settled_chair_whose_filter_was_dragged_away_still_takes_its_own_blob():
+    """House 47: a person walked behind a dining chair; the chair's track took some of their
+    blobs, and its filter stood 1.1 m from the chair at a person's height. Its own blobs then
+    fell outside its gate, started track after track, and the lost person's track took them."""
+    tracker = Tracker(ForegroundConfig())
+    for k in range(30):
+        tracker.step(k / RATE_HZ, [meas([1.0, 0.0, 0.46], "chair", k=k)])
+    (chair,) = tracker.tracks
+    dragged = np.array([1.9, 0.6, 1.0, 0.0, 0.0, 0.0])
+    chair.motion.reset(dragged, np.array(chair.motion.P))
+    _, joined = tracker.step(30 / RATE_HZ, [meas([1.02, 0.0, 0.46], "chair", k=30)])
+    assert joined == [chair.uuid]
+
+
 def test_same_class_wins_and_a_confused_detection_still_joins():
     tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5))
     for k in range(10):

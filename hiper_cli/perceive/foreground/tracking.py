@@ -542,6 +542,11 @@ class Tracker:
         pred = np.array([t.position for t in self.tracks])
         obs = np.array([m.center_map_m for m in measurements])
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
+        settled = [self._settled(t) for t in self.tracks]
+        for k in np.flatnonzero(settled):  # a filter that left the box of its blobs: the box's middle
+            seen, margin = self.tracks[k].seen.corners(), self.config.settled_overlap_m
+            if seen is not None and not np.all((seen[0] - margin <= pred[k]) & (pred[k] <= seen[1] + margin)):
+                cost[k] = np.linalg.norm((seen[0] + seen[1]) / 2.0 - obs, axis=1)
         walking = np.array([self._walks(t) for t in self.tracks])
         if walking.any():  # a walker's distance to a blob's box as a walker's
             obs_walker = np.array([m.for_walker()[0] for m in measurements])
@@ -566,7 +571,7 @@ class Tracker:
         footprints = np.hypot(extents[:, 0], extents[:, 1])  # diagonal seen from above
         for i, t in enumerate(self.tracks):
             cls = t.class_name
-            if self._settled(t):
+            if settled[i]:
                 # where its blobs were (``SeenBox``), not where a drifting filter puts it
                 lo, hi = t.seen.corners() or (t.position - t.extent_m / 2.0, t.position + t.extent_m / 2.0)
                 near = np.all(obs - half_extents <= hi + cfg.settled_overlap_m, axis=1)
