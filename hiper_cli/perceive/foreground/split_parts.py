@@ -10,7 +10,6 @@ from a table's blob (``Measurement.cut_from_table_m``) may not continue an unnam
 last blob held most of that table (``HELD_SHARE`` of the table box's volume); the table may,
 and the part starts a track of its own. A named track keeps its parts (a cup seen once with
 its table in one blob is still the cup's).
-
 """
 
 from __future__ import annotations
@@ -60,4 +59,3 @@ def last_box(track: Track) -> tuple[FloatArray, FloatArray] | None:
     if track.class_name != UNKNOWN or not track.seen.lower_m:
         return None
     return track.seen.lower_m[-1], track.seen.upper_m[-1]
-
