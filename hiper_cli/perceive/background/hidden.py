@@ -30,14 +30,6 @@ MAX_POINTS = 160  # kept per observation, evenly spaced (they go into the knowle
 MAX_RADIUS_SAMPLES = 48  # the band around the segment, in grid samples, at most
 
 
-def _dilate(mask: NDArray[np.bool_], radius: int) -> NDArray[np.bool_]:
-    import cv2
-
-    size = 2 * radius + 1
-    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
-    return np.asarray(cv2.dilate(mask.astype(np.uint8), kernel) > 0)
-
-
 def hidden_points(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,
                   cfg: BackgroundConfig) -> FloatArray:
     """(K, 3) camera-frame points on ``seg``'s plane, within ``cfg.table_bridge_m`` of its
@@ -56,7 +48,9 @@ def hidden_points(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment,
     seen = grid.points_cam[mask]
     near_z = max(float(seen[:, 2].min()), cfg.min_depth_m)
     radius = min(int(np.ceil(camera.fx * reach_m / near_z / grid.stride)), MAX_RADIUS_SAMPLES)
-    band = _dilate(mask, max(radius, 1)) & ~mask & grid.valid
+    size = 2 * max(radius, 1) + 1
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
+    band = (cv2.dilate(mask.astype(np.uint8), disc) > 0) & ~mask & grid.valid
     p = grid.points_cam
     rays = p / np.where(grid.valid, p[..., 2], 1.0)[..., None]  # through each sample, z = 1
     denom = rays @ n

@@ -89,12 +89,16 @@ class SeenBox:
     def __len__(self) -> int:
         return len(self.lower_m)
 
+    def _latest(self, per_blob: Sequence[Any]) -> Sequence[Any]:
+        """``per_blob`` (one value per blob) of the latest ``MAX_SEEN_BOXES`` blobs (the lists
+        are trimmed in batches, so they may hold more)."""
+        return per_blob[max(len(self.lower_m) - MAX_SEEN_BOXES, 0):]
+
     def _used(self, per_blob: Sequence[Any]) -> NDArray[Any]:
         """``per_blob`` (one value per blob) of the blobs the box is of: the latest
         ``MAX_SEEN_BOXES``, the named ones alone when there are ``MIN_NAMED_BOXES`` of them."""
-        start = max(len(self.lower_m) - MAX_SEEN_BOXES, 0)
-        values = np.array(per_blob[start:])
-        named = np.array(self.named[start:], dtype=bool)
+        values = np.array(self._latest(per_blob))
+        named = np.array(self._latest(self.named), dtype=bool)
         return values[named] if int(named.sum()) >= MIN_NAMED_BOXES else values
 
     def _boxes(self) -> tuple[FloatArray, FloatArray]:
@@ -186,8 +190,7 @@ class SeenBox:
         """The height (m, map frame) of the top of the blobs views named ``class_name``, as the
         union takes it (its upper quantile); None when no kept blob was. A table found by its
         shape is as high as its top, whatever stood on it when a detector named the blob."""
-        start = max(len(self.classes) - MAX_SEEN_BOXES, 0)
-        kept = zip(self.upper_m[start:], self.classes[start:], strict=True)
+        kept = zip(self._latest(self.upper_m), self._latest(self.classes), strict=True)
         tops = [upper[2] for upper, named in kept if named == class_name]
         return float(np.quantile(tops, 1.0 - SEEN_BOX_QUANTILE)) if tops else None
 
