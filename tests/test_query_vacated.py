@@ -64,7 +64,7 @@ def test_describe_counts_the_memory_and_says_how_many_are_vacated(kb_path):
         found = describe(kb)
     (chairs,) = [c for c in found.classes if c.class_name == "chair"]
     assert (chairs.count, chairs.vacated) == (2, 1)
-    assert "2 chair (1 vacated)" in found.text
+    assert "2 chairs (1 vacated)" in found.text
 
 
 @pytest.mark.parametrize("fmt", ["json", "turtle"])

@@ -18,6 +18,7 @@ import numpy as np
 
 from hiper_cli.qa.scene import SceneTruth
 from hiper_cli.query.results import iso_time
+from hiper_cli.query.vocabulary import plural
 
 __all__ = ["KINDS", "QUESTION_FORMAT", "Question", "generate_questions"]
 
@@ -53,15 +54,6 @@ class Question:
     def to_dict(self) -> dict[str, Any]:
         return {"format": QUESTION_FORMAT, "version": 1, **asdict(self),
                 "now_iso": iso_time(self.now_s), "pose": list(self.pose)}
-
-
-def _plural(name: str) -> str:
-    from hiper_cli.query.vocabulary import IRREGULAR_PLURALS
-
-    inverse = {v: k for k, v in IRREGULAR_PLURALS.items()} | {"person": "people"}
-    if name in inverse:
-        return inverse[name]
-    return name + ("es" if name.endswith(("s", "sh", "ch")) else "s")
 
 
 def _clock(stamp_s: float) -> str:
@@ -135,10 +127,10 @@ class _Builder:
         s = self.scene
         for cls in classes:
             ids = self.seen_in(cls, s.start_s, s.now_s)
-            self.add("count", "long", f"how many {_plural(cls)}", len(ids), cls,
+            self.add("count", "long", f"how many {plural(cls)}", len(ids), cls,
                      self.glimpsed(ids, s.start_s, s.now_s))
             ids = self.seen_in(cls, self.since, s.now_s)
-            self.add("count", "short", f"how many {_plural(cls)} in the last {self.short_s:g} seconds",
+            self.add("count", "short", f"how many {plural(cls)} in the last {self.short_s:g} seconds",
                      len(ids), cls, self.glimpsed(ids, self.since, s.now_s))
 
     def positions(self, classes: list[str]) -> None:

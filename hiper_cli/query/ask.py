@@ -15,6 +15,7 @@ from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
 from hiper_cli.query.results import Answer, AnswerKind, GoalPose, Hit, TimeValue, ago_text
 from hiper_cli.query.spec import QueryConfig
 from hiper_cli.query.verbs import passed_here, when
+from hiper_cli.query.vocabulary import plural
 
 __all__ = ["answer", "ask", "goal_for"]
 
@@ -41,14 +42,17 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
     spec = parsed.spec
     kind: AnswerKind = parsed.answer  # type: ignore[assignment]
     make = functools.partial(Answer, kind, parsed.text, ctx.now_s, ctx.reference, parsed=parsed.to_dict())
-    what = ", ".join(spec.classes) or ("objects" if spec.layer == "foreground" else "instances")
+    def what(n: int) -> str:
+        """The classes asked about, in words for ``n`` of them: "cup", "cups, bottles"."""
+        names = list(spec.classes) or ["object" if spec.layer == "foreground" else "instance"]
+        return ", ".join(c if n == 1 else plural(c) for c in names)
+
     if spec.passed_here:
         found = passed_here(ctx, spec)
         r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
         if found is None:
-            return make(
-                value=False if kind == "yes_no" else None, text=f"no {what} observed within {r:g} m of here"
-            )
+            return make(value=False if kind == "yes_no" else None,
+                        text=f"no {what(0)} observed within {r:g} m of here")
         stamp, hit = found
         return make(
             hits=(hit,),
@@ -58,7 +62,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         )
     cands = engine.select(ctx, spec)
     if kind == "count":
-        return make(count=len(cands), text=f"{len(cands)} {what}")
+        return make(count=len(cands), text=f"{len(cands)} {what(len(cands))}")
     if kind == "yes_no":
         shown = engine.hits(ctx, cands.take(np.arange(min(5, len(cands)))))
         return make(
@@ -69,7 +73,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
     total = len(cands)
     found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
     if not found_hits:
-        return make(count=0, text=f"no {what} found")
+        return make(count=0, text=f"no {what(0)} found")
     first = found_hits[0]
     if kind == "time":
         stamp = first.first_seen_s if parsed.time_of == "first" else first.last_seen_s
@@ -91,7 +95,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
             _describe(first, ctx.now_s) + f"; goal ({goal.x_m:.2f}, {goal.y_m:.2f}, yaw {goal.yaw_rad:.2f})"
         )
         return make(hits=tuple(found_hits), goal=goal, text=text)
-    text = f"{total} {what}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
+    text = f"{total} {what(total)}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
     if total > 3:
         text += f"; +{total - 3} more" + (f" ({len(found_hits)} listed)" if total > len(found_hits) else "")
     nearest = goal_for(ctx, first) if spec.sort == "distance" and spec.limit == 1 else None

@@ -14,6 +14,7 @@ from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query.index import instance_index
 from hiper_cli.query.results import TimeValue, ago_text, iso_time, short_uuid
 from hiper_cli.query.templates import template
+from hiper_cli.query.vocabulary import counted
 
 __all__ = ["ClassCount", "Description", "describe"]
 
@@ -61,7 +62,7 @@ class Description:
                 f"Time span {iso_time(t0)} .. {iso_time(t1)} ({t1 - t0:.0f} s); now {iso_time(self.now_s)}."
             )
         for layer in ("background", "foreground"):
-            parts = [f"{c.count} {c.class_name}" + (f" ({c.vacated} vacated)" if c.vacated else "")
+            parts = [counted(c.count, c.class_name) + (f" ({c.vacated} vacated)" if c.vacated else "")
                      for c in self.classes if c.layer == layer]
             lines.append(f"{layer.capitalize()}: {', '.join(parts) if parts else 'nothing'}.")
         if self.movers:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from functools import cache
 
-__all__ = ["ANY_FOREGROUND", "CLASS_NAMES", "class_words", "resolve_class", "singular"]
+__all__ = ["ANY_FOREGROUND", "CLASS_NAMES", "class_words", "counted", "plural", "resolve_class", "singular"]
 
 COCO = (
     "person",
@@ -181,6 +181,27 @@ def singular(word: str) -> str:
     if word.endswith("s") and not word.endswith("ss") and len(word) > 2:
         return word[:-1]
     return word
+
+
+def plural(name: str) -> str:
+    """The plural of a class name ("cup" -> "cups", "person" -> "people", "potted plant" ->
+    "potted plants"), the inverse of ``singular`` for the names it reads."""
+    head, _, last = name.rpartition(" ")
+    inverse = {v: k for k, v in IRREGULAR_PLURALS.items() if k != v} | {"person": "people", "sheep": "sheep"}
+    if last in inverse:
+        last = inverse[last]
+    elif last.endswith("y") and last[-2:-1] not in ("a", "e", "o", "u") and len(last) > 2:
+        last = last[:-1] + "ies"
+    elif last.endswith(("s", "sh", "ch", "x")):
+        last = last + "es" if singular(last + "es") == last else last
+    else:
+        last = last + "s"
+    return f"{head} {last}".strip()
+
+
+def counted(n: int, name: str) -> str:
+    """``n`` things of class ``name`` in words: "1 cup", "3 cups", "0 people"."""
+    return f"{n} {name if n == 1 else plural(name)}"
 
 
 @cache
