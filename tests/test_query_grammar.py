@@ -10,7 +10,7 @@ import pytest
 from hiper_cli.errors import QueryError
 from hiper_cli.query import parse
 from hiper_cli.query.spec import Near, On
-from hiper_cli.query.vocabulary import resolve_class, singular
+from hiper_cli.query.vocabulary import counted, plural, resolve_class, singular
 
 NOW = datetime(2026, 12, 2, 12, 30, tzinfo=UTC).timestamp()
 
@@ -105,6 +105,22 @@ def test_question_words(words, answer):
     assert parsed.answer == answer
     if answer == "duration":
         assert not parsed.spec.in_fov  # "in view" is the time in view here, not a filter
+
+
+def test_plurals_are_the_words_the_grammar_reads_back():
+    names = ("cup", "person", "couch", "shelf", "potted plant", "wine glass", "bus", "stairs", "knife")
+    assert [plural(n) for n in names] == [
+        "cups", "people", "couches", "shelves", "potted plants", "wine glasses", "buses", "stairs", "knives"
+    ]
+    assert all(resolve_class(plural(n)) == n for n in names)
+    assert [counted(k, "chair") for k in (0, 1, 2)] == ["0 chairs", "1 chair", "2 chairs"]
+
+
+@pytest.mark.parametrize("words", ["chairs after 25:00", "cups since 10:75", "people between 9:00 and 24:30",
+                                   "cups before 0:99"])
+def test_a_clock_time_that_does_not_exist_is_named(words):
+    with pytest.raises(QueryError, match=r'is not a time of day; write HH:MM'):
+        parse(words, now_s=NOW)
 
 
 def test_unknown_words_are_quoted_with_a_suggestion():

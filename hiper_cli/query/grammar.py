@@ -205,6 +205,14 @@ def _clock(token: str, now_s: float) -> float | None:
     return (when if when.tzinfo else when.replace(tzinfo=UTC)).timestamp()
 
 
+def _not_a_time(token: str) -> None:
+    """Raise for a token written like a clock time that is none ("25:00", "10:75"); any other
+    word after "since"/"before" is left to the rest of the grammar."""
+    if re.fullmatch(r"\d{1,2}(:\d{1,2}){1,2}(am|pm)?|\d{1,2}(am|pm)", token):
+        raise QueryError(f'"{token}" is not a time of day; write HH:MM or HH:MM:SS from 00:00 to 23:59:59, '
+                         'or 3pm, or an ISO date-time such as 2026-12-07T10:00')
+
+
 class _Parser:
     def __init__(self, text: str, now_s: float, config: QueryConfig) -> None:
         self.text, self.now_s, self.cfg = text, now_s, config
@@ -285,12 +293,14 @@ class _Parser:
         if i < len(t) and t[i] in ("since", "after", "before") and i + 1 < len(t):
             stamp = _clock(t[i + 1], self.now_s)
             if stamp is None:
+                _not_a_time(t[i + 1])
                 return 0
             self.set("until_s" if t[i] == "before" else "since_s", stamp)
             return 2
         if self.at(i, "between") and i + 3 < len(t) and t[i + 2] in ("and", "to"):
             a, b = _clock(t[i + 1], self.now_s), _clock(t[i + 3], self.now_s)
             if a is None or b is None:
+                _not_a_time(t[i + 1] if a is None else t[i + 3])
                 return 0
             self.set("since_s", min(a, b))
             self.set("until_s", max(a, b))
