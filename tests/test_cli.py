@@ -44,6 +44,13 @@ def test_every_command_has_an_example(path, cmd):
     assert "Example:" in (cmd.help or ""), f"hiper {' '.join(path)} has no 'Example:' in its help"
 
 
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) for p, _ in COMMANDS])
+def test_every_command_is_listed_in_whole_lines(path, cmd):
+    # the list of commands shows this text; a docstring's own line breaks would cut it mid-line
+    first = (cmd.help or "").split("\n\n")[0]
+    assert cmd.short_help == " ".join(first.split()), f"hiper {' '.join(path)}: short help"
+
+
 def test_help_does_not_import_heavy_packages():
     code = (
         "import sys; from hiper_cli.cli import app; "

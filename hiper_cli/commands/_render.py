@@ -62,14 +62,18 @@ class HiperTyper(typer.Typer):
     """
 
     def command(self, *args: Any, **kwargs: Any) -> Any:
-        decorator = super().command(*args, **kwargs)
-
         def wrap(func: Any) -> Any:
             import functools
+            import inspect
 
             from hiper_cli.errors import HiperError
             from hiper_cli.validate import check_options
 
+            if "short_help" not in kwargs:
+                # rich help keeps a docstring's line breaks in the list of commands; one line reads
+                first = (kwargs.get("help") or inspect.getdoc(func) or "").split("\n\n")[0]
+                kwargs["short_help"] = " ".join(first.split())
+            decorator = super(HiperTyper, self).command(*args, **kwargs)
             flags = _flag_names(func)
 
             @functools.wraps(func)
