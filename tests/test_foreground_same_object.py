@@ -120,6 +120,33 @@ def test_one_detection_naming_two_blobs_saw_one_thing():
     assert seen_apart(a, b, TrackerConfig())
 
 
+def test_two_chairs_seen_apart_for_long_stay_apart_when_later_seen_as_one_blob():
+    """Office 48: two chairs at the image's left edge, one partly behind the other, named apart
+    in 20 frames; then their blob stayed whole and one detection named it, for one track or the
+    other, in more frames than that. Those frames cannot show the two apart, and filled the
+    share's denominator: the two were folded into one chair. A pair found apart on a few named
+    frames is not settled: later frames may still show it was one thing."""
+    from hiper_cli.perceive.foreground.same_object import APART_SETTLED_NAMED, NamedBlob, seen_apart
+
+    def track(uuid):
+        motion = make_motion_model("constant_velocity", np.zeros(3), 0.03)
+        return Track(uuid, motion, 0.0, 1.0, 1.0, np.ones(3))
+
+    left = np.array([0.0, 0.0, 0.0]), np.array([0.45, 0.45, 0.9])
+    right = np.array([0.5, 0.0, 0.0]), np.array([0.95, 0.45, 0.9])
+    both = left[0], right[1]
+    cfg = TrackerConfig()
+    for apart_frames, stays_apart in ((20, True), (APART_SETTLED_NAMED - 2, False)):
+        a, b = track("a"), track("b")
+        a.named_at = {0.1 * k: NamedBlob(0, *left) for k in range(apart_frames)}
+        b.named_at = {0.1 * k: NamedBlob(1, *right) for k in range(apart_frames)}
+        assert seen_apart(a, b, cfg)
+        later = 3 * apart_frames
+        a.named_at.update({0.1 * k: NamedBlob(0, *both) for k in range(100, 100 + later)})
+        b.named_at.update({0.1 * k: NamedBlob(0, *both) for k in range(200, 200 + later)})
+        assert seen_apart(a, b, cfg) == stays_apart, apart_frames
+
+
 def test_a_chair_cut_in_two_by_a_table_top_is_one_chair():
     """House 61: the detector named a chair's back above a table top and its seat below it with
     two boxes, one above the other, frame after frame; the two tracks were seen apart at once

@@ -47,10 +47,11 @@ if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
     from hiper_cli.perceive.foreground.tracking import Track
 
-__all__ = ["APART_SHARE", "GROWN_FACTOR", "STACKED_SHARE", "NamedBlob", "cut_in_two", "due", "fold",
-           "footprint_m2", "newer_match", "seen_apart", "static_together"]
+__all__ = ["APART_SETTLED_NAMED", "APART_SHARE", "GROWN_FACTOR", "STACKED_SHARE", "NamedBlob", "cut_in_two",
+           "due", "fold", "footprint_m2", "newer_match", "seen_apart", "static_together"]
 
 APART_SHARE = 0.5  # of the shorter track's frames, taken apart at once: two objects
+APART_SETTLED_NAMED = 10  # named frames of each track behind a "seen apart" that stands
 STACKED_SHARE = 0.5  # of the narrower detection's width, in columns both cover: one above the other
 STAMP_DECIMALS = 4  # stamps of one frame agree to well within this (0.1 ms)
 GROWN_FACTOR = 1.5  # a static track's footprint this many times what it was when last offered
@@ -94,7 +95,14 @@ def seen_apart(a: Track, b: Track, config: TrackerConfig) -> bool:
     chair's back above a table and its seat below it) saw one thing, and so did two
     detections one above the other in the image whose blobs are one object (``cut_in_two``),
     when the votes of both tracks gave them that class: a piece the detector mostly left
-    unnamed may be something else."""
+    unnamed may be something else.
+
+    A pair found apart when each track had ``APART_SETTLED_NAMED`` named frames stays apart
+    (``Track.apart_from``): two chairs side by side at the image's border, later seen only as
+    one blob that one detection names, add frames to the share's denominator that cannot
+    show them apart, and would fold the two into one."""
+    if b.uuid in a.apart_from or a.uuid in b.apart_from:
+        return True
     if not a.named_at or not b.named_at:
         return False
     one_class = a.class_name == b.class_name != UNKNOWN
@@ -103,7 +111,13 @@ def seen_apart(a: Track, b: Track, config: TrackerConfig) -> bool:
         seen_b = b.named_at.get(stamp)
         if seen_b is not None and seen_b.detection != seen_a.detection:
             apart += not (one_class and cut_in_two(seen_a, seen_b, config))
-    return apart >= APART_SHARE * min(len(a.named_at), len(b.named_at))
+    fewer = min(len(a.named_at), len(b.named_at))
+    if apart < APART_SHARE * fewer:
+        return False
+    if fewer >= APART_SETTLED_NAMED:
+        a.apart_from.add(b.uuid)
+        b.apart_from.add(a.uuid)
+    return True
 
 
 def cut_in_two(a: NamedBlob, b: NamedBlob, config: TrackerConfig) -> bool:

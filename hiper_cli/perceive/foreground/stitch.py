@@ -232,6 +232,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     of both positions)."""
     old.observation_uuids.extend(new.observation_uuids)
     old.seen.extend(new.seen)
+    old.apart_from |= new.apart_from
     absorb_votes(old, new)
     old.score_sum += new.score_sum
     old.travelled = old.travelled or new.travelled

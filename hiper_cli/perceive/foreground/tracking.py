@@ -195,6 +195,7 @@ class Track:
     seen: SeenBox = field(default_factory=SeenBox)
     # stamp (rounded, ``same_object.STAMP_DECIMALS``) -> the detection that named its blob then
     named_at: dict[float, NamedBlob] = field(default_factory=dict)
+    apart_from: set[str] = field(default_factory=set)  # tracks seen apart for good (``seen_apart``)
     velocity_initialised: bool = False
     first_center: FloatArray = field(default_factory=lambda: np.zeros(3))
     class_votes: dict[str, float] = field(default_factory=dict)
