@@ -8,7 +8,7 @@ import pytest
 from hiper_cli.perceive.foreground.appearance import HISTOGRAM_BINS, histogram, similarity
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.stitch import RESUME, find_target
-from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker
+from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
 
 RATE_HZ = 15.0
 PERSON = np.array([0.5, 0.4, 1.7])
@@ -188,6 +188,28 @@ def test_a_walker_stands_on_the_floor_whatever_part_of_it_a_blob_shows():
     assert track.velocity[2] == 0.0
     (closed,) = tracker.close_all()
     assert [row[3] for row in closed.trajectory] == pytest.approx([0.85] * 60, abs=1e-6)
+
+
+def test_a_walker_last_seen_in_part_keeps_the_height_it_stood():
+    """House 44: a person walked out of the image's side; the last views showed slivers of the
+    upper body, and the instance box became 7 cm wide and 1.19 m tall, its bottom 0.3 m above
+    the floor, so the learned altitude of people then refused people whose feet were seen."""
+    run = _Run()
+    tracker = run.tracker
+    for k in range(45):
+        x = 0.6 * k / RATE_HZ
+        if k < 30:
+            box = (np.array([x, 0.0, 0.85]), PERSON)
+            m = Measurement(box[0], box[1], "person", 0.9, f"o{k}", standing=box)
+        else:  # a sliver of the upper body at the image's border, no floor under it
+            m = Measurement(np.array([x, 0.0, 1.25]), np.array([0.05, 0.04, 0.9]), "person", 0.9, f"o{k}",
+                            whole=False)
+        tracker.step(run.t_s, [m])
+        run.t_s += 1.0 / RATE_HZ
+    (track,) = tracker.tracks
+    centre, extent = object_box(track, tracker.config)
+    assert extent == pytest.approx(PERSON, abs=1e-6)
+    assert centre[2] - extent[2] / 2.0 == pytest.approx(0.0, abs=1e-6)
 
 
 def _walker_track(name, stamps, x_of_t, first_seen):

@@ -177,6 +177,7 @@ class Track:
     max_size_m: float = 0.0  # the largest blob seen (``_size_m``: footprint diagonal or height)
     hits: int = 1
     whole_stamps_s: list[float] = field(default_factory=list)  # of the whole observations
+    whole_footprint_m: FloatArray | None = None  # smoothed like ``extent_m``, whole views only
     unseen_in_view_s: float = 0.0
     confirmed: bool = False
     closed: bool = False
@@ -298,9 +299,12 @@ def standing_level(track: Track) -> tuple[float, float] | None:
 def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatArray]:
     """(centre, extent), map frame, of the object a track is: a static one's seen box (the union
     of its blobs, ``SeenBox``); a walker's or a moving object's filtered box where it was last
-    updated (not extrapolated past its last observation). An ``unknown`` track detections named
-    a static class (``Track.search_class``) is judged as that class: a book display turned down
-    as a bed, whose blob slid while the robot turned past it, is where its blobs were."""
+    updated (not extrapolated past its last observation), as wide as its whole views showed it and,
+    a walker seen standing, as tall as it stood (``standing_level``), not the mean of the legs,
+    upper bodies or slivers at the image's border its last views showed.
+    An ``unknown`` track detections named a static class (``Track.search_class``) is judged as
+    that class: a book display turned down as a bed, whose blob slid while the robot turned past
+    it, is where its blobs were."""
     named = track.search_class
     if is_static(track, config) or (
         named != track.class_name and named not in config.walker_classes and not track.seen.moved()
@@ -308,8 +312,14 @@ def object_box(track: Track, config: TrackerConfig) -> tuple[FloatArray, FloatAr
         found = track.seen.box()
         if found is not None:
             return found
-    centre = np.asarray(track.trajectory[-1][ROW_POSITION]) if track.trajectory else track.position
-    return np.asarray(centre, dtype=np.float64), track.extent_m
+    centre = np.array(track.trajectory[-1][ROW_POSITION] if track.trajectory else track.position, float)
+    extent = np.array(track.extent_m, float)
+    if track.whole_footprint_m is not None:  # not the slivers of it at the image's border
+        extent[:2] = track.whole_footprint_m
+    level = standing_level(track) if track.class_name in config.walker_classes else None
+    if level is not None:  # a whole person stands on the floor, whatever part the last views showed
+        centre[2], extent[2] = level
+    return centre, extent
 
 
 def _size_m(extent_m: FloatArray) -> float:
@@ -488,6 +498,9 @@ class Tracker:
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         if m.whole:
             track.whole_stamps_s.append(track.last_update_s)
+            seen = track.whole_footprint_m
+            track.whole_footprint_m = m.extent_map_m[:2] if seen is None else seen + EXTENT_GAIN * (
+                m.extent_map_m[:2] - seen)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
         track.observation_uuids.append(m.observation_uuid)
         if m.appearance is not None and m.class_name in self.config.walker_classes:
