@@ -156,6 +156,16 @@ def test_learned_altitude_prior_rejects_a_floating_person():
     assert [o.class_name for o in r.observations] == ["person"]
 
 
+def test_a_range_learned_from_fewer_instances_than_prior_min_instances_is_no_prior():
+    """House 44: one TV's learned altitude, a point, refused 9 of the next session's 46 TV views."""
+    world = World(background=background_instances(room()))
+    for instances, expected in ((1, "person"), (2, "person"), (3, "unknown")):
+        floating = AltitudeFeature(1.5, 1.4, 1.6, 1.2, 1.8, instances)
+        world.analyses = [floating.to_analysis("person", 0, 1, created_s=1.0)]
+        r = ForegroundStage(detector="log", pixel_step=2).process(walker_frames(1)[0], world)
+        assert [o.class_name for o in r.observations] == [expected], instances
+
+
 def test_learned_altitude_prior_keeps_a_person_cut_by_the_image_edge():
     """A bottom above the learned range rules a class out only where the blob is seen whole."""
     world = World(background=background_instances(room()))

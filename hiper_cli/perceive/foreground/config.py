@@ -572,6 +572,10 @@ class TrackerConfig(_Part):
     ``unknown`` (a person on a poster or a TV screen floats above the floor)."""
     prior_tolerance: float = 0.5
     """Size / altitude priors reject a class when a blob is outside [lo·(1-t), hi·(1+t)]."""
+    prior_min_instances: int = 3
+    """A class's learned feature is a prior only when learned from this many instances: the
+    range of one TV's altitude is a point, and the views of the next TV, stand in or out, are
+    not (house 44: 9 of 46 refused)."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -583,7 +587,8 @@ class TrackerConfig(_Part):
         _nonnegative(self, ("stitch_max_gap_s", "stitch_appearance_gap_s", "stitch_speed_mps",
                             "stitch_margin_m", "stitch_duplicate_m", "stitch_overlap_m",
                             "stitch_pace_factor", "stitch_min_pace_mps", "search_max_footprint_m",
-                            "reidentify_moved_m", "refused_min_views", "full_view_min_px2"))
+                            "reidentify_moved_m", "refused_min_views", "full_view_min_px2",
+                            "prior_min_instances"))
         _in_unit_interval(self, ("stitch_min_overlap", "class_size_tolerance", "refused_max_share",
                                  "full_view_cover"))
 

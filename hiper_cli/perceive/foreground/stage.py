@@ -174,9 +174,14 @@ class ForegroundStage:
                 except DataError:  # written by an older hiper: no prior rather than no run
                     continue
 
+    def _prior(self, kind: str, class_name: str) -> ObjectDynamics | SizeFeature | AltitudeFeature | None:
+        """The learned feature of a class, when learned from ``prior_min_instances`` instances."""
+        found = self._priors.get((kind, class_name))
+        return found if found is not None and found.instances >= self.config.prior_min_instances else None
+
     def _class_prior(self, class_name: str) -> ClassPrior:
         cfg = self.config
-        ods = self._priors.get((KIND_ODS, class_name))
+        ods = self._prior(KIND_ODS, class_name)
         if not isinstance(ods, ObjectDynamics) or not cfg.use_learned_priors:
             return ClassPrior()
         return ClassPrior(
@@ -198,12 +203,12 @@ class ForegroundStage:
         if not cfg.use_learned_priors:
             return True
         tol = cfg.prior_tolerance
-        size = self._priors.get((KIND_SIZE, class_name))
+        size = self._prior(KIND_SIZE, class_name)
         bounded = cfg.learned_size and class_name not in cfg.walker_classes  # walkers: a mean box
         volume_m3 = float(np.prod(blob.extent_map_m))
         if bounded and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
             return False
-        alt = self._priors.get((KIND_ALTITUDE, class_name))
+        alt = self._prior(KIND_ALTITUDE, class_name)
         if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
             slack = tol * max(alt.hi_m - alt.lo_m, MIN_ALTITUDE_SPAN_M)
             bottom = float(blob.center_map_m[2] - blob.extent_map_m[2] / 2.0)
