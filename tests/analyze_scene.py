@@ -14,8 +14,10 @@ from hiper_cli.model import Box3D, Instance
 def track_instance(
     rows: np.ndarray, class_name: str = "person", extent=(0.5, 0.4, 1.7), bottom_m: float = 0.0
 ) -> Instance:
-    """A closed foreground instance whose trajectory is ``rows`` (N, 7)."""
+    """A closed foreground instance whose trajectory is ``rows`` (N, 7); ``dynamic`` when it
+    travelled half a metre, as the tracker's state (``dynamic_travel_m``)."""
     rows = np.asarray(rows, dtype=np.float64).copy()
+    travelled_m = float(np.ptp(rows[:, 1:3], axis=0).max()) if len(rows) else 0.0
     rows[:, 3] = bottom_m + extent[2] / 2.0  # the tracked centre: the box's
     center = np.array([rows[-1, 1], rows[-1, 2], rows[-1, 3]])
     return Instance(
@@ -24,7 +26,7 @@ def track_instance(
         Box3D(center, np.asarray(extent, dtype=np.float64)),
         float(rows[0, 0]),
         float(rows[-1, 0]),
-        state="static",
+        state="dynamic" if travelled_m > 0.5 else "static",
         data={"trajectory": rows.tolist(), "closed": True},
     )
 

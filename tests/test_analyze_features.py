@@ -159,6 +159,22 @@ def test_a_class_that_never_stands_is_all_motion():
     assert ods.mean_mps == pytest.approx(0.6, abs=0.02) and ods.cl_mps <= 0.6 <= ods.cu_mps
 
 
+def test_a_static_instance_whose_filter_drifted_did_not_move(tmp_path):
+    """House 44: standing chairs, tables and beds, their filters drifting as more of them came
+    into view (0.1-0.7 m/s at times), made half of all chair rows "dynamic" at 0.38 m/s. The
+    tracker's state says they never moved; a chair that was pushed across the room did."""
+    rng = np.random.default_rng(3)
+    drifting = [
+        track_instance(walk_stand_rows(rng, 5.0 * k, 0.0, 0.0, 30.0, noise_mps=0.3), "chair")
+        for k in range(4)
+    ]
+    pushed = track_instance(walk_stand_rows(rng, 0.0, 0.5, 4.0, 6.0), "chair")
+    kb = write_instances(tmp_path / "kb", [*drifting, pushed])
+    (chair,) = compute_features(kb, ["chair"]).classes
+    assert chair.ods.ratio == pytest.approx(4.0 / (4 * 30.0 + 10.0), abs=0.01)  # the push alone
+    assert chair.ods.mean_mps == pytest.approx(0.5, abs=0.05)
+
+
 def test_the_kb_and_the_graph_take_the_speed_from_one_function(tmp_path):
     from hiper_cli.graph.ontology import speed_mps
     from hiper_cli.learned import path_speed_mps

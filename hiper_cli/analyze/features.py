@@ -1,8 +1,11 @@
 """Feature learning (paper VI-A): the Object Dynamic Score, size and altitude of each class.
 
 Speeds are the horizontal speeds |(vx, vy)| of the trajectory rows (the tracker's filtered
-velocity); σ of the folded-normal noise of the standing rows is estimated per class, rows above
-``noise_sigmas · σ`` (paper: 2σ) are the dynamic portion D. Size (box volume) and altitude
+velocity). The rows of a static instance stand (its state: the tracker found it never moved;
+its filter drifts as more of it comes into view, a table seen end first and then whole, and
+the drift is no motion); σ of the folded-normal noise of the other rows' standing phases is
+estimated per class, and those above ``noise_sigmas · σ`` (paper: 2σ) are the dynamic
+portion D. Size (box volume) and altitude
 (box bottom above the floor) are per instance: a track's box is the object's extent over all
 its sightings, where one observation sees only part of it. Confidence intervals of the means
 are percentile bootstraps; the speed's resamples whole tracks. Everything is computed from
@@ -140,12 +143,16 @@ def _value_feature(values: FloatArray, config: FeatureConfig) -> tuple[float, fl
 
 
 def object_dynamics(
-    speeds_mps: FloatArray, track: NDArray[np.int64], config: FeatureConfig
+    speeds_mps: FloatArray, track: NDArray[np.int64], config: FeatureConfig,
+    still: NDArray[np.bool_] | None = None,
 ) -> ObjectDynamics:
-    """The ODS of one class from its rows' speeds and the track of each row."""
-    sigma = folded_normal_sigma(speeds_mps, config.noise_sigmas, config.min_sigma_mps, config.max_sigma_mps)
+    """The ODS of one class from its rows' speeds and the track of each row; ``still`` rows (of
+    static instances) stand, and the noise σ is that of the other rows when there are any."""
+    still = np.zeros(speeds_mps.shape, dtype=bool) if still is None else still
+    noisy = speeds_mps[~still] if np.any(~still) else speeds_mps
+    sigma = folded_normal_sigma(noisy, config.noise_sigmas, config.min_sigma_mps, config.max_sigma_mps)
     threshold = config.noise_sigmas * sigma
-    dynamic = speeds_mps > threshold
+    dynamic = (speeds_mps > threshold) & ~still
     d = speeds_mps[dynamic]
     mean = lo = hi = cl = cu = None
     if d.size:
@@ -183,13 +190,14 @@ def features_of_tracks(
     names, codes = np.unique(np.asarray(inst.class_names, dtype=str), return_inverse=True)
     row_code = codes[track] if track.size else np.zeros(0, dtype=np.int64)
     speeds = np.hypot(rows[:, 4], rows[:, 5])
+    still = inst.static[track]
     out: list[ClassFeatures] = []
     for code, name in enumerate(names.tolist()):
         sel = row_code == code
         seen = np.unique(track[sel])
         if seen.size < config.min_instances:
             continue
-        ods = object_dynamics(speeds[sel], track[sel], config)
+        ods = object_dynamics(speeds[sel], track[sel], config, still[sel])
         n_rows = np.bincount(track[sel], minlength=len(inst.uuids)).astype(np.float64)
         z_sum = np.bincount(track[sel], weights=rows[sel, 3], minlength=len(inst.uuids))
         if ods.ratio >= config.moving_class_ratio:

@@ -43,6 +43,7 @@ class InstanceColumns:
     half_aabb_m: NDArray[np.float64]  # (N, 3), half size of the axis-aligned map-frame box
     first_seen_s: NDArray[np.float64]  # (N,)
     last_seen_s: NDArray[np.float64]  # (N,)
+    static: NDArray[np.bool_]  # (N,) the tracker's state: it never moved
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,8 @@ class TrajectoryColumns:
 
 _INSTANCES = (
     "SELECT uuid, class, json_extract(body, '$.box.center_m'), json_extract(body, '$.box.extent_m'), "
-    "json_extract(body, '$.first_seen_s'), stamp_s, seq, json_extract(body, '$.box.R') FROM docs "
+    "json_extract(body, '$.first_seen_s'), stamp_s, seq, json_extract(body, '$.box.R'), "
+    "json_extract(body, '$.state') FROM docs "
     "WHERE type = 'instance' AND layer = ?{where} ORDER BY id"
 )
 
@@ -112,6 +114,7 @@ def _instances(rows: list[tuple[object, ...]]) -> InstanceColumns:
         half_aabb_m=half,
         first_seen_s=np.array([float(r[4]) for r in rows], dtype=np.float64),  # type: ignore[arg-type]
         last_seen_s=np.array([float(r[5]) for r in rows], dtype=np.float64),  # type: ignore[arg-type]
+        static=np.array([r[8] == "static" for r in rows], dtype=bool),
     )
 
 
@@ -183,6 +186,7 @@ def columns_of_instances(instances: Sequence[Instance]) -> TrajectoryColumns:
         ).reshape(-1, 3),
         first_seen_s=np.array([i.first_seen_s for i in fg], dtype=np.float64),
         last_seen_s=np.array([i.last_seen_s for i in fg], dtype=np.float64),
+        static=np.array([i.state == "static" for i in fg], dtype=bool),
     )
     rows = np.concatenate(parts) if parts else np.zeros((0, ROW_WIDTH))
     track = (
