@@ -498,9 +498,8 @@ class Tracker:
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         if m.whole:
             track.whole_stamps_s.append(track.last_update_s)
-            seen = track.whole_footprint_m
-            track.whole_footprint_m = m.extent_map_m[:2] if seen is None else seen + EXTENT_GAIN * (
-                m.extent_map_m[:2] - seen)
+            was, now = track.whole_footprint_m, np.array(m.extent_map_m[:2], float)
+            track.whole_footprint_m = now if was is None else was + EXTENT_GAIN * (now - was)
         track.max_size_m = max(track.max_size_m, _size_m(m.extent_map_m))
         track.observation_uuids.append(m.observation_uuid)
         if m.appearance is not None and m.class_name in self.config.walker_classes:
