@@ -112,6 +112,11 @@ def test_sparql_file_and_stdin_are_read_only(kb_path, tmp_path):
     assert counts["chair"] == ask_count(kb_path, "how many chairs")
     stdin = runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path, "--json"], input=COUNT_QUERY)
     assert json.loads(stdin.output) == json.loads(result.output)
+    inline = runner.invoke(app, ["query", "--sparql", COUNT_QUERY, "--kb", kb_path, "--json"])
+    assert json.loads(inline.output) == json.loads(result.output)
+    missing = runner.invoke(app, ["query", "--sparql", str(tmp_path / "none.rq"), "--kb", kb_path])
+    assert missing.exit_code == 1
+    assert "none.rq: cannot read the SPARQL file" in " ".join(missing.output.split())
     before = _quads(kb_path)
     for update in (
         "INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } }",
@@ -121,6 +126,8 @@ def test_sparql_file_and_stdin_are_read_only(kb_path, tmp_path):
     ):
         refused = runner.invoke(app, ["query", "--sparql", "-", "--kb", kb_path], input=update)
         assert refused.exit_code == 1 and "refused" in refused.output
+        inline = runner.invoke(app, ["query", "--sparql", update, "--kb", kb_path])
+        assert inline.exit_code == 1 and "refused" in inline.output
     assert _quads(kb_path) == before
 
 

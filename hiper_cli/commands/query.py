@@ -1,4 +1,4 @@
-"""``hiper query "..."``, ``hiper query --sparql FILE``, ``hiper query workspace``,
+"""``hiper query "..."``, ``hiper query --sparql QUERY|FILE``, ``hiper query workspace``,
 ``hiper query bench``: ask the scene memory (see docs/query.md)."""
 
 from __future__ import annotations
@@ -93,7 +93,9 @@ def ask_command(
     sparql: Annotated[
         str | None,
         typer.Option(
-            "--sparql", help="Run a read-only SPARQL query from FILE ('-': stdin) instead of plain words."
+            "--sparql",
+            help="Run a read-only SPARQL query instead of plain words: the query itself, a FILE or "
+            "'-' (stdin).",
         ),
     ] = None,
     as_json: bool = JSON_OPTION,
@@ -106,11 +108,11 @@ def ask_command(
 
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         if sparql is not None:
-            text = sys.stdin.read() if sparql == "-" else _read(Path(sparql))
+            text = sys.stdin.read() if sparql == "-" else _sparql_text(sparql)
             _print_sparql(knowledge.run_readonly(text)[0], as_json)
             return
         if not words:
-            raise QueryError('no query; e.g. hiper query "cups in FOV" or --sparql FILE')
+            raise QueryError('no query; e.g. hiper query "cups in FOV" or --sparql "SELECT ..."')
         from hiper_cli.query import ask
 
         span = knowledge.stamp_span()
@@ -129,12 +131,24 @@ def ask_command(
     _render_answer(answer)
 
 
-def _read(path: Path) -> str:
+# the first word of a SPARQL query given inline rather than as a file
+SPARQL_OPENINGS = ("select", "ask", "construct", "describe", "prefix", "base", "insert", "delete", "with",
+                   "load", "clear", "drop", "create", "copy", "move", "add")
+
+
+def _sparql_text(value: str) -> str:
+    """The query ``--sparql`` names: its own text when it opens like a SPARQL query and names no
+    file, else the file's contents."""
+    words = value.split(maxsplit=1)
+    if words and words[0].lower() in SPARQL_OPENINGS and len(words) > 1 and not Path(value).is_file():
+        return value
+    path = Path(value)
     try:
         return path.read_text(encoding="utf-8")
     except OSError as err:
         raise QueryError(
-            f"{path}: cannot read the SPARQL file ({err.strerror}); pass a .rq file or '-'"
+            f"{path}: cannot read the SPARQL file ({err.strerror}); pass the query itself "
+            "(--sparql 'SELECT ...'), a .rq file or '-'"
         ) from err
 
 
