@@ -117,6 +117,8 @@ def test_sparql_file_and_stdin_are_read_only(kb_path, tmp_path):
     missing = runner.invoke(app, ["query", "--sparql", str(tmp_path / "none.rq"), "--kb", kb_path])
     assert missing.exit_code == 1
     assert "none.rq: cannot read the SPARQL file" in " ".join(missing.output.split())
+    flag_only = runner.invoke(app, ["query", COUNT_QUERY, "--sparql", "--kb", kb_path])  # the query before it
+    assert flag_only.exit_code == 1 and "right after --sparql" in " ".join(flag_only.output.split())
     before = _quads(kb_path)
     for update in (
         "INSERT DATA { GRAPH <urn:x> { <urn:a> <urn:b> <urn:c> } }",

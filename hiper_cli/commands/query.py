@@ -106,9 +106,9 @@ def ask_command(
     """
     from hiper_cli.graph import open_kb_for_reading
 
+    text = None if sparql is None else sys.stdin.read() if sparql == "-" else _sparql_text(sparql)
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
-        if sparql is not None:
-            text = sys.stdin.read() if sparql == "-" else _sparql_text(sparql)
+        if text is not None:
             _print_sparql(knowledge.run_readonly(text)[0], as_json)
             return
         if not words:
@@ -139,6 +139,8 @@ SPARQL_OPENINGS = ("select", "ask", "construct", "describe", "prefix", "base", "
 def _sparql_text(value: str) -> str:
     """The query ``--sparql`` names: its own text when it opens like a SPARQL query and names no
     file, else the file's contents."""
+    if value.startswith("--"):  # hiper query "SELECT ..." --sparql --kb x.hiper
+        raise QueryError(f"--sparql {value}: expected the query, a FILE or '-' right after --sparql")
     words = value.split(maxsplit=1)
     if words and words[0].lower() in SPARQL_OPENINGS and len(words) > 1 and not Path(value).is_file():
         return value
