@@ -182,6 +182,24 @@ def test_heatmap_window_selects_rows(hospital, tmp_path):
     assert full.rows == 5 * 90 * 5 and part.rows == 5 * 151 and part.instances == 5  # 5 Hz, [0, 30] s
 
 
+def test_a_window_with_no_rows_is_a_one_line_error_that_stores_nothing(hospital, tmp_path):
+    """A window after the data or a daily span the log never saw crashed in OpenCV's blur."""
+    from hiper_cli.graph import open_kb
+
+    path, _ = hospital
+    with open_kb(path) as kb:
+        before = kb.docs.count(type="analysis"), kb.docs.find(type="environment")
+    runner = CliRunner()
+    for window in (["--from", "1000"], ["--daily", "09:00-17:00"]):
+        r = runner.invoke(app, ["analyze", "heatmap", "--class", "person", "--kb", str(path), *window,
+                                "-o", str(tmp_path)])
+        text = " ".join(r.output.split())
+        assert r.exit_code == 1 and "Traceback" not in r.output, r.output
+        assert "no person trajectory rows in the window" in text and "holds them from 0.0 to 89.8 s" in text
+    with open_kb(path) as kb:
+        assert (kb.docs.count(type="analysis"), kb.docs.find(type="environment")) == before  # no map stored
+
+
 def test_heatmap_cli_json_and_errors(hospital, tmp_path):
     path, _ = hospital
     runner = CliRunner()

@@ -15,6 +15,7 @@ from hiper_cli.analyze.features import FeatureConfig, check_classes, object_dyna
 from hiper_cli.analyze.heatmap import Heatmap, HeatmapConfig, heatmap_from_rows
 from hiper_cli.analyze.maplayer import MapConfig, environment_of, map_for
 from hiper_cli.analyze.window import TimeWindow
+from hiper_cli.errors import DataError
 from hiper_cli.graph.columns import trajectory_columns
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.learned import KIND_HEATMAP, KIND_ODS, ObjectDynamics
@@ -42,6 +43,14 @@ def learned_speed_mps(kb: KnowledgeBase, class_name: str) -> float | None:
     return ObjectDynamics.from_values(Analysis.from_dict(newest).values).mean_mps
 
 
+def _nothing_in(kb: KnowledgeBase, class_name: str, window: TimeWindow) -> str:
+    """Why a window holds no row of a class, and when the class was seen."""
+    every = trajectory_columns(kb.docs, class_name).rows[:, 0]
+    seen = f"from {every.min():.1f} to {every.max():.1f} s" if every.size else "in no trajectory row"
+    return (f"no {class_name} trajectory rows in the window ({window.describe()}); {kb.location} holds "
+            f"them {seen}: widen --from/--to, --last or --daily")
+
+
 def generate_heatmap(
     kb: KnowledgeBase,
     class_name: str,
@@ -62,16 +71,19 @@ def generate_heatmap(
     window = window or TimeWindow()
     check_classes(kb, [class_name])
     env = environment_of(kb, env_name)
-    grid = map_for(kb, env, map_yaml, map_config, store=store)
     tracks = trajectory_columns(kb.docs, class_name, window.t_start_s, window.t_end_s)
+    keep = window.mask(tracks.rows[:, 0])
+    if not np.any(keep):  # before the map is built and stored: bad input changes nothing
+        raise DataError(_nothing_in(kb, class_name, window))
+    grid = map_for(kb, env, map_yaml, map_config, store=store)
     speed = learned_speed_mps(kb, class_name)
     source = "ods analysis"
     if speed is None:
-        keep = window.mask(tracks.rows[:, 0])
-        rows = tracks.rows[keep]
+        rows, track = tracks.rows[keep], tracks.track[keep]
         speeds = np.hypot(rows[:, 4], rows[:, 5])
-        ods = object_dynamics(speeds, tracks.track[keep], FeatureConfig(bootstrap_samples=10))
-        speed, source = ods.mean_mps, "these rows"
+        still = tracks.instances.static[track]
+        ods = object_dynamics(speeds, track, FeatureConfig(bootstrap_samples=10), still)
+        speed, source = (0.0 if ods.mean_mps is None else ods.mean_mps), "these rows"
     hm = heatmap_from_rows(class_name, tracks.rows, tracks.track, grid, window, speed, config)
     files = write_outputs(hm, out_dir, mask_config, inverse=inverse)
     if store:

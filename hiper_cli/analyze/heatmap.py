@@ -124,7 +124,8 @@ def heatmap_from_rows(
     weights = _row_weights(rows, track, config.max_row_dt_s)
     iy, ix, inside = grid.cell_of(rows[:, 1:3])
     h, w = grid.shape
-    flat = np.bincount(iy[inside] * w + ix[inside], weights=weights[inside], minlength=h * w)
+    cells = iy[inside] * w + ix[inside]
+    flat = np.bincount(cells, weights=weights[inside], minlength=h * w).astype(np.float64)  # float if empty
     sigma_cells = sigma_m / grid.resolution_m
     k = 2 * int(np.ceil(3.0 * sigma_cells)) + 1  # the kernel to 3σ
     density = cv2.GaussianBlur(
