@@ -312,3 +312,16 @@ def test_each_learned_dynamics_prior_switches_alone():
     assert (priors["no gates"].cu_mps, priors["no gates"].sigma_mps) == (None, 0.03)
     assert (priors["no noise"].cu_mps, priors["no noise"].sigma_mps) == (0.8, None)
     assert (priors["C2"].cu_mps, priors["C2"].sigma_mps) == (None, None)
+
+
+def test_a_class_seen_only_standing_sets_no_motion_noise():
+    """House 44 -> 47: the drift σ of standing chairs and bottles, taken for their motion noise,
+    stiffened their filters and added identity switches in the next log."""
+    from hiper_cli.learned import ObjectDynamics
+
+    world = World(background=background_instances(room()))
+    standing = ObjectDynamics(None, None, None, None, None, 0.0, 0.03, 0.06, 300, 0, 5)
+    world.analyses.append(standing.to_analysis("chair", 0, 1, created_s=1.0))
+    stage = ForegroundStage(detector="log", pixel_step=2)
+    stage.process(walker_frames(1)[0], world)
+    assert (stage._class_prior("chair").cu_mps, stage._class_prior("chair").sigma_mps) == (None, None)

@@ -564,7 +564,8 @@ class TrackerConfig(_Part):
     learned_gates: bool = True
     """The ODS's ``cu_mps · dt`` bounds the tracker's association gate (dt < 1 s)."""
     learned_motion_noise: bool = True
-    """The ODS's stationary-noise ``sigma_mps`` sets the class's acceleration noise."""
+    """The ODS's stationary-noise ``sigma_mps`` sets the class's acceleration noise, for a class
+    some instance of which moved (``dynamic_rows``)."""
     learned_size: bool = True
     """A detection whose blob volume is outside the class's learned range becomes ``unknown``."""
     learned_altitude: bool = True

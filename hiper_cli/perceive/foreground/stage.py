@@ -186,7 +186,8 @@ class ForegroundStage:
             return ClassPrior()
         return ClassPrior(
             cu_mps=ods.cu_mps if cfg.learned_gates else None,
-            sigma_mps=ods.sigma_mps if cfg.learned_motion_noise else None,
+            # a class seen only standing taught no motion: its σ is the drift of its own filter
+            sigma_mps=ods.sigma_mps if cfg.learned_motion_noise and ods.dynamic_rows else None,
         )
 
     def _fits_priors(self, class_name: str, blob: Blob, frame: Frame) -> bool:
