@@ -114,6 +114,9 @@ def test_sparql_file_and_stdin_are_read_only(kb_path, tmp_path):
     assert json.loads(stdin.output) == json.loads(result.output)
     inline = runner.invoke(app, ["query", "--sparql", COUNT_QUERY, "--kb", kb_path, "--json"])
     assert json.loads(inline.output) == json.loads(result.output)
+    long_query = COUNT_QUERY.replace("SELECT", "SELECT" + " " * 300)  # longer than a file name may be
+    inline = runner.invoke(app, ["query", "--sparql", long_query, "--kb", kb_path, "--json"])
+    assert json.loads(inline.output) == json.loads(result.output)
     missing = runner.invoke(app, ["query", "--sparql", str(tmp_path / "none.rq"), "--kb", kb_path])
     assert missing.exit_code == 1
     assert "none.rq: cannot read the SPARQL file" in " ".join(missing.output.split())

@@ -5,9 +5,9 @@ velocity). The rows of a static instance stand (its state: the tracker found it 
 its filter drifts as more of it comes into view, a table seen end first and then whole, and
 the drift is no motion); σ of the folded-normal noise of the other rows' standing phases is
 estimated per class, and those above ``noise_sigmas · σ`` (paper: 2σ) are the dynamic
-portion D. Size (box volume) and altitude
-(box bottom above the floor) are per instance: a track's box is the object's extent over all
-its sightings, where one observation sees only part of it. Confidence intervals of the means
+portion D. Size (box volume) and altitude (box bottom above the floor) are per instance: a
+track's box is the object's extent over all its sightings, where one observation sees only
+part of it. Confidence intervals of the means
 are percentile bootstraps; the speed's resamples whole tracks. Everything is computed from
 column reads of the knowledge base (``graph.columns``), never from a document per row.
 """

@@ -142,7 +142,7 @@ def _sparql_text(value: str) -> str:
     if value.startswith("--"):  # hiper query "SELECT ..." --sparql --kb x.hiper
         raise QueryError(f"--sparql {value}: expected the query, a FILE or '-' right after --sparql")
     words = value.split(maxsplit=1)
-    if words and words[0].lower() in SPARQL_OPENINGS and len(words) > 1 and not Path(value).is_file():
+    if len(words) > 1 and words[0].lower() in SPARQL_OPENINGS and not _is_file(value):
         return value
     path = Path(value)
     try:
@@ -152,6 +152,13 @@ def _sparql_text(value: str) -> str:
             f"{path}: cannot read the SPARQL file ({err.strerror}); pass the query itself "
             "(--sparql 'SELECT ...'), a .rq file or '-'"
         ) from err
+
+
+def _is_file(value: str) -> bool:
+    try:
+        return Path(value).is_file()
+    except OSError:  # a long query is no file name (ENAMETOOLONG)
+        return False
 
 
 def _print_sparql(body: bytes, as_json: bool) -> None:
