@@ -576,7 +576,7 @@ class TrackerConfig(_Part):
     prior_min_instances: int = 3
     """A class's learned feature is a prior only when learned from this many instances: the
     range of one TV's altitude is a point, and the views of the next TV, stand in or out, are
-    not (house 44: 9 of 46 refused)."""
+    not."""
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -173,8 +173,7 @@ def split_unseen_tables(
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
-                out.append(_part(blob, rest[part], top, config, width, height))
-                out[-1].cut_from_table_m = table_box
+                out.append(_part(blob, rest[part], top, table_box, config, width, height))
     return out, tables, lookalikes
 
 
@@ -195,10 +194,12 @@ def _held(
 
 
 def _part(
-    blob: Blob, sel: NDArray[np.int64], top: Box3D, config: SegmentConfig, width: int, height: int
+    blob: Blob, sel: NDArray[np.int64], top: Box3D, table_box: tuple[FloatArray, FloatArray] | None,
+    config: SegmentConfig, width: int, height: int,
 ) -> Blob:
     """A part of ``blob`` as a blob of its own, standing on the table top, on the floor below the
-    blob (as the segmentation found it), or on nothing known."""
+    blob (as the segmentation found it), or on nothing known; cut from the table in ``table_box``."""
     part = sub_blob(blob, sel, config.pixel_step, width, height)
     part.support_z_m = standing_on(part, [float(top.aabb()[1][2]), blob.support_z_m], config)
+    part.cut_from_table_m = table_box
     return part
