@@ -81,6 +81,27 @@ def test_cli_json_and_errors(tmp_path):
     assert result.exit_code != 0 and "--short-s" in result.output
 
 
+def test_several_logs_are_one_benchmark_with_figures_over_all_questions(tmp_path):
+    k = house_truth_kb()
+    log = str(k.path.parent / "log")
+    one = evaluate_qa(log, kb=str(k.path), out_dir=tmp_path / "one")
+    result = runner.invoke(app, ["eval", "qa", log, log, "--kb", str(k.path), "--kb", str(k.path),
+                                 "-o", str(tmp_path / "set"), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["format"] == "hiper-eval-qa-set" and len(data["logs"]) == 2
+    assert data["questions"] == 2 * one.figures["questions"]
+    for key in ("binary_accuracy", "count_accuracy", "position_error_median_m", "time_error_median_s"):
+        assert data[key] == one.figures[key] and data["logs"][1][key] == one.figures[key]
+    assert sorted(p.name for p in (tmp_path / "set").iterdir()) == ["log", "log-2"]
+    assert (tmp_path / "set" / "log-2" / "answers.jsonl").exists()
+    result = runner.invoke(app, ["eval", "qa", log, log, "--kb", str(k.path)])
+    assert result.exit_code != 0 and "1 --kb for 2 logs" in result.output
+    result = runner.invoke(app, ["eval", "qa", log, str(tmp_path / "nothing"), "-o", str(tmp_path / "x")])
+    assert result.exit_code != 0 and "nothing" in result.output and "not found" in result.output
+    assert not (tmp_path / "x").exists()  # named before the first log is perceived
+
+
 def test_without_a_kb_the_log_is_perceived_with_the_truth_detector(tmp_path):
     log = house_truth_kb().path.parent / "log"
     report = evaluate_qa(log, out_dir=tmp_path)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -23,9 +24,12 @@ def _err(v: Any) -> str:
 
 @eval_app.command("qa")
 def qa(
-    log: Annotated[Path, typer.Argument(help="A log with ground truth: hiper sim's gt/ or a world's gt/.")],
+    logs: Annotated[list[Path], typer.Argument(
+        help="Logs with ground truth: hiper sim's gt/ or a world's gt/. Several are one benchmark: "
+        "figures per log and over all their questions.")],
     kb: Annotated[
-        str | None, typer.Option("--kb", help="Answer from this knowledge base (default: perceive the log).")
+        list[str] | None, typer.Option("--kb", help="Answer from this knowledge base (default: perceive the "
+                                       "log); once per LOG, in order, for several logs.")
     ] = None,
     detector: Annotated[
         str, typer.Option("--detector", help="When perceiving: auto (truth where the log has gt/detections."
@@ -33,7 +37,8 @@ def qa(
     ] = "auto",
     out_dir: Annotated[
         Path | None,
-        typer.Option("--out", "-o", help="Folder for questions.jsonl, answers.jsonl (and kb.hiper)."),
+        typer.Option("--out", "-o", help="Folder for questions.jsonl, answers.jsonl (and kb.hiper); with "
+                     "several logs, a folder per log in it."),
     ] = None,
     short_s: Annotated[
         float, typer.Option("--short-s", help="The short horizon: the last this many seconds.")
@@ -51,22 +56,63 @@ def qa(
     name are scored apart. The questions with their true answers are written as JSONL.
 
     Example: hiper eval qa out/house -o out/house_qa --json
-    """
-    from hiper_cli.qa import evaluate_qa
 
-    with frame_progress("perceive", console(), enabled=not as_json and kb is None) as bar:
-        report = evaluate_qa(log, kb=kb, detector=detector, out_dir=out_dir, short_s=short_s, seed=seed,
-                             glimpse_s=glimpse_s, progress=None if bar is None else bar.update)
-    data = report.to_dict()
+    Example: hiper eval qa out/house_1 out/office_2 out/hospital_3 -o out/qa
+    """
+    from hiper_cli.qa import evaluate_qa, evaluate_qa_set
+
+    options: dict[str, Any] = {"detector": detector, "short_s": short_s, "seed": seed, "glimpse_s": glimpse_s}
+    if len(logs) == 1 and (kb is None or len(kb) == 1):
+        with frame_progress("perceive", console(), enabled=not as_json and kb is None) as bar:
+            report = evaluate_qa(logs[0], kb=kb[0] if kb else None, out_dir=out_dir,
+                                 progress=None if bar is None else bar.update, **options)
+        data = report.to_dict()
+        if as_json:
+            print_json(data)
+            return
+        title = f"hiper eval qa {logs[0]} (detector {report.detector}"
+        title += f", answers from {kb[0]})" if kb else ")"
+        _print_kinds(data, title)
+        _print_headline(data, glimpse_s, f"questions in {data['files']['questions']}")
+        return
+    bars = ExitStack()  # one bar at a time: rich shows a single live display
+
+    def on_log(i: int, log: Path) -> Any:
+        bars.close()
+        if as_json or kb is not None:
+            return None
+        bar = bars.enter_context(frame_progress(f"perceive {i + 1}/{len(logs)} {log.name}", console()))
+        return None if bar is None else bar.update
+
+    with bars:
+        result = evaluate_qa_set(logs, kbs=kb, out_dir=out_dir, on_log=on_log, **options)
+    data = result.to_dict()
     if as_json:
         print_json(data)
         return
+    _print_logs(data)
+    _print_kinds(data, f"hiper eval qa: all {len(logs)} logs")
+    _print_headline(data, glimpse_s, f"over all {len(logs)} logs")
+
+
+def _print_logs(data: dict[str, Any]) -> None:
     from rich.table import Table
 
-    out = console()
+    table = Table("log", "detector", "questions", "binary", "count", "count, glimpses optional",
+                  "position m", "time s", "duration s", title="hiper eval qa, per log")
+    for row in [*data["logs"], {**data, "log": "all", "detector": ""}]:
+        table.add_row(Path(row["log"]).name if row["log"] != "all" else "[bold]all", str(row["detector"]),
+                      str(row["questions"]), _fmt(row["binary_accuracy"]), _fmt(row["count_accuracy"]),
+                      _fmt(row["count_accuracy_glimpses_optional"]), _err(row["position_error_median_m"]),
+                      _err(row["time_error_median_s"]), _err(row["duration_error_median_s"]))
+    console().print(table)
+
+
+def _print_kinds(data: dict[str, Any], title: str) -> None:
+    from rich.table import Table
+
     table = Table("kind", "horizon", "questions", "answered", "accuracy / median error", "detail",
-                  title=f"hiper eval qa {log} (detector {report.detector}"
-                  + (f", answers from {kb})" if kb else ")"))
+                  title=title)
     for kind, by in data["by_kind"].items():
         for horizon in ("short", "long", "all"):
             f = by[horizon]
@@ -85,14 +131,18 @@ def qa(
             else:
                 note = f"answered: median {_fmt(f.get('median_error_answered'))}{unit}"
             table.add_row(kind, horizon, str(f["n"]), str(f["answered"]), value, note)
-    out.print(table)
+    console().print(table)
+
+
+def _print_headline(data: dict[str, Any], glimpse_s: float, where: str) -> None:
+    out = console()
     out.print(
         f"binary accuracy {_fmt(data['binary_accuracy'])}, count accuracy {_fmt(data['count_accuracy'])} "
         f"({_fmt(data['count_accuracy_glimpses_optional'])} with instances in view < {glimpse_s:g} s "
         "optional), "
         f"position error {_err(data['position_error_median_m'])} m, time error "
         f"{_err(data['time_error_median_s'])} s, duration error {_err(data['duration_error_median_s'])} s "
-        f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); questions in {data['files']['questions']}"
+        f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); {where}"
     )
     other = data["unnamed"]
     if other["questions"]:

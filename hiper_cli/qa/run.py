@@ -12,11 +12,12 @@ from pathlib import Path
 from typing import Any
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.logs.truth import load_truth
 from hiper_cli.qa.questions import generate_questions
 from hiper_cli.qa.scene import load_scene_truth
 from hiper_cli.qa.score import Scored, answer_question, summarise
 
-__all__ = ["QaReport", "evaluate_qa", "pick_detector"]
+__all__ = ["QaReport", "QaSet", "evaluate_qa", "evaluate_qa_set", "pick_detector"]
 
 # DAAAM (OC-NaVQA, real data, a cloud LLM): binary accuracy, position error (m), time error (s).
 PUBLISHED = {"system": "DAAAM on OC-NaVQA", "binary_accuracy": 0.711, "position_error_m": 41.75,
@@ -130,3 +131,55 @@ def evaluate_qa(
     figures = summarise(scored) | {"seen_min_pixels": scene.min_pixels, "glimpse_s": glimpse_s}
     return QaReport(str(log), kb, used, short_s, seed, figures, scored, files,
                     {k: round(v, 2) for k, v in seconds.items()})
+
+
+@dataclass
+class QaSet:
+    """Several logs asked as one benchmark: each log's report, and ``figures`` over every
+    question of them all (a median over all position errors, not a median of medians)."""
+
+    reports: list[QaReport]
+    figures: dict[str, Any]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"format": "hiper-eval-qa-set", "version": 1, "logs": [r.to_dict() for r in self.reports],
+                **self.figures, "published": PUBLISHED}
+
+
+def log_folders(logs: list[Path], out_dir: Path) -> list[Path]:
+    """One folder per log under ``out_dir``, named after the log (``name-2`` for a repeat)."""
+    folders: list[Path] = []
+    for log in logs:
+        name, k = log.resolve().name or "log", 1
+        while out_dir / name in folders:
+            k += 1
+            name = f"{log.resolve().name}-{k}"
+        folders.append(out_dir / name)
+    return folders
+
+
+def evaluate_qa_set(
+    logs: list[Path],
+    *,
+    kbs: list[str] | None = None,
+    out_dir: str | Path | None = None,
+    on_log: Callable[[int, Path], Callable[[int, int], None] | None] | None = None,
+    **options: Any,
+) -> QaSet:
+    """``evaluate_qa`` on each of ``logs`` (answered from ``kbs[i]`` when given, one per log),
+    each writing into its own folder under ``out_dir``; pooled figures over all questions.
+    ``on_log(i, log)`` before each log returns its frame progress callback."""
+    if kbs is not None and len(kbs) != len(logs):
+        raise ConfigError(f"{len(kbs)} --kb for {len(logs)} logs: give --kb once per LOG, "
+                          "in the same order, or leave it out to perceive each log")
+    for log in logs:  # a missing gt/ is named before any log is perceived
+        load_truth(log)
+    root = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="hiper-qa-"))
+    reports = []
+    for i, (log, folder) in enumerate(zip(logs, log_folders(logs, root), strict=True)):
+        progress = on_log(i, log) if on_log is not None else None
+        reports.append(evaluate_qa(log, kb=None if kbs is None else kbs[i], out_dir=folder,
+                                   progress=progress, **options))
+    scored = [s for r in reports for s in r.scored]
+    glimpse_s = reports[0].figures["glimpse_s"] if reports else options.get("glimpse_s", 0.5)
+    return QaSet(reports, summarise(scored) | {"glimpse_s": glimpse_s})
