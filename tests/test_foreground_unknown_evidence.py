@@ -41,6 +41,38 @@ def test_a_large_blob_is_not_whole():
     assert not seen_whole(_blob(_cube(size=1.5), [200, 100, 440, 380]), ForegroundConfig(), CAMERA)
 
 
+def _standing_cube(camera_up_m=0.5, ahead_m=4.0, size=0.3, seed=0):
+    """A cube on the floor ``ahead_m`` in front of a level camera ``camera_up_m`` high: its
+    blob, the camera pose (map z up) and the depth image of the floor alone."""
+    R = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # camera axes in the map
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, [0.0, 0.0, camera_up_m]
+    rng = np.random.default_rng(seed)
+    half = size / 2
+    pts_map = rng.uniform([ahead_m - half, -half, 0.0], [ahead_m + half, half, size], (600, 3))
+    pts_cam = (pts_map - T[:3, 3]) @ R
+    uv = np.stack([CAMERA.cx + CAMERA.fx * pts_cam[:, 0] / pts_cam[:, 2],
+                   CAMERA.cy + CAMERA.fy * pts_cam[:, 1] / pts_cam[:, 2]], axis=1).astype(np.int32)
+    box = np.array([uv[:, 0].min(), uv[:, 1].min(), uv[:, 0].max(), uv[:, 1].max()], float)
+    rows = np.arange(480, dtype=np.float64)[:, None] - CAMERA.cy
+    floor = np.where(rows > 1.0, camera_up_m * CAMERA.fy / np.maximum(rows, 1.0), 0.0)
+    depth = np.repeat(floor, 640, axis=1).astype(np.float32)
+    return Blob(pts_cam, pts_map, uv, box), T, depth
+
+
+def test_a_blob_over_something_nearer_tells_nothing():
+    """The top of a box stack seen over a nearer stack does not show where its object stands:
+    the view is no evidence either way. The floor in front of an object, nearer at a grazing
+    angle, is what it stands on: the view shows it whole."""
+    blob, pose, depth = _standing_cube()
+    x0, _, x1, y1 = (int(v) for v in blob.image_box_xyxy)
+    assert float(np.median(blob.points_cam[:, 2])) - depth[y1 + 6, x0] > 0.15  # the floor is nearer
+    assert seen_whole(blob, ForegroundConfig(), CAMERA, (depth, pose)) is True
+    depth[y1:, x0 - 10:x1 + 10] = 2.0  # a box 2 m away, reaching above the cube's base
+    assert seen_whole(blob, ForegroundConfig(), CAMERA, (depth, pose)) is None  # cannot tell
+    assert seen_whole(blob, ForegroundConfig(), CAMERA) is True  # without the view: as before
+
+
 def _track(config, frames, whole=True, cls="unknown"):
     tracker = Tracker(config)
     confirmed = False
@@ -51,6 +83,21 @@ def _track(config, frames, whole=True, cls="unknown"):
         changed, _ = tracker.step(k / RATE_HZ, [m])
         confirmed |= bool(changed)
     return confirmed
+
+
+def test_views_that_cannot_tell_count_neither_way():
+    """Seen only over something nearer (a box stack's top), a blob is no instance; an object
+    seen whole now and then, and otherwise behind a chair, is one."""
+    cfg = ForegroundConfig()
+    assert not _track(cfg, 30, whole=None)
+    tracker, confirmed = Tracker(cfg), False
+    for k in range(30):
+        m = Measurement(np.array([1.0, 2.0, 0.5]), np.array([0.3, 0.3, 0.3]), "unknown", 0.0, f"o{k}",
+                        whole=k % 3 == 0 or None)  # a third whole, the rest behind a chair
+        changed, _ = tracker.step(k / RATE_HZ, [m])
+        confirmed |= bool(changed)
+    assert confirmed
+    assert not _track(cfg, 30, whole=False)
 
 
 def test_an_unknown_track_needs_whole_observations_over_half_a_second():

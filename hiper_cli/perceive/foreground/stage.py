@@ -395,7 +395,8 @@ class ForegroundStage:
             measurements.append(
                 Measurement(
                     blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
-                    whole=match.detection_index is not None or seen_whole(blob, cfg, frame.camera),
+                    whole=match.detection_index is not None
+                    or seen_whole(blob, cfg, frame.camera, (frame.depth_m, frame.T_map_cam)),
                     appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
                     standing=self._standing_box(blob),  # a walking track takes any blob as standing
                     bounds_map_m=_corners(blob),

@@ -237,6 +237,7 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     old.score_sum += new.score_sum
     old.travelled = old.travelled or new.travelled
     old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked
+    old.unsure_views += new.unsure_views
     old.standing_tops_m.extend(new.standing_tops_m)
     old.floor_z_m = new.floor_z_m if new.floor_z_m is not None else old.floor_z_m
     if new.appearance is not None:

@@ -107,8 +107,9 @@ class Measurement:
     class_name: str
     score: float
     observation_uuid: str
-    whole: bool = True
-    """Seen whole: inside the image, compact and solid (``unknown_confirm_whole``)."""
+    whole: bool | None = True
+    """Seen whole: inside the image, compact and solid (``unknown_confirm_whole``); None: cannot
+    tell, its base hidden behind something nearer (``whole.seen_whole``)."""
     appearance: FloatArray | None = None
     """Colour histogram of the blob (``appearance.histogram``), None when not computed."""
     standing: tuple[FloatArray, FloatArray] | None = None
@@ -177,6 +178,7 @@ class Track:
     max_size_m: float = 0.0  # the largest blob seen (``_size_m``: footprint diagonal or height)
     hits: int = 1
     whole_stamps_s: list[float] = field(default_factory=list)  # of the whole observations
+    unsure_views: int = 0  # observations that could not tell whether it was whole (``whole=None``)
     whole_footprint_m: FloatArray | None = None  # smoothed like ``extent_m``, whole views only
     unseen_in_view_s: float = 0.0
     confirmed: bool = False
@@ -466,7 +468,7 @@ class Tracker:
         detections named it in ``min_class_share`` of its observations or gave it its class
         (``unknown_evidence_held``; else: named it ``min_class_observations`` times),
         ``unknown_confirm_whole`` whole ones over ``unknown_min_span_s``, at least
-        ``unknown_min_whole_share`` of all its observations. A track ``closing`` without a
+        ``unknown_min_whole_share`` of those that could tell. A track ``closing`` without a
         class that detections named most of the time must have lasted ``unknown_min_span_s``
         (while it lives, its class may still come: a person is named from its first view)."""
         cfg = self.config
@@ -487,7 +489,7 @@ class Tracker:
         return (
             len(stamps) >= cfg.unknown_confirm_whole
             and stamps[-1] - stamps[0] >= cfg.unknown_min_span_s
-            and len(stamps) >= cfg.unknown_min_whole_share * track.hits
+            and len(stamps) >= cfg.unknown_min_whole_share * (track.hits - track.unsure_views)
         )
 
     def _vote(self, track: Track, m: Measurement) -> None:
@@ -496,6 +498,7 @@ class Tracker:
         if m.detection_index is not None:
             stamp = round(track.last_update_s, STAMP_DECIMALS)
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
+        track.unsure_views += m.whole is None
         if m.whole:
             track.whole_stamps_s.append(track.last_update_s)
             was, now = track.whole_footprint_m, np.array(m.extent_map_m[:2], float)

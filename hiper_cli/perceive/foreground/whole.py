@@ -11,7 +11,9 @@ couch behind a chair (``occluded``). Its outline then borders nearer surfaces; a
 whole borders only farther ones, or what it stands on. A blob whose top borders a nearer
 surface (a chair's seat under a desk's top) does not show how tall its object is
 (``top_hidden``); one whose bottom borders a nearer surface (the back of a chair behind a table,
-above the table's top) does not show where its object stands (``bottom_hidden``).
+above the table's top) does not show where its object stands (``bottom_hidden``). For the
+evidence of an ``unknown`` object, ``base_occluded`` tells that apart from the floor or table top
+it stands on, which at a grazing angle is also nearer than its base.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
 
 __all__ = [
+    "base_occluded",
     "bottom_hidden",
     "in_full_view",
     "inside_image",
@@ -56,15 +59,25 @@ def inside_image(blob: Blob, pixel_step: int, camera: CameraIntrinsics) -> bool:
     return not (x0 <= edge or y0 <= edge or x1 >= camera.width - edge or y1 >= camera.height - edge)
 
 
-def seen_whole(blob: Blob, config: ForegroundConfig, camera: CameraIntrinsics) -> bool:
-    """Whether ``blob`` lies inside the image, is compact and is not flat."""
+def seen_whole(
+    blob: Blob, config: ForegroundConfig, camera: CameraIntrinsics,
+    view: tuple[NDArray[np.float32], NDArray[np.float64]] | None = None,
+) -> bool | None:
+    """Whether ``blob`` lies inside the image, is compact and is not flat. Given the frame's
+    ``view`` (depth image, camera pose), None when the camera did not see where it stands
+    (``base_occluded``): the view tells neither way (the top of a box stack seen over a nearer
+    one may be a whole thing or a part; a plant seen behind a chair is whole elsewhere)."""
     if not inside_image(blob, config.pixel_step, camera):
         return False
     if float(np.max(blob.extent_map_m)) > config.unknown_max_extent_m:
         return False
     depth = float(np.median(blob.points_cam[:, 2]))
     flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
-    return thickness_m(blob.points_cam) >= flat_m
+    if thickness_m(blob.points_cam) < flat_m:
+        return False
+    if view is not None and base_occluded(blob, view[0], camera, view[1], config.pixel_step):
+        return None
+    return True
 
 
 def occluded(
@@ -156,6 +169,39 @@ def bottom_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> 
     v = blob.pixels_uv[:, 1]
     base = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
     return _nearer_across(rows, base - OCCLUDER_MARGIN_M)
+
+
+def base_occluded(
+    blob: Blob, depth_m: NDArray[np.float32], camera: CameraIntrinsics, T_map_cam: NDArray[np.float64],
+    pixel_step: int,
+) -> bool:
+    """Whether something nearer stands in front of ``blob``'s base: in ``TOP_HIDDEN_SHARE`` of
+    the columns just below its box, a return more than ``OCCLUDER_MARGIN_M`` nearer than its
+    lowest samples that is no surface it could stand on: higher than its base, or seen from
+    below (above the camera). Unlike ``bottom_hidden``, the floor or a table top in front of
+    an object, nearer by more than the margin at a grazing angle, hides nothing."""
+    step, reach = pixel_step, pixel_step * OCCLUDER_RING_CELLS
+    x0, _, x1, y1 = (int(v) for v in blob.image_box_xyxy)
+    height = depth_m.shape[0]
+    if y1 >= height - step:
+        return True
+    vs = np.arange(y1, min(y1 + reach, height))
+    us = np.arange(x0, max(x1, x0 + 1), step)
+    z = depth_m[np.ix_(vs, us)].astype(np.float64)
+    if z.size == 0:
+        return False
+    v = blob.pixels_uv[:, 1]
+    base_m = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
+    nearer = (z > 0) & (z < base_m - OCCLUDER_MARGIN_M)
+    if not nearer.any():
+        return False
+    rows, cols = np.nonzero(nearer)
+    zz = z[rows, cols]
+    rays = np.stack([(us[cols] - camera.cx) / camera.fx * zz, (vs[rows] - camera.cy) / camera.fy * zz, zz])
+    up_m = T_map_cam[2, :3] @ rays + T_map_cam[2, 3]
+    base_up_m = float(blob.bounds_map[0][2])
+    nearer[rows, cols] = (up_m > base_up_m + OCCLUDER_MARGIN_M) | (up_m > T_map_cam[2, 3])
+    return bool(nearer.any(axis=0).mean() >= TOP_HIDDEN_SHARE)
 
 
 def _nearer_across(rows: NDArray[np.float64], limit_m: float) -> bool:
