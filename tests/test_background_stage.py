@@ -113,6 +113,17 @@ def test_keyframes_at_the_mapping_rate():
     )
 
 
+def test_the_last_frame_of_a_run_is_a_keyframe():
+    """What the robot saw last is in the map: through ``run_stages`` (which hands each stage the
+    next frame ahead), the log's last frame is a keyframe whatever the mapping rate says."""
+    T = look_at(CENTER, (6.0, 2.5, 1.2))
+    frames = [make_frame(box_room(), T, pose_id=i, stamp_s=0.1 * i) for i in range(7)]
+    seen: list[bool] = []
+    run_stages(iter(frames), [BackgroundStage()], on_frame=lambda f, r: seen.append(bool(r.observations))
+               if f is not None else None)
+    assert seen == [True, False, False, False, False, True, True]
+
+
 def test_ransac_method_finds_the_same_planes():
     frame = make_frame(box_room(), look_at((1.0, 1.0, 1.2), (5.0, 4.0, 1.0)), noise_m=0.001)
     fast = sorted(o.class_name for o in observe(frame, BackgroundConfig()))

@@ -181,6 +181,9 @@ class BackgroundStage:
         del log_path  # the background needs nothing from the log besides the frames
         self.config = BackgroundConfig.from_options(**options)
         self._last_keyframe_s: float | None = None
+        # whether ``prepare`` handed over a next frame since the last ``process``; None while
+        # no runner looks ahead (a caller feeding frames itself): no frame is known to be last
+        self._next_seen: bool | None = None
         self._not_walls = NotWalls(self.config)
         self._table_votes = TableVotes(self.config)
         _warm_up(self.config.method)
@@ -190,8 +193,18 @@ class BackgroundStage:
             return True
         return stamp_s - self._last_keyframe_s >= 1.0 / self.config.keyframe_hz - 1e-3
 
+    def prepare(self, frame: Frame) -> None:
+        """``run_stages`` hands over the next frame before it processes the current one; a frame
+        processed with none handed over is the log's last, and a keyframe: what the robot saw
+        last is in the map (a wall seen only in a log's last half second)."""
+        del frame
+        self._next_seen = True
+
     def process(self, frame: Frame, world: World) -> FrameResult:
-        if not self.is_keyframe(frame.stamp_s):
+        last = self._next_seen is False
+        if self._next_seen is not None:
+            self._next_seen = False
+        if not (self.is_keyframe(frame.stamp_s) or last):
             return FrameResult(skipped="not a keyframe")
         self._last_keyframe_s = frame.stamp_s
         start, start_cpu = time.perf_counter(), time.process_time()
