@@ -170,7 +170,8 @@ def evaluate_qa_set(
     each writing into its own folder under ``out_dir``; pooled figures over all questions.
     ``on_log(i, log)`` before each log returns its frame progress callback."""
     if kbs is not None and len(kbs) != len(logs):
-        raise ConfigError(f"{len(kbs)} --kb for {len(logs)} logs: give --kb once per LOG, "
+        logs_text = f"{len(logs)} log" + ("s" if len(logs) != 1 else "")
+        raise ConfigError(f"{len(kbs)} --kb for {logs_text}: give --kb once per LOG, "
                           "in the same order, or leave it out to perceive each log")
     for log in logs:  # a missing gt/ is named before any log is perceived
         load_truth(log)
