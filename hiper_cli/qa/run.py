@@ -150,10 +150,11 @@ def log_folders(logs: list[Path], out_dir: Path) -> list[Path]:
     """One folder per log under ``out_dir``, named after the log (``name-2`` for a repeat)."""
     folders: list[Path] = []
     for log in logs:
-        name, k = log.resolve().name or "log", 1
+        base = log.resolve().name or "log"
+        name, k = base, 1
         while out_dir / name in folders:
             k += 1
-            name = f"{log.resolve().name}-{k}"
+            name = f"{base}-{k}"
         folders.append(out_dir / name)
     return folders
 

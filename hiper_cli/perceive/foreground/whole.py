@@ -155,20 +155,32 @@ def top_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> boo
 def bottom_hidden(blob: Blob, depth_m: NDArray[np.float32], pixel_step: int) -> bool:
     """Whether the camera did not see where ``blob``'s object stands: the blob reaches the image's
     bottom edge, or the image rows just below its box (``OCCLUDER_RING_CELLS`` samples) show, in
-    ``TOP_HIDDEN_SHARE`` of its columns, something more than ``OCCLUDER_MARGIN_M`` nearer than
-    the blob's lowest samples (a table's top in front of the back of the chair behind it). What
+    ``TOP_HIDDEN_SHARE`` of its columns, something more than ``OCCLUDER_MARGIN_M`` nearer than the
+    blob's lowest samples (a table's top in front of the back of the chair behind it). What
     an object stands on meets its base at the base's depth, and hides nothing."""
+    below = _below(blob, depth_m, pixel_step)
+    if below is None:
+        return True
+    _, _, z, base_m = below
+    return z.size > 0 and _nearer_across(z, base_m - OCCLUDER_MARGIN_M)
+
+
+def _below(
+    blob: Blob, depth_m: NDArray[np.float32], pixel_step: int,
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], float] | None:
+    """The image rows just below ``blob``'s box (``OCCLUDER_RING_CELLS`` samples) at every
+    ``pixel_step``-th column of it: their row and column indices, their depth (m; 0: no return),
+    and the depth of the blob's lowest samples; None when the box reaches the image's bottom."""
     step, reach = pixel_step, pixel_step * OCCLUDER_RING_CELLS
     x0, _, x1, y1 = (int(v) for v in blob.image_box_xyxy)
     height = depth_m.shape[0]
     if y1 >= height - step:
-        return True
-    rows = depth_m[y1:min(y1 + reach, height), x0:max(x1, x0 + 1):step].astype(np.float64)
-    if rows.size == 0:
-        return False
+        return None
+    vs = np.arange(y1, min(y1 + reach, height))
+    us = np.arange(x0, max(x1, x0 + 1), step)
     v = blob.pixels_uv[:, 1]
-    base = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
-    return _nearer_across(rows, base - OCCLUDER_MARGIN_M)
+    base_m = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
+    return vs, us, depth_m[np.ix_(vs, us)].astype(np.float64), base_m
 
 
 def base_occluded(
@@ -180,18 +192,10 @@ def base_occluded(
     lowest samples that is no surface it could stand on: higher than its base, or seen from
     below (above the camera). Unlike ``bottom_hidden``, the floor or a table top in front of
     an object, nearer by more than the margin at a grazing angle, hides nothing."""
-    step, reach = pixel_step, pixel_step * OCCLUDER_RING_CELLS
-    x0, _, x1, y1 = (int(v) for v in blob.image_box_xyxy)
-    height = depth_m.shape[0]
-    if y1 >= height - step:
+    below = _below(blob, depth_m, pixel_step)
+    if below is None:
         return True
-    vs = np.arange(y1, min(y1 + reach, height))
-    us = np.arange(x0, max(x1, x0 + 1), step)
-    z = depth_m[np.ix_(vs, us)].astype(np.float64)
-    if z.size == 0:
-        return False
-    v = blob.pixels_uv[:, 1]
-    base_m = float(np.median(blob.points_cam[v >= v.max() - reach, 2]))
+    vs, us, z, base_m = below
     nearer = (z > 0) & (z < base_m - OCCLUDER_MARGIN_M)
     if not nearer.any():
         return False
