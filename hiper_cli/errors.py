@@ -10,6 +10,7 @@ from __future__ import annotations
 __all__ = [
     "ConfigError",
     "DataError",
+    "DownloadError",
     "GraphDamagedError",
     "HiperError",
     "KnowledgeBaseError",
@@ -53,3 +54,7 @@ class PerceptionError(HiperError):
 
 class QueryError(HiperError):
     """A query cannot be parsed or answered."""
+
+
+class DownloadError(HiperError):
+    """A file (a detector model) cannot be downloaded, or is not the file that was expected."""

@@ -38,6 +38,7 @@ def test_truth_detector_needs_a_log_and_onnx_needs_a_file(tmp_path):
 
 def test_missing_yolox_model_says_where_to_download(tmp_path, monkeypatch):
     monkeypatch.setenv("HIPER_MODELS", str(tmp_path))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     with pytest.raises(ConfigError, match=r"Megvii-BaseDetection/YOLOX/releases/download/0\.1\.1rc0"):
         find_yolox_model(tmp_path / "nope.onnx", search_roots=[])
 

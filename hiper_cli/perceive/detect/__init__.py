@@ -3,7 +3,10 @@
 ``make_detector(name, log_path=...)`` builds one of:
 
 - ``yolox``: the COCO YOLOX-Nano ONNX model (see ``hiper_cli.perceive.detect.yolox``);
-- ``onnx:PATH``: a user's YOLOv8 / YOLO11 ONNX export (output ``[1, 4 + nc, N]``);
+- a model of the catalog (``yolox_s``, ``yolo11n``, ``rtdetr-l``, ...) or one added with
+  ``hiper models add``, found in the models folders (``catalog``);
+- ``onnx:PATH``: a user's ONNX export in any layout of ``layouts`` (YOLOX, YOLOv5, YOLOv8 /
+  YOLO11, RT-DETR / RF-DETR);
 - ``log``: the detections recorded in the log (``Frame.detections``);
 - ``truth``: the simulator's noisy ground-truth detections (``LOG/gt/detections.jsonl``).
 
@@ -47,12 +50,12 @@ def make_detector(name: str, *, log_path: str | Path | None = None, **options: A
 
         return YoloxDetector(**options)
     if name.startswith("onnx:"):
-        from hiper_cli.perceive.detect.yolo_onnx import YoloOnnxDetector
+        from hiper_cli.perceive.detect.onnx_model import OnnxDetector
 
         path = name[len("onnx:") :]
         if not path:
             raise ConfigError("detector 'onnx:PATH' needs a path, e.g. onnx:models/yolo11n.onnx")
-        return YoloOnnxDetector(Path(path), **options)
+        return OnnxDetector(Path(path), **options)
     if name == "log":
         from hiper_cli.perceive.detect.recorded import LogDetector
 
@@ -66,4 +69,23 @@ def make_detector(name: str, *, log_path: str | Path | None = None, **options: A
                 "it only works on logs written by hiper sim"
             )
         return TruthDetector(Path(log_path), **options)
-    raise ConfigError(f"unknown detector {name!r}; expected one of {', '.join(DETECTOR_NAMES)}")
+    return _catalog_detector(name, options)
+
+
+def _catalog_detector(name: str, options: dict[str, Any]) -> Detector:
+    """A model of the catalog, or one added under ``name``, from the models folders."""
+    from hiper_cli.perceive.detect.catalog import CATALOG, find_model, locate
+    from hiper_cli.perceive.detect.onnx_model import OnnxDetector
+
+    known = {e.name: e for e in CATALOG}
+    if name in known:
+        entry = known[name]
+        return OnnxDetector(find_model(name), name=name, layout=entry.layout, input_px=entry.input_px,
+                            **options)
+    path = locate(name)
+    if path is not None:
+        return OnnxDetector(path, name=name, **options)
+    raise ConfigError(
+        f"unknown detector {name!r}; expected one of {', '.join(DETECTOR_NAMES)}, or a model of "
+        f"'hiper models list' ({', '.join(known)})"
+    )

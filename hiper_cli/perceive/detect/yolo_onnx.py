@@ -1,4 +1,4 @@
-"""The ``onnx:PATH`` detector: a user's YOLOv8 / YOLO11 ONNX export (Ultralytics layout).
+"""Decoding a YOLOv8 / YOLO11 ONNX export (Ultralytics layout ``yolov8``, see ``layouts``).
 
 Input: float32 [1, 3, H, W], RGB scaled to 0..1, letterboxed in the centre on a 114 canvas.
 Output: [1, 4 + nc, N]: box centre and size (cx, cy, w, h) in input pixels, then nc class
@@ -9,16 +9,14 @@ when nc is 80, else ``class_<k>``.
 from __future__ import annotations
 
 import ast
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.perceive.detect._onnx import COCO_NAMES, clip_boxes, letterbox, nms, open_session
-from hiper_cli.types import Detections, Frame
+from hiper_cli.perceive.detect._onnx import COCO_NAMES, nms
 
-__all__ = ["YoloOnnxDetector", "decode_yolov8", "parse_names"]
+__all__ = ["decode_yolov8", "parse_names"]
 
 
 def parse_names(metadata: dict[str, str], num_classes: int) -> tuple[str, ...]:
@@ -64,39 +62,3 @@ def decode_yolov8(
     xyxy = (xyxy - np.array([*pad_xy, *pad_xy])) / scale
     kept = nms(xyxy, scores, class_ids, nms_iou)
     return xyxy[kept], class_ids[kept], scores[kept]
-
-
-class YoloOnnxDetector:
-    """A YOLOv8 / YOLO11 detection model exported to ONNX by Ultralytics."""
-
-    def __init__(
-        self, path: Path, score_threshold: float = 0.3, nms_iou: float = 0.45, threads: int = 1
-    ) -> None:
-        self.name = f"onnx:{path}"
-        self.session = open_session(path, threads)
-        inp = self.session.get_inputs()[0]
-        self.input_name = inp.name
-        shape = inp.shape
-        self.size_hw = (
-            (int(shape[2]), int(shape[3]))
-            if isinstance(shape[2], int) and isinstance(shape[3], int)
-            else (640, 640)
-        )
-        out_shape = self.session.get_outputs()[0].shape
-        nc = int(out_shape[1]) - 4 if len(out_shape) == 3 and isinstance(out_shape[1], int) else 80
-        meta = self.session.get_modelmeta().custom_metadata_map or {}
-        self.class_names = parse_names(dict(meta), nc)
-        self.score_threshold = float(score_threshold)
-        self.nms_iou = float(nms_iou)
-
-    def detect(self, frame: Frame) -> Detections:
-        canvas, r, pad = letterbox(frame.rgb, self.size_hw, centre=True)
-        blob = (canvas.transpose(2, 0, 1)[None].astype(np.float32)) / np.float32(255.0)
-        (output,) = self.session.run(None, {self.input_name: blob})[:1]
-        xyxy, class_ids, scores = decode_yolov8(
-            output, r, pad, score_threshold=self.score_threshold, nms_iou=self.nms_iou
-        )
-        xyxy = clip_boxes(xyxy, frame.width, frame.height)
-        names = self.class_names
-        labels = tuple(names[int(c)] if int(c) < len(names) else f"class_{int(c)}" for c in class_ids)
-        return Detections(xyxy, labels, scores)

@@ -1,9 +1,8 @@
 """The ``yolox`` detector: Megvii's COCO YOLOX-Nano as ONNX, run with onnxruntime on the CPU.
 
-The model is never part of hiper. It is looked up, in order, at ``model_path``, at
-``$HIPER_MODELS/yolox_nano/yolox_nano.onnx`` and at ``shared/models/yolox_nano/yolox_nano.onnx``
-in any parent folder of the repository or of the working directory. Download it from the
-release 0.1.1rc0 of github.com/Megvii-BaseDetection/YOLOX (asset ``yolox_nano.onnx``).
+The model is never part of hiper: ``hiper models fetch yolox`` downloads the asset
+``yolox_nano.onnx`` of release 0.1.1rc0 of github.com/Megvii-BaseDetection/YOLOX into the user
+cache, and ``find_yolox_model`` looks there and in the other models folders (``catalog``).
 
 Interface: input ``images`` float32 [1, 3, 416, 416], BGR, raw 0..255, letterboxed at the top
 left on a 114 canvas; output [1, 3549, 85] = grids of strides 8, 16, 32, columns
@@ -12,7 +11,6 @@ left on a 114 canvas; output [1, 3549, 85] = grids of strides 8, 16, 32, columns
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
@@ -22,6 +20,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
 from hiper_cli.perceive.detect._onnx import COCO_NAMES, clip_boxes, letterbox, nms, open_session
+from hiper_cli.perceive.detect.catalog import locate, models_dir
 from hiper_cli.types import Detections, Frame
 
 __all__ = ["YOLOX_DOWNLOAD", "YoloxDetector", "decode_yolox", "find_yolox_model"]
@@ -29,37 +28,27 @@ __all__ = ["YOLOX_DOWNLOAD", "YoloxDetector", "decode_yolox", "find_yolox_model"
 YOLOX_DOWNLOAD = (
     "https://github.com/Megvii-BaseDetection/YOLOX/releases/download/0.1.1rc0/yolox_nano.onnx"
 )
-_MODEL_RELPATH = Path("yolox_nano") / "yolox_nano.onnx"
 _STRIDES = (8, 16, 32)
 
 
 def find_yolox_model(
     model_path: str | Path | None = None, search_roots: Sequence[Path] | None = None
 ) -> Path:
-    """Where the YOLOX-Nano model is; ``ConfigError`` with download instructions when absent.
+    """Where the YOLOX-Nano model is; ``ConfigError`` saying how to fetch it when absent.
 
-    ``search_roots`` (default: the repository and the working directory) are searched, with
-    all their parents, for ``shared/models/yolox_nano/yolox_nano.onnx``.
+    ``model_path`` first, then the models folders of ``catalog.search_dirs`` (``$HIPER_MODELS``,
+    the user cache that ``hiper models fetch`` fills, ``shared/models`` and ``models`` above
+    ``search_roots``, default the repository and the working directory).
     """
-    tried: list[Path] = []
-    if model_path is not None:
-        tried.append(Path(model_path))
-    env = os.environ.get("HIPER_MODELS")
-    if env:
-        tried.append(Path(env) / _MODEL_RELPATH)
-    if search_roots is None:
-        search_roots = (Path(__file__).resolve().parents[3], Path.cwd().resolve())
-    for base in search_roots:
-        for parent in (base, *base.parents):
-            tried.append(parent / "shared" / "models" / _MODEL_RELPATH)
-    for path in tried:
-        if path.is_file():
-            return path
+    if model_path is not None and Path(model_path).is_file():
+        return Path(model_path)
+    found = locate("yolox_nano", roots=search_roots)
+    if found is not None:
+        return found
     raise ConfigError(
-        "YOLOX-Nano model not found (looked at model_path, $HIPER_MODELS/yolox_nano/yolox_nano.onnx "
-        "and shared/models/yolox_nano/yolox_nano.onnx above the repository); download it with "
-        f"'mkdir -p models/yolox_nano && curl -L -o models/yolox_nano/yolox_nano.onnx {YOLOX_DOWNLOAD}' "
-        "and set HIPER_MODELS=models"
+        f"YOLOX-Nano model not found (looked at model_path and in {models_dir()}, $HIPER_MODELS and "
+        "shared/models); run 'hiper models fetch yolox', or on a machine with network download "
+        f"{YOLOX_DOWNLOAD} and run 'hiper models add yolox_nano.onnx'"
     )
 
 
