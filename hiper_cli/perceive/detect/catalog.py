@@ -189,7 +189,8 @@ def find_model(name: str, override: str | Path | None = None, roots: Sequence[Pa
     known = next((e for e in CATALOG if e.name == wanted), None)
     where = models_dir(override)
     if known is not None and known.url is not None:
-        fix = f"run 'hiper models fetch {wanted}' (or download {known.url} and run 'hiper models add FILE')"
+        flag = "" if known.sha256 else " --trust-unverified"
+        fix = f"run 'hiper models fetch {wanted}{flag}' (or download {known.url}, 'hiper models add FILE')"
     elif known is not None:
         fix = f"export it ({known.export}) and run 'hiper models add {wanted}.onnx'"
     else:
