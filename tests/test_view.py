@@ -249,3 +249,44 @@ def test_perceive_view_streams_to_rerun_and_says_how_to_install(tmp_path, monkey
     monkeypatch.setitem(sys.modules, "rerun", None)
     result = runner.invoke(app, [*args[:3], str(tmp_path / "x.hiper"), *args[4:], "--view"])
     assert result.exit_code == 2 and "pip install 'hiper[view]'" in result.output
+
+
+def _jittery_track(state: str):
+    """A table seen 12 times, its sightings scattered over 3 m (segmentation noise), 1 m/s."""
+    from hiper_cli.model import Box3D
+    from hiper_cli.view.scene import TrackItem
+
+    stamps = np.arange(12, dtype=float) * 0.25
+    centers = np.column_stack([np.linspace(0, 3, 12), 0.3 * (-1.0) ** np.arange(12), np.full(12, 0.4)])
+    return TrackItem("0190-aaaa", "table", state, Box3D(np.array([1.5, 0.0, 0.4]), np.array([1.0, 0.6, 0.8])),
+                     stamps, centers, np.ones(12))
+
+
+def test_a_static_instance_is_drawn_without_path_or_speed():
+    from hiper_cli.view.scene import ViewScene
+    from hiper_cli.view.style import speed_colors
+    from hiper_cli.view.topdown import render_topdown
+
+    path_bgr = speed_colors(np.array([1.0]))[0][::-1].astype(int)
+
+    def path_pixels(state: str) -> int:
+        scene = ViewScene("t.hiper", TimeWindow(), (), (_jittery_track(state),), (), ())
+        image = render_topdown(scene).astype(int)
+        return int(np.all(np.abs(image - path_bgr) <= 2, axis=2).sum())
+
+    assert path_pixels("dynamic") > 200  # a mover's path, in its speed colour
+    assert path_pixels("static") < 40  # only the legend's speed ramp
+
+
+def test_static_instances_in_the_recording_have_no_path_or_speed(kb_dir, tmp_path):
+    pytest.importorskip("rerun", reason="rerun-sdk (the hiper[view] extra) is not installed")
+    out = tmp_path / "static.rrd"
+    render_view(ViewRequest(str(kb_dir), rrd=out))
+    entities = _read_rrd(out)
+    with open_kb_for_reading(kb_dir) as kb:
+        static = [i for i in kb.instances() if i.layer == "foreground" and i.state == "static"]
+    assert static
+    for inst in static:
+        path = entity_path("foreground", inst.class_name, inst.uuid)
+        assert f"{path}/trajectory" not in entities and f"{path}/speed_mps" not in entities
+        assert entities[path]["stamps_s"] == [pytest.approx(inst.first_seen_s)]  # one fused box, kept

@@ -3,9 +3,10 @@
 One timeline, ``stamp``: the log's stamps (a duration from 0 for logs whose stamps start near
 0, as the simulator's; wall-clock time for stamps after 1973, as TUM's and ROS's). Background
 instances appear when first seen, as translucent boxes in their class colour with their plane
-contour; foreground instances are labelled boxes at each sighting, cleared when not seen for
-``hold_s``; each track's path is a line strip coloured by speed, with its speed as a scalar
-series; the robot's path and its camera (a pinhole frustum) move along the poses. Entity paths:
+contour; a static foreground instance is its fused box from its first sighting on, with no path
+or speed; a moving one is a labelled box at each sighting, cleared when not seen for ``hold_s``,
+with its path as a line strip coloured by speed and its speed as a scalar series; the robot's
+path and its camera (a pinhole frustum) move along the poses. Entity paths:
 ``style.py`` and docs/view.md. Columns go in with ``send_columns`` so a long track is one call.
 """
 
@@ -123,7 +124,19 @@ def _seen_spans(stamps_s: NDArray[np.float64], hold_s: float) -> NDArray[np.floa
     return stamps_s[ends] + hold_s
 
 
+def _log_static(rr: Any, rec: Any, tl: Timeline, track: TrackItem) -> None:
+    """A static instance: its fused box from its first sighting on; no path, no speed series."""
+    tl.set(track.stamps_s[0])
+    rec.log(entity_path("foreground", track.class_name, track.uuid),
+            rr.Boxes3D(centers=[track.box.center_m], half_sizes=[track.box.extent_m / 2.0],
+                       quaternions=[quat_xyzw(track.box.R)], colors=[class_color(track.class_name)],
+                       labels=[f"{track.class_name} {track.uuid[-4:]}"]))
+
+
 def _log_track(rr: Any, rec: Any, tl: Timeline, track: TrackItem, hold_s: float) -> None:
+    if track.is_static:
+        _log_static(rr, rec, tl, track)
+        return
     path = entity_path("foreground", track.class_name, track.uuid)
     n = len(track.stamps_s)
     label = f"{track.class_name} {track.uuid[-4:]}"

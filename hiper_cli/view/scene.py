@@ -73,6 +73,11 @@ class TrackItem:
     speed_mps: NDArray[np.float64]
 
     @property
+    def is_static(self) -> bool:
+        """A static instance never moved: it is drawn at its fused box, with no path or speed."""
+        return self.state == "static"
+
+    @property
     def mean_speed_mps(self) -> float:
         """Path length over duration (0 for a single sighting)."""
         dt = float(self.stamps_s[-1] - self.stamps_s[0])

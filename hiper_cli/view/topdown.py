@@ -3,10 +3,11 @@
 Drawn in the map's x-y plane, +y up: the occupancy map in greys, floor polygons filled,
 heatmaps over them in the turbo colour map (faint cells left out), walls and other
 background planes as their footprint in the class colour, the robot's path in grey with its
-start and end, each foreground track as a polyline coloured by speed (thin grey across times it
-was not seen) with its last box footprint and a label (class, short uuid, and mean speed when
-it moved), "unknown" clusters faint, a 1 m grid, a scale bar, a legend and the time window in
-the title.
+start and end, each moving foreground track as a polyline coloured by speed (thin grey across
+times it was not seen) with its last box footprint and a label (class, short uuid, mean speed);
+a static instance only as its fused box's footprint and a label without speed (the jitter of
+its sightings is not a path); "unknown" clusters faint, a 1 m grid, a scale bar, a legend and
+the time window in the title.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.view.scene import ViewScene
+from hiper_cli.view.scene import TrackItem, ViewScene
 from hiper_cli.view.style import SPEED_RED_MPS, class_color, speed_colors
 
 __all__ = ["TopDownConfig", "draw_topdown", "render_topdown"]
@@ -161,6 +162,9 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
     gap_s = scene.gap_s()
     for track in tracks:
         faint = track.class_name == UNKNOWN
+        if track.is_static:
+            _static(img, canvas, track, faint)
+            continue
         xy = canvas.px(track.centers_map_m[:, :2])
         if faint:
             cv2.polylines(img, [xy], False, _FAINT, 1, cv2.LINE_AA)
@@ -180,6 +184,18 @@ def render_topdown(scene: ViewScene, config: TopDownConfig | None = None) -> NDA
             _text(img, f"{track.class_name} {track.uuid[-4:]}{speed}", (u + 8, v - 8), color)
     _header(img, scene, canvas)
     return img
+
+
+def _static(img: NDArray[np.uint8], canvas: _Canvas, track: TrackItem, faint: bool) -> None:
+    """A static instance: its fused box's footprint and its label; no path, no speed."""
+    import cv2
+
+    color = _FAINT if faint else _bgr(class_color(track.class_name))
+    footprint = canvas.px(_footprint(track.box.corners()))
+    cv2.polylines(img, [footprint], True, color, 1 if faint else 2, cv2.LINE_AA)
+    if not faint:
+        u, v = (int(a) for a in canvas.px(track.box.center_m[:2])[0])
+        _text(img, f"{track.class_name} {track.uuid[-4:]}", (u + 8, v - 8), color)
 
 
 def _header(img: NDArray[np.uint8], scene: ViewScene, canvas: _Canvas) -> None:
