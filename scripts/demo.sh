@@ -21,8 +21,8 @@ elif err=$("$HIPER" models fetch yolox --timeout-s 15 2>&1 >/dev/null); then
   echo "demo: detector 'yolox' (YOLOX-Nano, fetched now and verified by 'hiper models fetch yolox')"
 else
   DETECTOR=truth
-  echo "demo: detector 'truth' (the log's simulated detections), as YOLOX-Nano could not be fetched:" \
-       "$(echo "${err#error: }" | tr -s '\n' ' ')"
+  why=$(printf '%s' "$err" | tr -s '\n' ' ' | sed 's/^ *//; s/ *$//; s/^error: //')
+  echo "demo: detector 'truth' (the log's simulated detections), as YOLOX-Nano could not be fetched: $why"
 fi
 
 rm -rf "$KB" out/demo.json out/demo.png out/demo.rrd
