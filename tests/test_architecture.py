@@ -26,6 +26,8 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # shared checks and safe file writes every layer may use
     "validate": _CORE_FORBIDDEN,
     "files": _CORE_FORBIDDEN,
+    # the log's clock: how a stamp is shown (log time or ISO 8601 UTC)
+    "clock": _CORE_FORBIDDEN,
     # the typed learned features: analyze writes them, perceive reads them
     "learned": _CORE_FORBIDDEN,
     # recognition: log readers (the simulator's truth format included), stages, detectors

@@ -27,7 +27,9 @@ def time_input(what: str) -> Schema:
     return {"type": ["number", "string"], "description": f"{what}: {TIME_HELP}."}
 
 
-TIME_VALUE: Schema = obj({"stamp_s": NUMBER, "iso": STRING, "ago": STRING}, ("stamp_s", "iso", "ago"))
+# "iso" is null for a log's own clock that is not wall-clock time (hiper_cli.clock)
+TIME_VALUE: Schema = obj({"stamp_s": NUMBER, "iso": {"type": ["string", "null"]}, "ago": STRING},
+                         ("stamp_s", "iso", "ago"))
 TIME: Schema = {"anyOf": [TIME_VALUE, {"type": "null"}]}
 VEC3: Schema = {"type": "array", "items": NUMBER, "minItems": 3, "maxItems": 3}
 HIT: Schema = obj(

@@ -10,9 +10,10 @@ from typing import Any
 
 import numpy as np
 
+from hiper_cli.clock import is_wall_clock, stamp_text
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query.index import instance_index
-from hiper_cli.query.results import TimeValue, ago_text, iso_time, short_uuid
+from hiper_cli.query.results import TimeValue, ago_text, short_uuid
 from hiper_cli.query.templates import template
 from hiper_cli.query.vocabulary import counted
 
@@ -58,9 +59,9 @@ class Description:
         ]
         if self.span_s:
             t0, t1 = self.span_s
-            lines.append(
-                f"Time span {iso_time(t0)} .. {iso_time(t1)} ({t1 - t0:.0f} s); now {iso_time(self.now_s)}."
-            )
+            clock = "" if is_wall_clock(t0) else " of log time"
+            lines.append(f"Time span {stamp_text(t0)} .. {stamp_text(t1)}{clock} ({t1 - t0:.0f} s); "
+                         f"now {stamp_text(self.now_s)}.")
         for layer in ("background", "foreground"):
             parts = [counted(c.count, c.class_name) + (f" ({c.vacated} vacated)" if c.vacated else "")
                      for c in self.classes if c.layer == layer]

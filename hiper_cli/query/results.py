@@ -2,8 +2,9 @@
 ``hiper query --json`` prints (schema: ``hiper_cli/query/schema.json``, docs/query.md).
 
 Units: metres and seconds, map frame (z up); yaw in radians, counter-clockwise from +x.
-Times are given three ways: stamp (s), ISO 8601 (UTC, the stamp read as Unix time) and
-"N min ago" relative to the query's ``now``.
+Times are given three ways: stamp (s), ISO 8601 (UTC; null for a log's own clock that is not
+wall-clock time, as a simulated log's, see ``hiper_cli.clock``) and "N min ago" relative to the
+query's ``now``.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ import math
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from typing import Any, Literal
+
+from hiper_cli.clock import iso_utc
 
 __all__ = [
     "ANSWER_KINDS",
@@ -70,7 +73,7 @@ class TimeValue:
     def to_dict(self) -> dict[str, Any]:
         return {
             "stamp_s": self.stamp_s,
-            "iso": iso_time(self.stamp_s),
+            "iso": iso_utc(self.stamp_s),  # None for a log's own clock (a sim log): no date
             "ago": ago_text(self.stamp_s, self.now_s),
         }
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from hiper_cli.clock import span_text
 from hiper_cli.errors import ConfigError
 from hiper_cli.view.scene import TimeWindow, ViewScene, load_scene
 
@@ -55,7 +56,7 @@ class ViewSummary:
         """One line for people: what was written and what it holds."""
         wrote = ", ".join(p for p in (self.rrd, self.png) if p) or "the viewer"
         return (f"{wrote}: {self.counts['background']} background, {self.counts['foreground']} foreground "
-                f"instances, {self.frames_logged} frames, t {self.t_min_s:g}-{self.t_max_s:g} s")
+                f"instances, {self.frames_logged} frames, {span_text(self.t_min_s, self.t_max_s, 'g')}")
 
     def to_dict(self) -> dict[str, Any]:
         return {"kb": self.kb, "rrd": self.rrd, "png": self.png,

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from hiper_cli.clock import WALL_CLOCK_MIN_S
 from hiper_cli.errors import ConfigError
 from hiper_cli.types import CameraIntrinsics
 from hiper_cli.view.floor import FloorImage
@@ -32,7 +33,7 @@ __all__ = ["INSTALL_HINT", "TIMELINE", "RecordingConfig", "Timeline", "import_re
 TIMELINE = "stamp"
 INSTALL_HINT = "pip install 'hiper[view]'"
 # Stamps above this are seconds since 1970 (wall-clock logs), below it seconds since the log began.
-EPOCH_STAMP_S = 1e8
+EPOCH_STAMP_S = WALL_CLOCK_MIN_S
 # A camera of 60° horizontal field of view, 4:3, when the recording has no log to take it from.
 DEFAULT_CAMERA = CameraIntrinsics(width=640, height=480, fx=554.3, fy=554.3, cx=319.5, cy=239.5)
 

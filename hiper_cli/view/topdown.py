@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.clock import span_text
 from hiper_cli.errors import ConfigError
 from hiper_cli.view.scene import TrackItem, ViewScene
 from hiper_cli.view.style import SPEED_RED_MPS, class_color, speed_colors
@@ -202,7 +203,7 @@ def _header(img: NDArray[np.uint8], scene: ViewScene, canvas: _Canvas) -> None:
     import cv2
 
     title = (f"{Path(scene.kb_path).name}: {len(scene.background)} background, {len(scene.foreground)} "
-             f"foreground, t {scene.t_min_s:.2f}-{scene.t_max_s:.2f} s")
+             f"foreground, {span_text(scene.t_min_s, scene.t_max_s)}")
     _text(img, title, (8, 16), _INK, 0.5)
     classes = sorted({b.class_name for b in scene.background} | {t.class_name for t in scene.foreground})
     u = 8
