@@ -149,3 +149,29 @@ def test_catalog_names_and_added_models_are_detectors(tmp_path, monkeypatch):
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["layout"] == "yolov8"
     assert make_detector("shelf_bot").detect(_frame()).class_names == ("robot",)
+
+
+def test_the_real_yolox_nano_is_read_by_its_layout_alone():
+    """``onnx:PATH`` on the YOLOX-Nano file tells its layout and finds what ``yolox`` finds."""
+    from hiper_cli.perceive.detect.catalog import locate
+
+    path = locate("yolox_nano")
+    if path is None:
+        pytest.skip("YOLOX-Nano model absent (run 'hiper models fetch yolox' or set HIPER_MODELS)")
+    try:
+        import matplotlib.cbook as cbook
+
+        photo = cbook.get_sample_data("grace_hopper.jpg", asfileobj=False)
+    except Exception:
+        pytest.skip("matplotlib's sample photo grace_hopper.jpg is not installed")
+    import cv2
+
+    rgb = np.ascontiguousarray(cv2.resize(cv2.imread(str(photo))[:, :, ::-1], (128, 96)))
+    frame = _frame()
+    frame = Frame(0.0, rgb, frame.depth_m, frame.camera, np.eye(4), 0)
+    generic = make_detector(f"onnx:{path}", score_threshold=0.05)
+    assert generic.layout == "yolox" and generic.size_hw == (416, 416) and len(generic.class_names) == 80
+    a = generic.detect(frame)
+    b = make_detector("yolox", model_path=path, score_threshold=0.05).detect(frame)
+    assert "person" in a.class_names
+    assert a.class_names == b.class_names and np.allclose(a.xyxy, b.xyxy) and np.allclose(a.scores, b.scores)

@@ -19,7 +19,8 @@ Text = str | None
 Stages = Annotated[Text, typer.Option(
     "--stages", help="Comma-separated stages (default: all available, background first).")]
 Detector = Annotated[Text, typer.Option(
-    "--detector", help="Foreground detector: yolox (default), onnx:PATH, log or truth.")]
+    "--detector", help="Foreground detector: yolox (default), a model of 'hiper models list', onnx:PATH, log "
+    "or truth.")]
 NoFilter = Annotated[bool, typer.Option(
     "--no-background-filter", help="Foreground: keep points of background instances.")]
 Classes = Annotated[Text, typer.Option(
