@@ -175,3 +175,11 @@ def test_the_real_yolox_nano_is_read_by_its_layout_alone():
     b = make_detector("yolox", model_path=path, score_threshold=0.05).detect(frame)
     assert "person" in a.class_names
     assert a.class_names == b.class_names and np.allclose(a.xyxy, b.xyxy) and np.allclose(a.scores, b.scores)
+
+
+def test_a_post_processed_output_is_not_misread_as_detr(tmp_path):
+    """YOLOv10-style [1, 300, 6] (box, score, class) with 80 names is refused, not decoded as 2 classes."""
+    names = repr(dict(enumerate(["person"] * 80)))
+    model = _graph(tmp_path / "v10.onnx", {"output0": np.zeros((1, 300, 6), np.float32)}, names, side=640)
+    with pytest.raises(ConfigError, match=r"read as layout detr give 2 classes but the model names 80"):
+        OnnxDetector(model)

@@ -79,8 +79,13 @@ class OnnxDetector:
                               f"hiper reads {layouts.LAYOUTS_TEXT}") from err
         self.layout = layout or layouts.identify_layout(shapes, self.size_hw, str(path))
         meta = dict(self.session.get_modelmeta().custom_metadata_map or {})
-        self.class_names = layouts.class_names(
-            self._num_classes(shapes), _metadata_names(meta), labels or layouts.labels_file(path))
+        named, num_classes = _metadata_names(meta), self._num_classes(shapes)
+        if named is not None and len(named) != num_classes:  # e.g. a post-processed [1, 300, 6]
+            raise ConfigError(
+                f"{path}: outputs {', '.join(str(list(s)) for s in shapes)} read as layout "
+                f"{self.layout} give {num_classes} classes but the model names {len(named)}; "
+                f"hiper reads {layouts.LAYOUTS_TEXT}")
+        self.class_names = layouts.class_names(num_classes, named, labels or layouts.labels_file(path))
 
     def _num_classes(self, shapes: list[tuple[int, ...]]) -> int:
         first = shapes[0]
