@@ -6,6 +6,7 @@ no ``shared/models`` above it is found."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -81,3 +82,13 @@ def test_demo_uses_yolox_once_it_is_in_the_cache(tmp_path):
     ]
     assert "--detector yolox" in done.stderr  # the perceive command, as set -x shows it
     assert (repo / "out" / "demo.png").is_file()
+
+
+def test_the_readme_picture_is_the_demo_s_and_says_which_detector():
+    """The README's picture block is the one scripts/readme_image.sh rewrites from a demo run."""
+    readme = (ROOT / "README.md").read_text()
+    script = (ROOT / "scripts" / "readme_image.sh").read_text()
+    block = readme.split("<!-- demo-image -->\n", 1)[1].split("<!-- /demo-image -->", 1)[0]
+    assert "scripts/readme_image.sh" in block and re.search(r"detector `(yolox|truth)`", block)
+    image = re.search(r"!\[[^\]]*\]\((docs/images/[^)]+\.png)\)", readme.split("<!-- /demo-image -->", 1)[1])
+    assert image and f"cp out/demo.png {image.group(1)}" in script and (ROOT / image.group(1)).is_file()
