@@ -3,10 +3,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
 
+from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query import engine
 from hiper_cli.query import geometry as geo
@@ -14,10 +16,11 @@ from hiper_cli.query.engine import Context, make_context
 from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
 from hiper_cli.query.results import Answer, AnswerKind, GoalPose, Hit, TimeValue, ago_text
 from hiper_cli.query.spec import QueryConfig
+from hiper_cli.query.timewords import TimeAnchor, TimeWindow
 from hiper_cli.query.verbs import passed_here, when
 from hiper_cli.query.vocabulary import plural
 
-__all__ = ["answer", "ask", "goal_for"]
+__all__ = ["answer", "ask", "goal_for", "resolve_events"]
 
 
 def goal_for(ctx: Context, hit: Hit) -> GoalPose:
@@ -48,17 +51,19 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         return ", ".join(c if n == 1 else plural(c) for c in names)
 
     if spec.passed_here:
-        found = passed_here(ctx, spec)
+        found = passed_here(ctx, spec, parsed.time_of)
         r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
+        place = "here" if spec.near is None or spec.near.target == "me" else f"the {spec.near.target}"
         if found is None:
             return make(value=False if kind == "yes_no" else None,
-                        text=f"no {what(0)} observed within {r:g} m of here")
+                        text=f"no {what(0)} observed within {r:g} m of {place}")
         stamp, hit = found
+        verb = "first came" if parsed.time_of == "first" else "last passed"
         return make(
             hits=(hit,),
             time=TimeValue(stamp, ctx.now_s),
             value=True if kind == "yes_no" else None,
-            text=f"{hit.class_name} last passed within {r:g} m of here {ago_text(stamp, ctx.now_s)}",
+            text=f"{hit.class_name} {verb} within {r:g} m of {place} {ago_text(stamp, ctx.now_s)}",
         )
     cands = engine.select(ctx, spec)
     if kind == "count":
@@ -72,8 +77,9 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         )
     total = len(cands)
     found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
+    changed = {"added": "new", "removed": "gone", "moved": "moved"}.get(spec.change or "", "")
     if not found_hits:
-        return make(count=0, text=f"no {what(0)} found")
+        return make(count=0, text=f"no {what(0)} {changed or 'found'}".replace("no instances", "nothing"))
     first = found_hits[0]
     if kind == "time":
         stamp = first.first_seen_s if parsed.time_of == "first" else first.last_seen_s
@@ -95,7 +101,8 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
             _describe(first, ctx.now_s) + f"; goal ({goal.x_m:.2f}, {goal.y_m:.2f}, yaw {goal.yaw_rad:.2f})"
         )
         return make(hits=tuple(found_hits), goal=goal, text=text)
-    text = f"{total} {what(total)}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
+    label = f"{total} {what(total)}" + (f" {changed}" if changed else "")
+    text = f"{label}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
     if total > 3:
         text += f"; +{total - 3} more" + (f" ({len(found_hits)} listed)" if total > len(found_hits) else "")
     nearest = goal_for(ctx, first) if spec.sort == "distance" and spec.limit == 1 else None
@@ -116,4 +123,35 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
-    return answer(ctx, with_limit(parse(text, now_s=ctx.now_s, config=ctx.config), limit))
+    parsed = with_limit(parse(text, now_s=ctx.now_s, config=ctx.config), limit)
+    return answer(ctx, resolve_events(ctx, parsed))
+
+
+def _event_stamp(ctx: Context, anchor: TimeAnchor) -> float:
+    """The stamp of an event: the earliest first sighting or the latest last sighting (up to
+    now) of the anchor's class."""
+    idx = ctx.index
+    rows = np.flatnonzero((idx.classes == anchor.class_name) & (idx.first_s <= ctx.now_s))
+    if len(rows) == 0:
+        raise QueryError(
+            f'no {anchor.class_name} was seen by {ctx.now_s:g} s, so "{anchor.words()}" names no time; '
+            "ask without it, or with a clock time such as 'since 10:00'"
+        )
+    if anchor.sighting == "first":
+        return float(idx.first_s[rows].min())
+    return float(np.minimum(idx.last_s[rows], ctx.now_s).max())
+
+
+def resolve_events(ctx: Context, parsed: ParsedQuery) -> ParsedQuery:
+    """``parsed`` with its event bounds ("after the person left") turned into stamps."""
+    if parsed.since_event is None and parsed.until_event is None:
+        return parsed
+    window = TimeWindow(parsed.spec.since_s, parsed.spec.until_s)
+    if parsed.since_event is not None:
+        window = window & TimeWindow(_event_stamp(ctx, parsed.since_event), None)
+    if parsed.until_event is not None:
+        window = window & TimeWindow(None, _event_stamp(ctx, parsed.until_event))
+    if window.since_s is not None and window.until_s is not None and window.since_s > window.until_s:
+        raise QueryError(f'"{parsed.text}": the time window starts after it ends; nothing can be in it')
+    spec = dataclasses.replace(parsed.spec, since_s=window.since_s, until_s=window.until_s)
+    return dataclasses.replace(parsed, spec=spec)

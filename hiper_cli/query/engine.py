@@ -124,11 +124,7 @@ def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
     window, confidence). An instance whose place a later session saw empty (``vacated_s``)
     was there until then: a window starting (or, without a start, ending) later leaves it out."""
     idx = ctx.index
-    until = spec.until_s if spec.until_s is not None else ctx.now_s
-    mask = (idx.first_s <= until) & (idx.confidence >= spec.min_confidence)
-    mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
-    if spec.since_s is not None:
-        mask &= idx.last_s >= spec.since_s
+    mask = _window_mask(ctx, spec) & (idx.confidence >= spec.min_confidence)
     if spec.classes:
         mask &= np.isin(idx.classes, list(spec.classes))
     if spec.layer is not None:
@@ -136,6 +132,24 @@ def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
     if spec.state is not None:
         mask &= idx.states == spec.state
     return Candidates(idx, np.flatnonzero(mask))
+
+
+def _window_mask(ctx: Context, spec: QuerySpec) -> np.ndarray:
+    """Seen at some time in [since, until] and not vacated by then; for a change, the change
+    in the window: first seen in it ("added"), vacated in it ("removed"), or moving while
+    seen in it ("moved")."""
+    idx = ctx.index
+    until = spec.until_s if spec.until_s is not None else ctx.now_s
+    since = spec.since_s if spec.since_s is not None else -np.inf
+    if spec.change == "removed":
+        return (idx.vacated_s >= since) & (idx.vacated_s <= until) & (idx.first_s <= until)
+    mask = (idx.first_s <= until) & (idx.last_s >= since)
+    mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
+    if spec.change == "added":
+        mask &= idx.first_s >= since
+    if spec.change == "moved":
+        mask &= idx.states == "dynamic"
+    return mask
 
 
 def details(ctx: Context, uuid: str) -> dict[str, Any] | None:

@@ -181,19 +181,35 @@ def when(
     )
 
 
-def passed_here(ctx: Context, spec: QuerySpec) -> tuple[float, Hit] | None:
-    """The last time an instance of ``spec`` was observed within the config's
-    ``pass_radius_m`` (horizontally) of the reference position, and that instance."""
+def passed_here(ctx: Context, spec: QuerySpec, sighting: str = "last") -> tuple[float, Hit] | None:
+    """The last (``sighting`` "first": the first) time an instance of ``spec`` was observed
+    within ``spec.near`` (default: the config's ``pass_radius_m`` of the reference position)
+    horizontally: of the reference position when the target is "me", else of the footprint of
+    any instance of the target class (its own observations aside). Returns that time and
+    instance."""
     r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
-    x, y = ctx.reference.x_m, ctx.reference.y_m
+    target = spec.near.target if spec.near is not None else "me"
+    if target == "me":
+        places = [(np.array([ctx.reference.x_m, ctx.reference.y_m]), np.zeros(2))]
+        own: set[str] = set()
+    else:
+        sup = engine.supports(ctx, target)
+        places = [(sup.centers[k, :2], sup.extents[k, :2]) for k in range(len(sup))]
+        own = set(sup.uuids)
     until = spec.until_s if spec.until_s is not None else ctx.now_s
     best: tuple[float, str] | None = None
-    for class_name in spec.classes or (None,):
-        for p in ctx.kb.observations_near((x - r, y - r, -1e6), (x + r, y + r, 1e6), class_name):
-            ok = (p.center_map_m[0] - x) ** 2 + (p.center_map_m[1] - y) ** 2 <= r * r
-            ok = ok and p.stamp_s <= until and (spec.since_s is None or p.stamp_s >= spec.since_s)
-            if ok and p.instance_uuid and (best is None or p.stamp_s > best[0]):
-                best = (p.stamp_s, p.instance_uuid)
+    for center, extent in places:
+        lo, hi = center - extent / 2.0 - r, center + extent / 2.0 + r
+        for class_name in spec.classes or (None,):
+            for p in ctx.kb.observations_near((lo[0], lo[1], -1e6), (hi[0], hi[1], 1e6), class_name):
+                gap = np.maximum(np.abs(np.asarray(p.center_map_m[:2]) - center) - extent / 2.0, 0.0)
+                ok = float(np.hypot(*gap)) <= r and p.stamp_s <= until
+                ok = ok and (spec.since_s is None or p.stamp_s >= spec.since_s)
+                if not ok or not p.instance_uuid or p.instance_uuid in own:
+                    continue
+                later = best is None or (p.stamp_s > best[0] if sighting == "last" else p.stamp_s < best[0])
+                if later:
+                    best = (p.stamp_s, p.instance_uuid)
     if best is None:
         return None
     found = engine.hits(ctx, engine.candidates_of(ctx, [best[1]]))
