@@ -23,6 +23,9 @@ from hiper_cli.query.vocabulary import plural
 __all__ = ["answer", "ask", "goal_for", "resolve_events"]
 
 
+_CHANGED = {"added": "new", "removed": "gone", "moved": "moved", "any": "changed"}
+
+
 def goal_for(ctx: Context, hit: Hit) -> GoalPose:
     """A nav2 goal ``goal_standoff_m`` in front of the hit, on the side of the reference
     pose, facing the hit."""
@@ -77,7 +80,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         )
     total = len(cands)
     found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
-    changed = {"added": "new", "removed": "gone", "moved": "moved"}.get(spec.change or "", "")
+    changed = _CHANGED.get(spec.change or "", "")
     if not found_hits:
         return make(count=0, text=f"no {what(0)} {changed or 'found'}".replace("no instances", "nothing"))
     first = found_hits[0]

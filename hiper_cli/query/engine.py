@@ -136,20 +136,18 @@ def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
 
 def _window_mask(ctx: Context, spec: QuerySpec) -> np.ndarray:
     """Seen at some time in [since, until] and not vacated by then; for a change, the change
-    in the window: first seen in it ("added"), vacated in it ("removed"), or moving while
-    seen in it ("moved")."""
+    in the window: first seen in it ("added"), vacated in it ("removed"), moving while seen
+    in it ("moved"), or any of these ("any")."""
     idx = ctx.index
     until = spec.until_s if spec.until_s is not None else ctx.now_s
     since = spec.since_s if spec.since_s is not None else -np.inf
+    removed = (idx.vacated_s >= since) & (idx.vacated_s <= until) & (idx.first_s <= until)
     if spec.change == "removed":
-        return (idx.vacated_s >= since) & (idx.vacated_s <= until) & (idx.first_s <= until)
+        return removed
     mask = (idx.first_s <= until) & (idx.last_s >= since)
     mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
-    if spec.change == "added":
-        mask &= idx.first_s >= since
-    if spec.change == "moved":
-        mask &= idx.states == "dynamic"
-    return mask
+    added, moved = mask & (idx.first_s >= since), mask & (idx.states == "dynamic")
+    return {"added": added, "moved": moved, "any": added | moved | removed}.get(spec.change or "", mask)
 
 
 def details(ctx: Context, uuid: str) -> dict[str, Any] | None:

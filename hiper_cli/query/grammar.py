@@ -39,7 +39,7 @@ UNDERSTOOD = (
 FILLER = frozenset(
     [
      "the", "a", "an", "of", "is", "are", "was", "were", "be", "been", "being", "did", "do", "does", "there",
-     "that", "which", "what", "who", "show", "list", "find", "me", "give", "tell", "all", "any", "some",
+     "that", "which", "what", "who", "me", "all", "any", "some",
      "please", "currently", "in", "at", "with", "and", "by", "you", "i", "we", "my", "your", "our", "can",
      "could", "would", "will", "know", "want", "need", "like", "to", "hey", "ok", "okay", "robot", "so",
      "just", "still", "ever", "else", "it", "its", "they", "them", "these", "those", "this", "right",
@@ -54,11 +54,27 @@ _LENGTH_UNITS = {
 }
 _NUMBERS = {"one": 1.0, "two": 2.0, "three": 3.0, "four": 4.0, "five": 5.0, "six": 6.0, "ten": 10.0}
 _MOVING = {"moving", "walking", "dynamic", "running", "driving", "mobile"}
-_STATIC = {"static", "still", "stationary", "parked", "standing", "unmoved"}
+_STATIC = {"static", "stationary", "parked", "standing", "unmoved"}
+# Chat shorthand and contractions written without the apostrophe.
+_SHORTHAND = {
+    "ppl": "people", "r": "are", "u": "you", "ur": "your", "plz": "please", "pls": "please", "thx": "",
+    "wheres": "where is", "whats": "what is", "hows": "how is", "whos": "who is", "thats": "that is",
+    "isnt": "is not", "arent": "are not", "dont": "do not", "didnt": "did not", "doesnt": "does not",
+    "cant": "cannot", "wasnt": "was not", "werent": "were not", "havent": "have not", "hasnt": "has not",
+    "#": "number", "w/": "with", "nr": "number", "no.": "number",
+}
+# Words putting an instance near a target: None = ``near_radius_m``; 0 = inside or touching.
+_NEAR_WORDS: tuple[tuple[tuple[str, ...], float | None], ...] = (
+    (("near",), None), (("close", "to"), None), (("next", "to"), None), (("beside",), None),
+    (("around",), None), (("by",), None), (("from",), None), (("in",), 0.0), (("inside",), 0.0),
+    (("into",), 0.0),
+)
+_VERTICAL = frozenset(["wall", "door", "picture"])
+_REQUESTS = frozenset(["show", "list", "give", "tell", "display", "print", "report"])
 _ME = {"me", "here", "robot", "you", "us"}
 _FOV = {"fov", "view", "sight", "camera"}
-_SEEN = ("seen", "spotted", "detected", "observed")
-_AUX = ("is", "are", "was", "were", "did", "do", "does", "has", "have", "any")
+_SEEN = ("seen", "spotted", "detected", "observed", "see", "saw", "spot")
+_AUX = ("is", "are", "was", "were", "did", "do", "does", "has", "have", "any", "can", "could")
 # Question phrases -> the answer they ask for. Read where they stand; "did/is/any" at the start
 # ask yes or no only when no other question word says otherwise ("do you know where the cup is").
 _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
@@ -73,6 +89,8 @@ _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("location", "of"), "location"),
     (("position", "of"), "location"),
     (("locate",), "location"),
+    (("find",), "location"),
+    (("how", "far"), "location"),
     (("at", "what", "time"), "time"),
     (("what", "time"), "time"),
     (("when",), "time"),
@@ -106,6 +124,10 @@ _CHANGES: tuple[tuple[tuple[str, ...], str], ...] = (
     (("vanished",), "removed"),
     (("taken", "away"), "removed"),
     (("no", "longer", "there"), "removed"),
+    (("changed",), "any"),
+    (("change",), "any"),
+    (("changes",), "any"),
+    (("different",), "any"),
     (("moved",), "moved"),
     (("move",), "moved"),
     (("shifted",), "moved"),
@@ -169,8 +191,10 @@ def tokens(text: str) -> list[str]:
     text = re.sub(r"'d\b", " did", text)
     text = re.sub(r"(?<=[a-z])[-/](?=[a-z])", " ", text)
     text = re.sub(r"(\d)(m|cm|s|sec|secs|min|mins|h|hr|hrs|ft)\b", r"\1 \2", text)
+    text = re.sub(r"#", " # ", text)
     words = re.split(r"[\s,;!?\"'()\[\]{}<>*]+", text)
-    return [w.rstrip(".") if re.fullmatch(r"[\d.:]+", w) else w.rstrip(".:") for w in words if w.strip(".:")]
+    words = [w.rstrip(".") if re.fullmatch(r"[\d.:]+", w) else w.rstrip(".:") for w in words if w.strip(".:")]
+    return [part for w in words for part in _SHORTHAND.get(w, w).split()]
 
 
 def _number(token: str) -> float | None:
@@ -187,6 +211,7 @@ class _Parser:
         self.t = tokens(text)
         self.answer: str | None = None
         self.ask_yes_no = False  # "is the cup on the table": yes/no unless a question word says otherwise
+        self.request = False
         self.time_of: str | None = None
         self.window = TimeWindow()
         self.fields: dict[str, Any] = {}
@@ -243,6 +268,12 @@ class _Parser:
         if i == 0 and self.word(0) in _AUX:
             self.ask_yes_no = True
             return 1
+        if self.word(i) in _REQUESTS:  # "show me ...", "could you list ...": a list, not yes/no
+            self.request = True
+            return 1
+        if self.word(i) == "see" and not {"did", "have", "had", "last", "first"} & set(self.t[:i]):
+            self.set("in_fov", True)  # "do you see", "what can you see": in view now
+            return 1
         return 0
 
     def times(self, i: int) -> int:
@@ -256,8 +287,9 @@ class _Parser:
             self.time_of = t[i]
             self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
             return 2
-        if self.word(i) == "last":  # "when did a person last pass here"
-            self.set("sort", "last_seen")
+        if self.word(i) in ("last", "first"):  # "when did a person last pass here", "first see"
+            self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
+            self.time_of = self.time_of or t[i]
             return 1
         return 0
 
@@ -286,8 +318,9 @@ class _Parser:
                 self.time_of = self.time_of or sighting
                 self.set("near", Near(target[0], self.cfg.pass_radius_m))
             return k - i + target[1]
-        if self.at(i, "pass", "by") or self.at(i, "passed", "by"):
+        if self.at(i, "pass", "by") or self.at(i, "passed", "by"):  # by here
             self.passed = self.implies_time = True
+            self.set("near", Near("me", self.cfg.pass_radius_m))
             return 2
         for words, sighting in _ARRIVE_LEAVE:
             if self.at(i, *words):
@@ -314,6 +347,10 @@ class _Parser:
         if self.word(i) in ("closest", "nearest"):
             self.set("sort", "distance")
             self.fields.setdefault("limit", 1)
+            target = self.target_at(i + 2) if self.word(i + 1) in ("to", "from") else None
+            if target is not None and target[0] not in ("me", "view"):  # "closest to the door"
+                self.set("near", Near(target[0], self.cfg.near_radius_m))
+                return 2 + target[1]
             return 1
         if self.at(i, "within") and (n := _number(self.word(i + 1))) is not None and t[i + 2:i + 3] and (
             t[i + 2] in _LENGTH_UNITS
@@ -322,12 +359,12 @@ class _Parser:
             target = self.target_at(k)
             self.set("near", Near(target[0] if target else "me", n * _LENGTH_UNITS[t[i + 2]]))
             return k - i + (target[1] if target else 0)
-        for words in (("near",), ("close", "to"), ("next", "to"), ("beside",), ("around",), ("by",)):
+        for words, radius_m in _NEAR_WORDS:
             if self.at(i, *words):
                 target = self.target_at(i + len(words))
-                if target is None or target[0] == "view":
+                if target is None or target[0] == "view" or (radius_m == 0.0 and target[0] == "me"):
                     continue
-                self.set("near", Near(target[0], self.cfg.near_radius_m))
+                self.set("near", Near(target[0], self.cfg.near_radius_m if radius_m is None else radius_m))
                 return len(words) + target[1]
         return self.support(i) or self.nearby(i)
 
@@ -340,7 +377,10 @@ class _Parser:
         found = self.class_at(j + closest)
         if found is None:
             return 0
-        self.set("on", On(found[0], closest))
+        if found[0] in _VERTICAL:  # "pictures on the wall": touching it, not standing on it
+            self.set("near", Near(found[0], self.cfg.support_gap_m))
+        else:
+            self.set("on", On(found[0], closest))
         return j + closest + found[1] - i
 
     def nearby(self, i: int) -> int:
@@ -449,11 +489,14 @@ class _Parser:
         classes = tuple(dict.fromkeys(c for c in self.classes if c != ANY_FOREGROUND))
         if ANY_FOREGROUND in self.classes and not classes:
             layer = "foreground"
-        answer = self.answer or ("yes_no" if self.ask_yes_no else "time" if self.implies_time else "list")
+        yes_no = self.ask_yes_no and not self.request
+        answer = self.answer or ("yes_no" if yes_no else "time" if self.implies_time else "list")
         time_of = self.time_of or "last"
         change = self.change
         if answer == "time" and change in ("added", "removed"):
             time_of, change = ("first" if change == "added" else "last"), None
+        # "when was someone near the couch": the time of the sighting near it, as for "pass"
+        passed = self.passed or (answer == "time" and isinstance(f.get("near"), Near))
         window = self.window
         if change is not None and window.is_open:  # "anything new": new within the recent window
             window = TimeWindow(self.now_s - self.cfg.recent_s, None)
@@ -461,13 +504,11 @@ class _Parser:
             f.setdefault("limit", 1)
         if answer == "goal":
             f.setdefault("sort", "distance")
-        if answer in ("time", "duration") and not self.passed:
+        if answer in ("time", "duration") and not passed:
             f.setdefault("sort", "first_seen" if time_of == "first" else "last_seen")
         if answer == "location" and "sort" not in f:
             f["sort"] = "last_seen"
-        if not self.passed and isinstance(f.get("near"), Near) and f["near"].target == "view":
-            f.pop("near")
-        spec = QuerySpec(classes=classes, layer=layer, passed_here=self.passed, since_s=window.since_s,
+        spec = QuerySpec(classes=classes, layer=layer, passed_here=passed, since_s=window.since_s,
                          until_s=window.until_s, change=change, **f)
         assert answer in ANSWER_KINDS
         return ParsedQuery(self.text, answer, spec, time_of, window.since_event, window.until_event)
@@ -483,11 +524,12 @@ def keywords() -> set[str]:
 
 
 def _parses(text: str, now_s: float, cfg: QueryConfig) -> bool:
+    """Whether ``text`` parses and asks about something (a class, a place, a change)."""
     try:
-        _Parser(text, now_s, cfg).run(suggest=False)
+        spec = _Parser(text, now_s, cfg).run(suggest=False).spec
     except QueryError:
         return False
-    return True
+    return bool(spec.classes or spec.layer or spec.change or spec.near or spec.on or spec.in_fov)
 
 
 def parse(text: str, *, now_s: float = 0.0, config: QueryConfig | None = None) -> ParsedQuery:

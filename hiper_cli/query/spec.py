@@ -19,8 +19,8 @@ Sort = Literal["distance", "last_seen", "first_seen", "confidence"]
 SORTS: tuple[str, ...] = ("distance", "last_seen", "first_seen", "confidence")
 STATES: tuple[str, ...] = ("static", "dynamic")
 # What changed about an instance in the time window: first seen in it ("added"), its place seen
-# empty in it ("removed", ``vacated_s``), or it moved while seen in it ("moved": dynamic).
-CHANGES: tuple[str, ...] = ("added", "removed", "moved")
+# empty in it ("removed", ``vacated_s``), it moved while seen in it ("moved": dynamic), or any.
+CHANGES: tuple[str, ...] = ("added", "removed", "moved", "any")
 
 
 @dataclass(frozen=True)

@@ -1,12 +1,13 @@
 """The refusal of a query the grammar cannot read: it quotes every word not understood, says
 when one is a place name (hiper keeps no named places), and offers a question that parses.
 
-A word is replaced by a known one only when the two are near relative to the word's length
-(at most one edit, a swap of neighbours counting as one, for words of 4-7 letters, two from 8
-letters, none below 4): "chiars" -> "chairs", never "count" -> "computer" or "kitchen" ->
-"kite". Other unknown words are dropped with the prepositions that led to them ("cups in the
-kitchen" -> "cups"). When the result does not parse, the suggestion is built from what was
-understood ("how many chairs").
+A word is replaced by a known one only when the two are near relative to the word's length:
+one edit for 6-7 letters, two from 8, a letter missing, doubled or swapped with its neighbour
+for 4-5, only a swap for 3 ("chiars" -> "chairs", "teh" -> "the"), never "count" -> "computer",
+"open" -> "oven" or "kitchen" -> "kite"; place names are never replaced at all. Other unknown
+words are dropped with the prepositions that led to them ("cups in the kitchen" -> "cups").
+The result is offered when it parses and still asks about something (a class, a place, a
+change); else a question built from what was understood ("how many chairs").
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from hiper_cli.query.vocabulary import PLACE_WORDS, class_words
 
 __all__ = ["edit_distance", "max_edits", "nearest_word", "refusal"]
 
+_TRAILING = frozenset(["is", "are", "was", "were", "there", "the", "a", "an", "my", "of", "and", "please"])
 _LEADING = frozenset(["in", "at", "on", "near", "from", "to", "the", "a", "an", "of", "inside", "into", "my"])
 
 
@@ -37,8 +39,20 @@ def edit_distance(a: str, b: str) -> int:
 
 
 def max_edits(word: str) -> int:
-    """How many edits a typo of ``word`` may hold: none below 4 letters, one up to 7, then two."""
-    return 0 if len(word) < 4 else 1 if len(word) < 8 else 2
+    """How many edits a typo of ``word`` may hold: none below 3 letters, one up to 7, then two."""
+    return 0 if len(word) < 3 else 1 if len(word) < 8 else 2
+
+
+def _near_enough(word: str, known: str, d: int) -> bool:
+    """A short word's typo is a swap of neighbours (3 letters) or a letter missing, doubled or
+    swapped (4-5 letters), not another letter: "open" is no typo of "oven"."""
+    if d == 0 or d > max_edits(word):
+        return False
+    if len(word) == 3:
+        return sorted(word) == sorted(known)
+    if len(word) <= 5 and len(word) == len(known):
+        return sorted(word) == sorted(known)
+    return True
 
 
 @cache
@@ -57,14 +71,24 @@ def nearest_word(word: str, vocabulary: Sequence[str] | None = None) -> str | No
     limit = max_edits(word)
     if limit == 0:
         return None
-    best: tuple[int, int, str] | None = None
+    best: tuple[int, bool, bool, int, str] | None = None
     for known in vocabulary if vocabulary is not None else _vocabulary():
         if abs(len(known) - len(word)) > limit:
             continue
+        if not _near_enough(word, known, edit_distance(word, known)):
+            continue
         d = edit_distance(word, known)
-        if d <= limit and (key := (d, known[0] != word[0], known)) < (best or (limit + 1, 1, "")):
+        key = (d, not known.startswith(word), known[0] != word[0], -_common_prefix(word, known), known)
+        if best is None or key < best:
             best = key
-    return None if best is None else best[2]
+    return None if best is None else best[-1]
+
+
+def _common_prefix(a: str, b: str) -> int:
+    n = 0
+    while n < min(len(a), len(b)) and a[n] == b[n]:
+        n += 1
+    return n
 
 
 def _corrected(tokens: Sequence[str], unknown: Sequence[str], places: Sequence[str]) -> str:
@@ -75,16 +99,15 @@ def _corrected(tokens: Sequence[str], unknown: Sequence[str], places: Sequence[s
         two = " ".join(tokens[i : i + 2])
         n = 2 if two in places else 1
         word = tokens[i]
-        if n == 2 or word in places or word in unknown:
-            fixed = nearest_word(word) if word in unknown else None
-            if fixed is None:
-                while out and out[-1] in _LEADING:
-                    out.pop()
-            else:
-                out.append(fixed)
+        fixed = nearest_word(word) if word in unknown and word not in _vocabulary() else word
+        if n == 2 or word in places or fixed is None:  # drop it and the words leading to it
+            while out and out[-1] in _LEADING:
+                out.pop()
         else:
-            out.append(word)
+            out.append(fixed)
         i += n
+    while out and out[-1] in _TRAILING:  # "how many chairs are"
+        out.pop()
     return " ".join(out)
 
 
@@ -99,7 +122,9 @@ def refusal(
 ) -> str:
     """The one-line refusal: the words not read, a place note, a question that parses (the
     corrected query, else ``fallback``) and what the grammar understands."""
-    quoted = ", ".join(f'"{w}"' for w in dict.fromkeys([*unknown, *places]))
+    # Known words left unread because of a neighbour ("many" after "hwo") are not quoted.
+    strange = [w for w in unknown if w not in _vocabulary()] or list(unknown)
+    quoted = ", ".join(f'"{w}"' for w in dict.fromkeys([*strange, *places]))
     note = ""
     if places:
         named = ", ".join(f'"{p}"' for p in dict.fromkeys(places))

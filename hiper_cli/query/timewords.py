@@ -200,14 +200,28 @@ class _Reader:
         if w in ("yesterday", "today"):
             return _day_start_s(self.now_s) - (86400.0 if w == "yesterday" else 0.0), 1
         if self.at(i, "this") and self.word(i + 1) in _DAY_PARTS:
-            return _day_start_s(self.now_s) + _DAY_PARTS[self.word(i + 1)][0] * 3600.0, 2
+            return self.day_part(self.word(i + 1))[0], 2
+        if (self.word(i), self.word(i + 1)) in (("the", "start"), ("the", "beginning")):
+            return -math.inf, 2
         if (ago := self.ago(i)) is not None:
             return self.now_s - ago[0], ago[1]
         if (span := self.clock(i)) is not None:
             return span[0], span[2]
+        if re.fullmatch(r"\d{1,2}", w) and int(w) <= 23 and self.word(i + 1) not in TIME_UNITS_S:
+            found = _clock_span(f"{w}:00", self.now_s)  # "between 10 and 11": hours
+            if found is not None:
+                return found[0], 1
         if (event := self.event(i)) is not None:
             return event
         return None
+
+    def day_part(self, part: str) -> tuple[float, float]:
+        """The window of "this morning|afternoon|evening", "tonight": on the latest day on
+        which it has begun (as for clock times)."""
+        lo, hi = _DAY_PARTS[part]
+        start = _day_start_s(self.now_s) + lo * 3600.0
+        start -= 86400.0 if start > self.now_s else 0.0
+        return start, start + (hi - lo) * 3600.0
 
     def clock(self, i: int) -> tuple[float, float, int] | None:
         """(stamp, precision s, tokens used) of a clock time; raises for an impossible one."""
@@ -336,8 +350,8 @@ class _Reader:
             return TimeWindow(start - 6 * 3600.0, start + 6 * 3600.0), 2
         part = {"this": self.word(i + 1), "tonight": "tonight"}.get(self.word(i), "")
         if part in _DAY_PARTS:
-            lo, hi = _DAY_PARTS[part]
-            return TimeWindow(start + lo * 3600.0, start + hi * 3600.0), 2 if self.word(i) == "this" else 1
+            lo, hi = self.day_part(part)
+            return TimeWindow(lo, hi), 2 if self.word(i) == "this" else 1
         return None
 
     def _ago(self, i: int) -> tuple[TimeWindow, int] | None:
@@ -351,6 +365,7 @@ class _Reader:
 
 
 def _window(since: float | TimeAnchor | None, until: float | TimeAnchor | None) -> TimeWindow:
+    since = None if since == -math.inf else since  # "since the start": no bound
     return TimeWindow(
         None if since is None or isinstance(since, TimeAnchor) else float(since),
         None if until is None or isinstance(until, TimeAnchor) else float(until),
