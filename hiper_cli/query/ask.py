@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
 from hiper_cli.query.results import Answer, AnswerKind, GoalPose, Hit, TimeValue, ago_text
 from hiper_cli.query.spec import QueryConfig
 from hiper_cli.query.timewords import TimeAnchor, TimeWindow
-from hiper_cli.query.verbs import passed_here, when
+from hiper_cli.query.verbs import passes, when
 from hiper_cli.query.vocabulary import plural
 
 __all__ = ["answer", "ask", "goal_for", "resolve_events"]
@@ -43,6 +44,33 @@ def _describe(hit: Hit, now_s: float) -> str:
     )
 
 
+def _passed(
+    ctx: Context, parsed: ParsedQuery, make: Callable[..., Answer], what: Callable[[int], str]
+) -> Answer:
+    """The answer to "when did X pass|enter|leave Y", "did anyone pass here", "how many
+    people passed by": from the observations near the target (``verbs.passes``)."""
+    spec, kind = parsed.spec, parsed.answer
+    r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
+    place = "here" if spec.near is None or spec.near.target == "me" else f"the {spec.near.target}"
+    found = passes(ctx, spec, parsed.time_of)
+    if kind == "count":
+        return make(count=len(found), text=f"{len(found)} {what(len(found))} within {r:g} m of {place}")
+    if not found:
+        return make(value=False if kind == "yes_no" else None, count=0 if kind == "list" else None,
+                    text=f"no {what(0)} observed within {r:g} m of {place}")
+    uuids = [uuid for _stamp, uuid in found][: ctx.config.max_hits]
+    hits = engine.hits(ctx, engine.candidates_of(ctx, uuids))
+    stamp, hit = found[0][0], hits[0]
+    verb = "first came" if parsed.time_of == "first" else "last passed"
+    return make(
+        hits=tuple(hits) if kind == "list" else (hit,),
+        count=len(found) if kind == "list" else None,
+        time=TimeValue(stamp, ctx.now_s),
+        value=True if kind == "yes_no" else None,
+        text=f"{hit.class_name} {verb} within {r:g} m of {place} {ago_text(stamp, ctx.now_s)}",
+    )
+
+
 def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
     """The answer to a parsed query in a context (reference pose, now)."""
     spec = parsed.spec
@@ -54,20 +82,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         return ", ".join(c if n == 1 else plural(c) for c in names)
 
     if spec.passed_here:
-        found = passed_here(ctx, spec, parsed.time_of)
-        r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
-        place = "here" if spec.near is None or spec.near.target == "me" else f"the {spec.near.target}"
-        if found is None:
-            return make(value=False if kind == "yes_no" else None,
-                        text=f"no {what(0)} observed within {r:g} m of {place}")
-        stamp, hit = found
-        verb = "first came" if parsed.time_of == "first" else "last passed"
-        return make(
-            hits=(hit,),
-            time=TimeValue(stamp, ctx.now_s),
-            value=True if kind == "yes_no" else None,
-            text=f"{hit.class_name} {verb} within {r:g} m of {place} {ago_text(stamp, ctx.now_s)}",
-        )
+        return _passed(ctx, parsed, make, what)
     cands = engine.select(ctx, spec)
     if kind == "count":
         return make(count=len(cands), text=f"{len(cands)} {what(len(cands))}")
@@ -83,6 +98,12 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
     changed = _CHANGED.get(spec.change or "", "")
     if not found_hits:
         return make(count=0, text=f"no {what(0)} {changed or 'found'}".replace("no instances", "nothing"))
+    if kind == "list" and changed:
+        label = f"{total} new {what(total)}" if changed == "new" else f"{total} {what(total)} {changed}"
+        text = f"{label}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
+        if total > 3:
+            text += f"; +{total - 3} more"
+        return make(hits=tuple(found_hits), count=total, text=text)
     first = found_hits[0]
     if kind == "time":
         stamp = first.first_seen_s if parsed.time_of == "first" else first.last_seen_s
@@ -104,8 +125,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
             _describe(first, ctx.now_s) + f"; goal ({goal.x_m:.2f}, {goal.y_m:.2f}, yaw {goal.yaw_rad:.2f})"
         )
         return make(hits=tuple(found_hits), goal=goal, text=text)
-    label = f"{total} {what(total)}" + (f" {changed}" if changed else "")
-    text = f"{label}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
+    text = f"{total} {what(total)}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
     if total > 3:
         text += f"; +{total - 3} more" + (f" ({len(found_hits)} listed)" if total > len(found_hits) else "")
     nearest = goal_for(ctx, first) if spec.sort == "distance" and spec.limit == 1 else None

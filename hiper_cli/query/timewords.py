@@ -394,7 +394,8 @@ def time_window(text: str, now_s: float, *, now_window_s: float = 2.0, recent_s:
             if tokens[i] in ("the", "and", "of", "in"):
                 i += 1
                 continue
-            raise QueryError(f'cannot read "{tokens[i]}" in the time "{text}"; write e.g. {TIME_PHRASES}')
+            rest = " ".join(tokens[i:])
+            raise QueryError(f'cannot read "{rest}" in the time "{text}"; write e.g. {TIME_PHRASES}')
         window, i = window & found[0], i + found[1]
     if not tokens:
         raise QueryError(f"empty time; write e.g. {TIME_PHRASES}")
