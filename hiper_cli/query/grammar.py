@@ -39,13 +39,14 @@ UNDERSTOOD = (
 FILLER = frozenset(
     [
      "the", "a", "an", "of", "is", "are", "was", "were", "be", "been", "being", "did", "do", "does", "there",
-     "that", "which", "what", "who", "me", "all", "any", "some",
-     "please", "currently", "in", "at", "with", "and", "by", "you", "i", "we", "my", "your", "our", "can",
-     "could", "would", "will", "know", "want", "need", "like", "to", "hey", "ok", "okay", "robot", "so",
-     "just", "still", "ever", "else", "it", "its", "they", "them", "these", "those", "this", "right",
-     "exactly", "also", "has", "have", "had", "got", "get", "again", "see", "seen", "saw", "spot", "spotted",
-     "notice", "noticed", "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about",
-     "let", "display", "print", "report", "check",
+     "that", "which", "what", "who", "me", "all", "any", "some", "please", "currently", "in", "at", "with",
+     "and", "by", "you", "i", "we", "my", "your", "our", "can", "could", "would", "will", "know", "want",
+     "need", "like", "to", "hey", "ok", "okay", "robot", "so", "just", "still", "ever", "else", "it", "its",
+     "they", "them", "these", "those", "this", "right", "exactly", "also", "has", "have", "had", "got",
+     "get", "again", "see", "seen", "saw", "spot", "spotted", "notice", "noticed", "observed", "detected",
+     "look", "looking", "for", "from", "one", "ones", "about", "let", "display", "print", "report", "check",
+     "remember", "recall", "located", "situated", "positioned", "sit", "sits", "sitting", "lying", "lies",
+     "placed", "stored", "kept", "resting",
     ]
 )
 _LENGTH_UNITS = {
@@ -115,6 +116,8 @@ _CHANGES: tuple[tuple[tuple[str, ...], str], ...] = (
     (("appeared",), "added"),
     (("appear",), "added"),
     (("showed", "up"), "added"),
+    (("show", "up"), "added"),
+    (("turn", "up"), "added"),
     (("turned", "up"), "added"),
     (("gone",), "removed"),
     (("missing",), "removed"),
@@ -131,6 +134,8 @@ _CHANGES: tuple[tuple[tuple[str, ...], str], ...] = (
     (("moved",), "moved"),
     (("move",), "moved"),
     (("shifted",), "moved"),
+    (("movement",), "moved"),
+    (("movements",), "moved"),
     (("relocated",), "moved"),
 )
 # Passing a place: the verb says which sighting near it ("first" for enter, "last" otherwise).
@@ -220,6 +225,7 @@ class _Parser:
         self.passed = False
         self.implies_time = False  # "pass the table", "leave", "last time": a time is asked for
         self.change: str | None = None
+        self.arrival: str | None = None  # "came in", "left": a change unless a time or place is asked
         self.unknown: list[str] = []
         self.places: list[str] = []
 
@@ -268,7 +274,7 @@ class _Parser:
         if i == 0 and self.word(0) in _AUX:
             self.ask_yes_no = True
             return 1
-        if self.word(i) in _REQUESTS:  # "show me ...", "could you list ...": a list, not yes/no
+        if self.word(i) in _REQUESTS and not self.at(i, "show", "up"):  # "could you list ...": not yes/no
             self.request = True
             return 1
         if self.word(i) == "see" and not {"did", "have", "had", "last", "first"} & set(self.t[:i]):
@@ -323,11 +329,9 @@ class _Parser:
             self.set("near", Near("me", self.cfg.pass_radius_m))
             return 2
         for words, sighting in _ARRIVE_LEAVE:
-            if self.at(i, *words):
+            if self.at(i, *words):  # "when did X leave": a time; "who came in": a change
                 self.time_of = self.time_of or sighting
-                self.implies_time = self.implies_time or self.change is None
-                if self.change is None and self.answer is None:
-                    self.change = "added" if sighting == "first" else "removed"
+                self.arrival = "added" if sighting == "first" else "removed"
                 return len(words)
         return 0
 
@@ -364,6 +368,8 @@ class _Parser:
                 target = self.target_at(i + len(words))
                 if target is None or target[0] == "view" or (radius_m == 0.0 and target[0] == "me"):
                     continue
+                if words == ("from",) and target[0] == "me":  # "visible from here": the viewpoint
+                    return 1 + target[1]
                 self.set("near", Near(target[0], self.cfg.near_radius_m if radius_m is None else radius_m))
                 return len(words) + target[1]
         return self.support(i) or self.nearby(i)
@@ -492,7 +498,7 @@ class _Parser:
         yes_no = self.ask_yes_no and not self.request
         answer = self.answer or ("yes_no" if yes_no else "time" if self.implies_time else "list")
         time_of = self.time_of or "last"
-        change = self.change
+        change = self.change or (self.arrival if answer in ("list", "yes_no", "count") else None)
         if answer == "time" and change in ("added", "removed"):
             time_of, change = ("first" if change == "added" else "last"), None
         # "when was someone near the couch": the time of the sighting near it, as for "pass"
