@@ -74,3 +74,13 @@ def test_a_time_that_does_not_exist_is_named(text):
 def test_words_that_are_no_time_are_named():
     with pytest.raises(QueryError, match=r'cannot read "last fortnight" in the time "the last fortnight"'):
         time_window("the last fortnight", NOW)
+
+
+def test_an_agent_time_may_be_any_time_phrase():
+    from hiper_cli.agent.times import resolve_time
+
+    assert resolve_time("this morning", NOW) == _at(6)
+    assert resolve_time("since 9am", NOW) == _at(9)
+    assert resolve_time("10:30", NOW) == _at(10, 30)
+    with pytest.raises(QueryError, match="time 'banana': expected a stamp"):
+        resolve_time("banana", NOW)
