@@ -213,3 +213,29 @@ def test_no_far_fetched_suggestion_and_no_class_for_a_place():
     assert "kite" not in str(err.value) and 'did you mean "anything new"' in str(err.value)
     with pytest.raises(QueryError, match=r'cannot read "forklift".*did you mean "where is the chair"'):
         parse("where is the forklift")
+
+
+def test_random_word_salad_never_crashes_and_every_suggestion_parses():
+    """Seeded word salad from the grammar's own words, numbers, clock times and places: each
+    query parses or is refused with a QueryError; a suggested question parses."""
+    import random
+    import re
+
+    from hiper_cli.query.grammar import keywords
+    from hiper_cli.query.vocabulary import class_words
+
+    rng = random.Random(7)
+    words = [
+        *sorted(keywords() | set(class_words())),
+        *("10:00", "25:00", "3pm", "5", "0.5", "2.5m", "kitchen", "xyz", "?", "'s", "-", "1e309", "-3"),
+    ]
+    for _ in range(800):
+        text = " ".join(rng.choice(words) for _ in range(rng.randint(1, 8)))
+        try:
+            parse(text, now_s=NOW)
+        except QueryError as err:
+            found = re.search(r'did you mean "([^"]*)"\?', str(err))
+            if found:
+                parse(found.group(1), now_s=NOW)
+    with pytest.raises(QueryError, match="leave no time between them"):
+        parse("cups after 11:00 before 10:00", now_s=NOW)

@@ -23,7 +23,7 @@ from hiper_cli.query.results import ANSWER_KINDS
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
 from hiper_cli.query.suggest import refusal
 from hiper_cli.query.timewords import TIME_UNITS_S, TimeAnchor, TimeWindow, clock_stamp, read_time_phrase
-from hiper_cli.query.vocabulary import ANY_FOREGROUND, PLACE_WORDS, resolve_class, singular
+from hiper_cli.query.vocabulary import ANY_FOREGROUND, PLACE_WORDS, plural, resolve_class, singular
 
 __all__ = ["FILLER", "UNDERSTOOD", "ParsedQuery", "keywords", "parse", "parse_time", "tokens", "with_limit"]
 
@@ -38,15 +38,15 @@ UNDERSTOOD = (
 )
 FILLER = frozenset(
     [
-     "the", "a", "an", "of", "is", "are", "was", "were", "be", "been", "being", "did", "do", "does", "there",
-     "that", "which", "what", "who", "me", "all", "any", "some", "please", "currently", "in", "at", "with",
-     "and", "by", "you", "i", "we", "my", "your", "our", "can", "could", "would", "will", "know", "want",
-     "need", "like", "to", "hey", "ok", "okay", "robot", "so", "just", "still", "ever", "else", "it", "its",
-     "they", "them", "these", "those", "this", "right", "exactly", "also", "has", "have", "had", "got",
-     "get", "again", "see", "seen", "saw", "spot", "spotted", "notice", "noticed", "observed", "detected",
-     "look", "looking", "for", "from", "one", "ones", "about", "let", "display", "print", "report", "check",
-     "remember", "recall", "located", "situated", "positioned", "sit", "sits", "sitting", "lying", "lies",
-     "placed", "stored", "kept", "resting",
+        "the", "a", "an", "of", "is", "are", "was", "were", "be", "been", "being", "did", "do", "does",
+        "there", "that", "which", "what", "who", "me", "all", "any", "some", "please", "currently", "in",
+        "at", "with", "and", "by", "you", "i", "we", "my", "your", "our", "can", "could", "would", "will",
+        "know", "want", "need", "like", "to", "hey", "ok", "okay", "robot", "so", "just", "still", "ever",
+        "else", "it", "its", "they", "them", "these", "those", "this", "right", "exactly", "also", "has",
+        "have", "had", "got", "get", "again", "see", "seen", "saw", "spot", "spotted", "notice", "noticed",
+        "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about", "let", "display",
+        "print", "report", "check", "remember", "recall", "located", "situated", "positioned", "sit", "sits",
+        "sitting", "lying", "lies", "placed", "stored", "kept", "resting",
     ]
 )
 _LENGTH_UNITS = {
@@ -478,8 +478,6 @@ class _Parser:
     def example(self) -> str:
         """A question that parses, built from what was understood (the fallback suggestion)."""
         name = next((c for c in self.classes if c != ANY_FOREGROUND), "chair")
-        from hiper_cli.query.vocabulary import plural
-
         return {
             "count": f"how many {plural(name)}",
             "location": f"where is the {name}",
@@ -506,6 +504,9 @@ class _Parser:
         window = self.window
         if change is not None and window.is_open:  # "anything new": new within the recent window
             window = TimeWindow(self.now_s - self.cfg.recent_s, None)
+        if window.since_s is not None and window.until_s is not None and window.since_s > window.until_s:
+            raise QueryError(f'the times in "{self.text}" leave no time between them (the window would '
+                             'start after it ends); ask e.g. "people between 9:00 and 11:00"')
         if answer in ("location", "time", "duration", "goal") and not self.plural:
             f.setdefault("limit", 1)
         if answer == "goal":
