@@ -46,7 +46,8 @@ FILLER = frozenset(
         "have", "had", "got", "get", "again", "see", "seen", "saw", "spot", "spotted", "notice", "noticed",
         "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about", "let", "display",
         "print", "report", "check", "remember", "recall", "located", "situated", "positioned", "sit", "sits",
-        "sitting", "lying", "lies", "placed", "stored", "kept", "resting",
+        "sitting", "lying", "lies", "placed", "stored", "kept", "resting", "stay", "stayed", "remain",
+        "remained",
     ]
 )
 _LENGTH_UNITS = {
@@ -70,6 +71,10 @@ _NEAR_WORDS: tuple[tuple[tuple[str, ...], float | None], ...] = (
     (("around",), None), (("by",), None), (("from",), None), (("in",), 0.0), (("inside",), 0.0),
     (("into",), 0.0),
 )
+_CONFIDENCE = frozenset(["confidence", "confident", "sure", "certainty", "score"])
+_AT_LEAST = frozenset(["above", "over", "at", "least", ">", ">=", "of", "more", "than", "greater", "higher"])
+_ORDERS = {"distance": "distance", "proximity": "distance", "time": "last_seen", "recency": "last_seen",
+           "confidence": "confidence", "date": "last_seen"}
 _VERTICAL = frozenset(["wall", "door", "picture"])
 _REQUESTS = frozenset(["show", "list", "give", "tell", "display", "print", "report"])
 _ME = {"me", "here", "robot", "you", "us"}
@@ -93,6 +98,8 @@ _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("find",), "location"),
     (("how", "far"), "location"),
     (("at", "what", "time"), "time"),
+    (("at", "which", "time"), "time"),
+    (("which", "time"), "time"),
     (("what", "time"), "time"),
     (("when",), "time"),
     (("is", "there"), "yes_no"),
@@ -107,6 +114,12 @@ _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("head", "to"), "goal"),
     (("move", "to"), "goal"),
     (("guide", "me", "to"), "goal"),
+    (("go", "near"), "goal"),
+    (("go", "towards"), "goal"),
+    (("go", "next", "to"), "goal"),
+    (("get", "me"), "goal"),
+    (("fetch",), "goal"),
+    (("send",), "goal"),
 )
 # Change words -> the change they ask about (``QuerySpec.change``).
 _CHANGES: tuple[tuple[tuple[str, ...], str], ...] = (
@@ -410,16 +423,31 @@ class _Parser:
         return 0
 
     def confidence(self, i: int) -> int:
-        if self.t[i] not in ("confidence", "confident"):
-            return 0
-        k = i + 1
-        while self.word(k) in ("above", "over", "at", "least", ">", ">=", "of"):
+        """"confidence above 0.5", "more than 50% confidence", "at least 80 % sure"."""
+        k = i + (1 if self.word(i) in _CONFIDENCE else 0)
+        while self.word(k) in _AT_LEAST:
             k += 1
         n = _number(self.word(k))
         if n is None:
             return 0
+        k += 1
+        if self.word(i) not in _CONFIDENCE:  # the number first: the confidence word must follow
+            if self.word(k) not in _CONFIDENCE:
+                return 0
+            k += 1
         self.set("min_confidence", n)
-        return k - i + 1
+        return k - i
+
+    def order(self, i: int) -> int:
+        """"sorted by distance", "by time", "most recent first": the order of the answer."""
+        k = i + (1 if self.word(i) in ("sorted", "ordered", "sort", "order", "ranked") else 0)
+        if self.word(k) == "by" and self.word(k + 1) in _ORDERS:
+            self.set("sort", _ORDERS[self.word(k + 1)])
+            return k + 2 - i
+        if self.at(i, "most", "recent", "first") or self.at(i, "latest", "first"):
+            self.set("sort", "last_seen")
+            return 3 if self.word(i) == "most" else 2
+        return 0
 
     def noun(self, i: int) -> int:
         n = _number(self.t[i])
@@ -450,7 +478,7 @@ class _Parser:
     def read(self) -> None:
         rules: list[Callable[[int], int]] = [
             self.questions, self.times, self.changes, self.passes, self.space, self.state,
-            self.confidence, self.noun, self.place,
+            self.confidence, self.order, self.noun, self.place,
         ]
         i = 0
         while i < len(self.t):

@@ -19,7 +19,8 @@ from hiper_cli.query.vocabulary import PLACE_WORDS, class_words
 
 __all__ = ["edit_distance", "max_edits", "nearest_word", "refusal"]
 
-_TRAILING = frozenset(["is", "are", "was", "were", "there", "the", "a", "an", "my", "of", "and", "please"])
+_TRAILING = frozenset(["is", "are", "was", "were", "there", "the", "a", "an", "my", "of", "and", "please",
+                       "by", "to", "with", "in", "at", "on"])
 _LEADING = frozenset(["in", "at", "on", "near", "from", "to", "the", "a", "an", "of", "inside", "into", "my"])
 
 

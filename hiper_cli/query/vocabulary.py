@@ -179,7 +179,7 @@ PLACE_WORDS = frozenset(
         "storeroom", "basement", "attic", "garden", "yard", "upstairs", "downstairs", "corner", "area",
         "zone", "house", "home", "building", "store", "shop", "bookstore", "living room",
         "dining room", "meeting room", "break room", "conference room", "loading dock", "back room",
-        "stockroom", "canteen", "cafeteria", "lounge", "porch", "balcony",
+        "stockroom", "canteen", "cafeteria", "lounge", "porch", "balcony", "place", "places",
     ]
 )
 IRREGULAR_PLURALS = {
