@@ -105,6 +105,7 @@ def reading_errors(entry: dict[str, Any], parsed: ParsedQuery, now_s: float) -> 
             check(f"{bound} event", (event.class_name, event.sighting) if event else None, (want[1], want[2]))
         else:
             check(bound, got, None if want is None else expected_stamp(want, now_s))
+    check("rank_from", spec.rank_from, entry.get("rank_from"))
     for key, got in (("time_of", parsed.time_of), ("sort", spec.sort), ("limit", spec.limit),
                      ("min_confidence", spec.min_confidence)):
         if key in entry:

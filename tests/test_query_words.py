@@ -123,3 +123,12 @@ def test_events_bound_the_window(kb_path):
     assert _ask(kb_path, "bottles seen before the person arrived").count == 0
     with pytest.raises(QueryError, match=r'no dog was seen .* "the dog was last seen" names no time'):
         _ask(kb_path, "cups seen after the dog left")
+
+
+def test_closest_to_a_class_ranks_from_it(kb_path):
+    with open_kb(kb_path) as kb:
+        here = (-10.0, 0.0, 1.2, 0.0)  # cup A (x = -0.2 m) is the nearer to here
+        closest = ask(kb, "closest cup", pose=here).hits[0]
+        to_bottle = ask(kb, "which cup is closest to the bottle", pose=here).hits  # cup B, x = 0.2 m
+    assert closest.center_map_m[0] == pytest.approx(-0.2)
+    assert len(to_bottle) == 1 and to_bottle[0].center_map_m[0] == pytest.approx(0.2)

@@ -210,7 +210,10 @@ def select(ctx: Context, spec: QuerySpec) -> Candidates:
     idx = ctx.index
     # Ties (two cups last seen in one frame) go to the nearer, then the later seen, never to
     # the index's order (uuids): the same question gets the same answer in every run.
-    distance_m = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
+    if spec.rank_from is not None:
+        cands, distance_m = _distances_from(ctx, cands, spec.rank_from)
+    else:
+        distance_m = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
     if spec.sort in (None, "distance"):
         order = np.lexsort((-cands.last_s, distance_m))
     elif spec.sort == "last_seen":
@@ -223,6 +226,19 @@ def select(ctx: Context, spec: QuerySpec) -> Candidates:
     if spec.limit is not None:
         cands = cands.take(np.arange(min(spec.limit, len(cands))))
     return cands
+
+
+def _distances_from(ctx: Context, cands: Candidates, class_name: str) -> tuple[Candidates, np.ndarray]:
+    """The candidates other than the instances of ``class_name``, and each one's horizontal
+    gap (m) to the nearest of those instances (inf when there is none)."""
+    targets = supports(ctx, class_name)
+    cands = cands.take(~np.isin(cands.rows, targets.rows))
+    gap_m = np.full(len(cands), np.inf)
+    for k in range(len(targets)):
+        lo, hi = cands.centers[:, :2], targets.centers[k, :2]
+        gap = np.maximum(np.abs(lo - hi) - (cands.extents[:, :2] + targets.extents[k, :2]) / 2.0, 0.0)
+        gap_m = np.minimum(gap_m, np.linalg.norm(gap, axis=1))
+    return cands, gap_m
 
 
 def supports_of(ctx: Context, cands: Candidates) -> list[Support | None]:

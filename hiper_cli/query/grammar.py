@@ -364,10 +364,12 @@ class _Parser:
         if self.word(i) in ("closest", "nearest"):
             self.set("sort", "distance")
             self.fields.setdefault("limit", 1)
-            target = self.target_at(i + 2) if self.word(i + 1) in ("to", "from") else None
-            if target is not None and target[0] not in ("me", "view"):  # "closest to the door"
-                self.set("near", Near(target[0], self.cfg.near_radius_m))
-                return 2 + target[1]
+            # "the chair closest to the door", "the cup nearest the sink": ranked from the door
+            to = 1 if self.word(i + 1) in ("to", "from") else 0
+            target = self.target_at(i + 1 + to) if to or self.classes else None
+            if target is not None and target[0] not in ("me", "view"):
+                self.set("rank_from", target[0])
+                return 1 + to + target[1]
             return 1
         if self.at(i, "within") and (n := _number(self.word(i + 1))) is not None and t[i + 2:i + 3] and (
             t[i + 2] in _LENGTH_UNITS

@@ -72,7 +72,9 @@ class On:
 class QuerySpec:
     """Which instances a query selects. Empty ``classes`` = any class (of ``layer`` if set).
     Times are stamps (s): an instance passes when it was seen at some time in [since, until];
-    with ``change`` (``CHANGES``) when that change happened in [since, until] instead."""
+    with ``change`` (``CHANGES``) when that change happened in [since, until] instead.
+    ``rank_from``: a class; sort "distance" then measures from the nearest instance of it
+    ("the chair closest to the door"), not from the reference pose."""
 
     classes: tuple[str, ...] = ()
     layer: str | None = None
@@ -86,6 +88,7 @@ class QuerySpec:
     passed_here: bool = False
     change: str | None = None
     sort: str | None = None
+    rank_from: str | None = None
     limit: int | None = None
 
     def __post_init__(self) -> None:
