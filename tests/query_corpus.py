@@ -179,9 +179,11 @@ def _refusal_verdict(entry: dict[str, Any], message: str, now_s: float) -> tuple
 def judge(entry: dict[str, Any], h: TruthKb | None, kb: Any, now_s: float) -> Outcome:
     """The verdict on one corpus question (``kb`` open on ``h``'s path, or None: reading only)."""
     q = entry["q"]
+    envs = kb.environments() if kb is not None else []
+    whole = [envs[0].name] if len(envs) == 1 else []  # as ``ask`` reads "in the house"
     try:
         try:
-            parsed = parse(q, now_s=now_s)
+            parsed = parse(q, now_s=now_s, whole_place=whole)
         except QueryError as err:
             verdict, detail = _refusal_verdict(entry, str(err), now_s)
             return Outcome(q, verdict, detail)

@@ -132,3 +132,9 @@ def test_closest_to_a_class_ranks_from_it(kb_path):
         to_bottle = ask(kb, "which cup is closest to the bottle", pose=here).hits  # cup B, x = 0.2 m
     assert closest.center_map_m[0] == pytest.approx(-0.2)
     assert len(to_bottle) == 1 and to_bottle[0].center_map_m[0] == pytest.approx(0.2)
+
+
+def test_the_name_of_the_whole_place_is_no_filter(kb_path):
+    assert _ask(kb_path, "how many cups are there in the lab").count == 2  # the KB's one place
+    with pytest.raises(QueryError, match='"kitchen": hiper keeps no named places'):
+        _ask(kb_path, "how many cups are there in the kitchen")

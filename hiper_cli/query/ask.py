@@ -146,7 +146,9 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
-    parsed = with_limit(parse(text, now_s=ctx.now_s, config=ctx.config), limit)
+    envs = kb.environments()
+    whole = [envs[0].name] if len(envs) == 1 else []  # "in the house": the KB's one place
+    parsed = with_limit(parse(text, now_s=ctx.now_s, config=ctx.config, whole_place=whole), limit)
     return answer(ctx, resolve_events(ctx, parsed))
 
 

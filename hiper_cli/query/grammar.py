@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -224,8 +224,10 @@ def _number(token: str) -> float | None:
 
 
 class _Parser:
-    def __init__(self, text: str, now_s: float, config: QueryConfig) -> None:
-        self.text, self.now_s, self.cfg = text, now_s, config
+    def __init__(
+        self, text: str, now_s: float, config: QueryConfig, whole_place: frozenset[str] = frozenset()
+    ) -> None:
+        self.text, self.now_s, self.cfg, self.whole_place = text, now_s, config, whole_place
         self.t = tokens(text)
         self.answer: str | None = None
         self.ask_yes_no = False  # "is the cup on the table": yes/no unless a question word says otherwise
@@ -467,11 +469,17 @@ class _Parser:
         return found[1]
 
     def place(self, i: int) -> int:
-        """A room or area name: hiper keeps no named places, so the query is refused with a
-        note that says so (never read as a class spelled alike)."""
+        """A room or area name. The name of the whole place the KB holds ("in the house" when
+        its one environment is "house") asks about all of it; any other is refused with a
+        note that hiper keeps no named places (never read as a class spelled alike)."""
         for n in (2, 1):
-            if " ".join(self.t[i : i + n]) in PLACE_WORDS:
-                self.places.append(" ".join(self.t[i : i + n]))
+            phrase = " ".join(self.t[i : i + n])
+            if len(self.t[i : i + n]) < n:
+                continue
+            if phrase in self.whole_place:
+                return n
+            if phrase in PLACE_WORDS:
+                self.places.append(phrase)
                 return n
         return 0
 
@@ -569,9 +577,13 @@ def _parses(text: str, now_s: float, cfg: QueryConfig) -> bool:
     return bool(spec.classes or spec.layer or spec.change or spec.near or spec.on or spec.in_fov)
 
 
-def parse(text: str, *, now_s: float = 0.0, config: QueryConfig | None = None) -> ParsedQuery:
-    """Parse a plain-words query; ``now_s`` anchors relative times ("last 10 minutes")."""
-    return _Parser(text, now_s, config or QueryConfig()).run()
+def parse(
+    text: str, *, now_s: float = 0.0, config: QueryConfig | None = None, whole_place: Sequence[str] = ()
+) -> ParsedQuery:
+    """Parse a plain-words query; ``now_s`` anchors relative times ("last 10 minutes");
+    ``whole_place``: names of the whole place asked about ("house"), read as no filter."""
+    names = frozenset(" ".join(tokens(name)) for name in whole_place)
+    return _Parser(text, now_s, config or QueryConfig(), names).run()
 
 
 def with_limit(parsed: ParsedQuery, limit: int | None) -> ParsedQuery:
