@@ -47,7 +47,7 @@ FILLER = frozenset(
         "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about", "let", "display",
         "print", "report", "check", "remember", "recall", "located", "situated", "positioned", "sit", "sits",
         "sitting", "lying", "lies", "placed", "stored", "kept", "resting", "stay", "stayed", "remain",
-        "remained",
+        "remained", "put", "left",
     ]
 )
 _LENGTH_UNITS = {
@@ -65,11 +65,13 @@ _SHORTHAND = {
     "cant": "cannot", "wasnt": "was not", "werent": "were not", "havent": "have not", "hasnt": "has not",
     "#": "number", "w/": "with", "nr": "number", "no.": "number",
 }
-# Words putting an instance near a target: None = ``near_radius_m``; 0 = inside or touching.
-_NEAR_WORDS: tuple[tuple[tuple[str, ...], float | None], ...] = (
-    (("near",), None), (("close", "to"), None), (("next", "to"), None), (("beside",), None),
-    (("around",), None), (("by",), None), (("from",), None), (("in",), 0.0), (("inside",), 0.0),
-    (("into",), 0.0),
+# Words putting an instance near a target: "near" (within ``near_radius_m``), "inside" (its box
+# touches or is inside the target's), "with" (touching: ``support_gap_m``; "the table with the
+# laptop", "people with a backpack"; only after a class).
+_NEAR_WORDS: tuple[tuple[tuple[str, ...], str], ...] = (
+    (("near",), "near"), (("close", "to"), "near"), (("next", "to"), "near"), (("beside",), "near"),
+    (("around",), "near"), (("by",), "near"), (("from",), "near"), (("in",), "inside"),
+    (("inside",), "inside"), (("into",), "inside"), (("with",), "with"),
 )
 _CONFIDENCE = frozenset(["confidence", "confident", "sure", "certainty", "score"])
 _AT_LEAST = frozenset(["above", "over", "at", "least", ">", ">=", "of", "more", "than", "greater", "higher"])
@@ -322,9 +324,13 @@ class _Parser:
         return 0
 
     def passes(self, i: int) -> int:
-        """"pass|enter|leave X|here|view", and without a place "come in", "leave"."""
+        """"pass|enter|leave X|here|view", and without a place "come in", "leave". The mover
+        is named before the verb ("when did the person pass the table"); without one it is
+        no passing ("where did I leave my phone"), and "left" after "is" means remaining."""
+        if self.word(i) == "left" and self.word(i - 1) in ("is", "are", "was", "were", "anything"):
+            return 0
         for words, sighting in _PASS_VERBS:
-            if not self.at(i, *words):
+            if not self.at(i, *words) or not self.classes:
                 continue
             k = i + len(words)
             k += 1 if self.word(k) in ("by", "past", "near", "through", "into", "at") else 0
@@ -343,6 +349,8 @@ class _Parser:
             self.passed = self.implies_time = True
             self.set("near", Near("me", self.cfg.pass_radius_m))
             return 2
+        if self.word(i - 1) in ("the", "a", "an", "nearest", "closest", "my", "main"):
+            return 0  # "the nearest exit": a noun, not a verb
         for words, sighting in _ARRIVE_LEAVE:
             if self.at(i, *words):  # "when did X leave": a time; "who came in": a change
                 self.time_of = self.time_of or sighting
@@ -380,14 +388,17 @@ class _Parser:
             target = self.target_at(k)
             self.set("near", Near(target[0] if target else "me", n * _LENGTH_UNITS[t[i + 2]]))
             return k - i + (target[1] if target else 0)
-        for words, radius_m in _NEAR_WORDS:
+        for words, how in _NEAR_WORDS:
             if self.at(i, *words):
                 target = self.target_at(i + len(words))
-                if target is None or target[0] == "view" or (radius_m == 0.0 and target[0] == "me"):
+                if target is None or target[0] == "view" or (how != "near" and target[0] == "me"):
+                    continue
+                if how == "with" and not self.classes:
                     continue
                 if words == ("from",) and target[0] == "me":  # "visible from here": the viewpoint
                     return 1 + target[1]
-                self.set("near", Near(target[0], self.cfg.near_radius_m if radius_m is None else radius_m))
+                radius_m = {"near": self.cfg.near_radius_m, "inside": 0.0}.get(how, self.cfg.support_gap_m)
+                self.set("near", Near(target[0], radius_m))
                 return len(words) + target[1]
         return self.support(i) or self.nearby(i)
 
@@ -451,6 +462,9 @@ class _Parser:
         if self.at(i, "most", "recent", "first") or self.at(i, "latest", "first"):
             self.set("sort", "last_seen")
             return 3 if self.word(i) == "most" else 2
+        if self.at(i, "most", "recently") or self.at(i, "most", "recent"):
+            self.set("sort", "last_seen")
+            return 2
         return 0
 
     def noun(self, i: int) -> int:
