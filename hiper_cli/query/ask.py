@@ -24,6 +24,15 @@ from hiper_cli.query.vocabulary import plural
 __all__ = ["answer", "ask", "goal_for", "resolve_events"]
 
 
+def _changed(n: int, names: str, change: str) -> str:
+    """A change answer's words: "2 new chairs", "nothing moved", "1 cup gone"."""
+    if n == 0 and names in ("instances", "objects"):
+        return {"added": "nothing new"}.get(change, f"nothing {_CHANGED[change]}")
+    if change == "added":
+        return f"{n or 'no'} new {names}"
+    return f"{n or 'no'} {names} {_CHANGED[change]}"
+
+
 _CHANGED = {"added": "new", "removed": "gone", "moved": "moved", "any": "changed"}
 
 
@@ -95,15 +104,13 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         )
     total = len(cands)
     found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
-    changed = _CHANGED.get(spec.change or "", "")
-    if not found_hits:
-        return make(count=0, text=f"no {what(0)} {changed or 'found'}".replace("no instances", "nothing"))
-    if kind == "list" and changed:
-        label = f"{total} new {what(total)}" if changed == "new" else f"{total} {what(total)} {changed}"
-        text = f"{label}: " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])
-        if total > 3:
-            text += f"; +{total - 3} more"
+    if spec.change is not None and (kind == "list" or not found_hits):
+        text = _changed(total, what(total), spec.change)
+        text += (": " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])) if found_hits else ""
+        text += f"; +{total - 3} more" if total > 3 else ""
         return make(hits=tuple(found_hits), count=total, text=text)
+    if not found_hits:
+        return make(count=0, text=f"no {what(0)} found")
     first = found_hits[0]
     if kind == "time":
         stamp = first.first_seen_s if parsed.time_of == "first" else first.last_seen_s
