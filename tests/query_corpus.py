@@ -91,7 +91,8 @@ def reading_errors(entry: dict[str, Any], parsed: ParsedQuery, now_s: float) -> 
     else:
         check("classes", (set(spec.classes), spec.layer), (set(classes), None))
     near = entry.get("near")
-    check("near", spec.near, Near(near[0], float(near[1])) if near else None)
+    got_near = None if spec.near is None else Near(spec.near.target, round(spec.near.radius_m, 6))
+    check("near", got_near, Near(near[0], float(near[1])) if near else None)
     on = entry.get("on")
     check("on", spec.on, On(on[0], on[1]) if on else None)
     check("in_fov", spec.in_fov, bool(entry.get("fov")))

@@ -47,7 +47,7 @@ FILLER = frozenset(
         "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about", "let", "display",
         "print", "report", "check", "remember", "recall", "located", "situated", "positioned", "sit", "sits",
         "sitting", "lying", "lies", "placed", "stored", "kept", "resting", "stay", "stayed", "remain",
-        "remained", "put", "left",
+        "remained", "put", "left", "or", "seeing",
     ]
 )
 _LENGTH_UNITS = {
@@ -81,6 +81,10 @@ _VERTICAL = frozenset(["wall", "door", "picture"])
 _REQUESTS = frozenset(["show", "list", "give", "tell", "display", "print", "report"])
 _ME = {"me", "here", "robot", "you", "us"}
 _FOV = {"fov", "view", "sight", "camera"}
+_SIGHTINGS = tuple(
+    ((verb, seeing), "first" if verb.startswith("start") else "last")
+    for verb in ("start", "started", "stop", "stopped") for seeing in ("seeing", "observing", "detecting")
+)
 _SEEN = ("seen", "spotted", "detected", "observed", "see", "saw", "spot")
 _AUX = ("is", "are", "was", "were", "did", "do", "does", "has", "have", "any", "can", "could")
 # Question phrases -> the answer they ask for. Read where they stand; "did/is/any" at the start
@@ -91,12 +95,15 @@ _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("count",), "count"),
     (("number", "of"), "count"),
     (("total", "number", "of"), "count"),
+    (("how", "long", "ago"), "time"),
     (("for", "how", "long"), "duration"),
     (("how", "long"), "duration"),
     (("where",), "location"),
     (("location", "of"), "location"),
     (("position", "of"), "location"),
     (("locate",), "location"),
+    (("location",), "location"),
+    (("position",), "location"),
     (("find",), "location"),
     (("how", "far"), "location"),
     (("at", "what", "time"), "time"),
@@ -117,6 +124,9 @@ _QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("move", "to"), "goal"),
     (("guide", "me", "to"), "goal"),
     (("go", "near"), "goal"),
+    (("go", "back", "to"), "goal"),
+    (("return", "to"), "goal"),
+    (("come", "back", "to"), "goal"),
     (("go", "towards"), "goal"),
     (("go", "next", "to"), "goal"),
     (("get", "me"), "goal"),
@@ -296,6 +306,7 @@ class _Parser:
             return 1
         if self.word(i) == "see" and not {"did", "have", "had", "last", "first"} & set(self.t[:i]):
             self.set("in_fov", True)  # "do you see", "what can you see": in view now
+            self.ask_yes_no = self.ask_yes_no or self.t[:i] == ["you"]  # "you see any cup?"
             return 1
         return 0
 
@@ -306,6 +317,11 @@ class _Parser:
             self.window = self.window & found[0]
             return found[1]
         t = self.t
+        for words, sighting in _SIGHTINGS:  # "when did you start seeing the couch"
+            if self.at(i, *words):
+                self.time_of = sighting
+                self.set("sort", f"{sighting}_seen")
+                return len(words)
         if self.word(i) in ("last", "first") and self.word(i + 1) in _SEEN:
             self.time_of = t[i]
             self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
