@@ -13,12 +13,34 @@ it and offers a question that parses.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 from hiper_cli.errors import QueryError
+from hiper_cli.query.phrases import (
+    ARRIVE_LEAVE_VERBS,
+    AT_LEAST_WORDS,
+    AUX_WORDS,
+    CHANGE_WORDS,
+    CONFIDENCE_WORDS,
+    FILLER,
+    FOV_WORDS,
+    LENGTH_UNITS,
+    ME_WORDS,
+    MOVING_WORDS,
+    NEAR_WORDS,
+    NUMBER_WORDS,
+    ORDER_WORDS,
+    PASS_VERBS,
+    QUESTION_PHRASES,
+    REQUEST_WORDS,
+    SEEN_WORDS,
+    SIGHTING_VERBS,
+    STATIC_WORDS,
+    VERTICAL_CLASSES,
+    tokens,
+)
 from hiper_cli.query.results import ANSWER_KINDS
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
 from hiper_cli.query.suggest import refusal
@@ -36,157 +58,6 @@ UNDERSTOOD = (
     "passing: pass|enter|leave X|here; state: moving, static; questions: how many/count/number of, "
     "where, when/last time, how long, is there/any/did, go to"
 )
-FILLER = frozenset(
-    [
-        "the", "a", "an", "of", "is", "are", "was", "were", "be", "been", "being", "did", "do", "does",
-        "there", "that", "which", "what", "who", "me", "all", "any", "some", "please", "currently", "in",
-        "at", "with", "and", "by", "you", "i", "we", "my", "your", "our", "can", "could", "would", "will",
-        "know", "want", "need", "like", "to", "hey", "ok", "okay", "robot", "so", "just", "still", "ever",
-        "else", "it", "its", "they", "them", "these", "those", "this", "right", "exactly", "also", "has",
-        "have", "had", "got", "get", "again", "see", "seen", "saw", "spot", "spotted", "notice", "noticed",
-        "observed", "detected", "look", "looking", "for", "from", "one", "ones", "about", "let", "display",
-        "print", "report", "check", "remember", "recall", "located", "situated", "positioned", "sit", "sits",
-        "sitting", "lying", "lies", "placed", "stored", "kept", "resting", "stay", "stayed", "remain",
-        "remained", "put", "left", "or", "seeing",
-    ]
-)
-_LENGTH_UNITS = {
-    "m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0, "cm": 0.01, "ft": 0.3048,
-    "feet": 0.3048, "foot": 0.3048,
-}
-_NUMBERS = {"one": 1.0, "two": 2.0, "three": 3.0, "four": 4.0, "five": 5.0, "six": 6.0, "ten": 10.0}
-_MOVING = {"moving", "walking", "dynamic", "running", "driving", "mobile"}
-_STATIC = {"static", "stationary", "parked", "standing", "unmoved"}
-# Chat shorthand and contractions written without the apostrophe.
-_SHORTHAND = {
-    "ppl": "people", "r": "are", "u": "you", "ur": "your", "plz": "please", "pls": "please", "thx": "",
-    "wheres": "where is", "whats": "what is", "hows": "how is", "whos": "who is", "thats": "that is",
-    "isnt": "is not", "arent": "are not", "dont": "do not", "didnt": "did not", "doesnt": "does not",
-    "cant": "cannot", "wasnt": "was not", "werent": "were not", "havent": "have not", "hasnt": "has not",
-    "#": "number", "w/": "with", "nr": "number", "no.": "number",
-}
-# Words putting an instance near a target: "near" (within ``near_radius_m``), "inside" (its box
-# touches or is inside the target's), "with" (touching: ``support_gap_m``; "the table with the
-# laptop", "people with a backpack"; only after a class).
-_NEAR_WORDS: tuple[tuple[tuple[str, ...], str], ...] = (
-    (("near",), "near"), (("close", "to"), "near"), (("next", "to"), "near"), (("beside",), "near"),
-    (("around",), "near"), (("by",), "near"), (("from",), "near"), (("in",), "inside"),
-    (("inside",), "inside"), (("into",), "inside"), (("with",), "with"),
-)
-_CONFIDENCE = frozenset(["confidence", "confident", "sure", "certainty", "score"])
-_AT_LEAST = frozenset(["above", "over", "at", "least", ">", ">=", "of", "more", "than", "greater", "higher"])
-_ORDERS = {"distance": "distance", "proximity": "distance", "time": "last_seen", "recency": "last_seen",
-           "confidence": "confidence", "date": "last_seen"}
-_VERTICAL = frozenset(["wall", "door", "picture"])
-_REQUESTS = frozenset(["show", "list", "give", "tell", "display", "print", "report"])
-_ME = {"me", "here", "robot", "you", "us"}
-_FOV = {"fov", "view", "sight", "camera"}
-_SIGHTINGS = tuple(
-    ((verb, seeing), "first" if verb.startswith("start") else "last")
-    for verb in ("start", "started", "stop", "stopped") for seeing in ("seeing", "observing", "detecting")
-)
-_SEEN = ("seen", "spotted", "detected", "observed", "see", "saw", "spot")
-_AUX = ("is", "are", "was", "were", "did", "do", "does", "has", "have", "any", "can", "could")
-# Question phrases -> the answer they ask for. Read where they stand; "did/is/any" at the start
-# ask yes or no only when no other question word says otherwise ("do you know where the cup is").
-_QUESTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
-    (("how", "many"), "count"),
-    (("how", "much"), "count"),
-    (("count",), "count"),
-    (("number", "of"), "count"),
-    (("total", "number", "of"), "count"),
-    (("how", "long", "ago"), "time"),
-    (("for", "how", "long"), "duration"),
-    (("how", "long"), "duration"),
-    (("where",), "location"),
-    (("location", "of"), "location"),
-    (("position", "of"), "location"),
-    (("locate",), "location"),
-    (("location",), "location"),
-    (("position",), "location"),
-    (("find",), "location"),
-    (("how", "far"), "location"),
-    (("at", "what", "time"), "time"),
-    (("at", "which", "time"), "time"),
-    (("which", "time"), "time"),
-    (("what", "time"), "time"),
-    (("when",), "time"),
-    (("is", "there"), "yes_no"),
-    (("are", "there"), "yes_no"),
-    (("was", "there"), "yes_no"),
-    (("were", "there"), "yes_no"),
-    (("go", "to"), "goal"),
-    (("navigate", "to"), "goal"),
-    (("take", "me", "to"), "goal"),
-    (("bring", "me", "to"), "goal"),
-    (("drive", "to"), "goal"),
-    (("head", "to"), "goal"),
-    (("move", "to"), "goal"),
-    (("guide", "me", "to"), "goal"),
-    (("go", "near"), "goal"),
-    (("go", "back", "to"), "goal"),
-    (("return", "to"), "goal"),
-    (("come", "back", "to"), "goal"),
-    (("go", "towards"), "goal"),
-    (("go", "next", "to"), "goal"),
-    (("get", "me"), "goal"),
-    (("fetch",), "goal"),
-    (("send",), "goal"),
-)
-# Change words -> the change they ask about (``QuerySpec.change``).
-_CHANGES: tuple[tuple[tuple[str, ...], str], ...] = (
-    (("new",), "added"),
-    (("newly",), "added"),
-    (("added",), "added"),
-    (("appeared",), "added"),
-    (("appear",), "added"),
-    (("showed", "up"), "added"),
-    (("show", "up"), "added"),
-    (("turn", "up"), "added"),
-    (("turned", "up"), "added"),
-    (("gone",), "removed"),
-    (("missing",), "removed"),
-    (("removed",), "removed"),
-    (("disappeared",), "removed"),
-    (("disappear",), "removed"),
-    (("vanished",), "removed"),
-    (("taken", "away"), "removed"),
-    (("no", "longer", "there"), "removed"),
-    (("changed",), "any"),
-    (("change",), "any"),
-    (("changes",), "any"),
-    (("different",), "any"),
-    (("moved",), "moved"),
-    (("move",), "moved"),
-    (("shifted",), "moved"),
-    (("movement",), "moved"),
-    (("movements",), "moved"),
-    (("relocated",), "moved"),
-)
-# Passing a place: the verb says which sighting near it ("first" for enter, "last" otherwise).
-_PASS_VERBS: tuple[tuple[tuple[str, ...], str], ...] = (
-    (("walked", "past"), "last"), (("walk", "past"), "last"), (("went", "past"), "last"),
-    (("go", "past"), "last"), (("walked", "by"), "last"), (("walk", "by"), "last"),
-    (("went", "by"), "last"), (("go", "by"), "last"), (("came", "by"), "last"), (("come", "by"), "last"),
-    (("pass", "by"), "last"), (("passed", "by"), "last"), (("passing", "by"), "last"),
-    (("pass",), "last"), (("passed",), "last"), (("passing",), "last"), (("cross",), "last"),
-    (("crossed",), "last"), (("been",), "last"),
-    (("come", "into"), "first"), (("came", "into"), "first"), (("go", "into"), "first"),
-    (("went", "into"), "first"), (("enter",), "first"), (("entered",), "first"),
-    (("arrive", "at"), "first"), (("arrived", "at"), "first"), (("reach",), "first"),
-    (("reached",), "first"), (("get", "to"), "first"),
-    (("leave",), "last"), (("left",), "last"), (("exit",), "last"), (("exited",), "last"),
-)
-# The same verbs without a place: a first or last sighting ("when did the person leave").
-_ARRIVE_LEAVE: tuple[tuple[tuple[str, ...], str], ...] = (
-    (("come", "in"), "first"), (("came", "in"), "first"), (("show", "up"), "first"),
-    (("showed", "up"), "first"), (("arrive",), "first"), (("arrived",), "first"),
-    (("enter",), "first"), (("entered",), "first"), (("appear",), "first"), (("appeared",), "first"),
-    (("leave",), "last"), (("left",), "last"), (("exit",), "last"), (("exited",), "last"),
-    (("go",), "last"), (("went",), "last"), (("disappear",), "last"), (("disappeared",), "last"),
-)
-
-
 @dataclass(frozen=True)
 class ParsedQuery:
     """A plain-words query as data: the answer kind, the selection and, for time answers,
@@ -208,30 +79,11 @@ class ParsedQuery:
         return out
 
 
-def tokens(text: str) -> list[str]:
-    """The words of a query, normalised: lower case, contractions opened ("where's" -> "where
-    is", "isn't" -> "is not"), "field of view" -> "fov", numbers split from units ("5min")."""
-    text = text.lower().replace("’", "'").replace("field of view", "fov").replace("in front of", "front")
-    text = re.sub(r"\bo'?clock\b", "oclock", text)
-    text = re.sub(r"n't\b", " not", text).replace("can not", "cannot")
-    text = re.sub(r"'s\b", " is", text)
-    text = re.sub(r"'re\b", " are", text)
-    text = re.sub(r"'ve\b", " have", text)
-    text = re.sub(r"'ll\b", " will", text)
-    text = re.sub(r"'d\b", " did", text)
-    text = re.sub(r"(?<=[a-z])[-/](?=[a-z])", " ", text)
-    text = re.sub(r"(\d)(m|cm|s|sec|secs|min|mins|h|hr|hrs|ft)\b", r"\1 \2", text)
-    text = re.sub(r"#", " # ", text)
-    words = re.split(r"[\s,;!?\"'()\[\]{}<>*]+", text)
-    words = [w.rstrip(".") if re.fullmatch(r"[\d.:]+", w) else w.rstrip(".:") for w in words if w.strip(".:")]
-    return [part for w in words for part in _SHORTHAND.get(w, w).split()]
-
-
 def _number(token: str) -> float | None:
     try:
         value = float(token.rstrip("%"))
     except ValueError:
-        return _NUMBERS.get(token)
+        return NUMBER_WORDS.get(token)
     return value / 100.0 if token.endswith("%") else value if math.isfinite(value) else None
 
 
@@ -280,9 +132,9 @@ class _Parser:
         """'me'/'here', 'view', or a class phrase (after optional 'the'/'a'/'my'), and the
         tokens used."""
         j = i + 1 if self.word(i) in ("the", "a", "an", "my", "your") else i
-        if self.word(j) in _ME:
+        if self.word(j) in ME_WORDS:
             return "me", j - i + 1
-        if self.word(j) in _FOV:
+        if self.word(j) in FOV_WORDS:
             return "view", j - i + 1
         found = self.class_at(j)
         return (found[0], j - i + found[1]) if found else None
@@ -290,7 +142,7 @@ class _Parser:
     # -- rules: each returns the number of tokens it read (0: not this rule) ----------------
 
     def questions(self, i: int) -> int:
-        for words, kind in _QUESTIONS:
+        for words, kind in QUESTION_PHRASES:
             if self.at(i, *words):
                 self.answer = self.answer or kind
                 return len(words)
@@ -298,10 +150,10 @@ class _Parser:
             self.implies_time = True
             self.time_of = self.time_of or self.word(i)
             return 2
-        if i == 0 and self.word(0) in _AUX:
+        if i == 0 and self.word(0) in AUX_WORDS:
             self.ask_yes_no = True
             return 1
-        if self.word(i) in _REQUESTS and not self.at(i, "show", "up"):  # "could you list ...": not yes/no
+        if self.word(i) in REQUEST_WORDS and not self.at(i, "show", "up"):  # "could you list ...": not yes/no
             self.request = True
             return 1
         if self.word(i) == "see" and not {"did", "have", "had", "last", "first"} & set(self.t[:i]):
@@ -317,12 +169,12 @@ class _Parser:
             self.window = self.window & found[0]
             return found[1]
         t = self.t
-        for words, sighting in _SIGHTINGS:  # "when did you start seeing the couch"
+        for words, sighting in SIGHTING_VERBS:  # "when did you start seeing the couch"
             if self.at(i, *words):
                 self.time_of = sighting
                 self.set("sort", f"{sighting}_seen")
                 return len(words)
-        if self.word(i) in ("last", "first") and self.word(i + 1) in _SEEN:
+        if self.word(i) in ("last", "first") and self.word(i + 1) in SEEN_WORDS:
             self.time_of = t[i]
             self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
             return 2
@@ -333,7 +185,7 @@ class _Parser:
         return 0
 
     def changes(self, i: int) -> int:
-        for words, kind in _CHANGES:
+        for words, kind in CHANGE_WORDS:
             if self.at(i, *words):
                 self.change = self.change or kind
                 return len(words)
@@ -345,7 +197,7 @@ class _Parser:
         no passing ("where did I leave my phone"), and "left" after "is" means remaining."""
         if self.word(i) == "left" and self.word(i - 1) in ("is", "are", "was", "were", "anything"):
             return 0
-        for words, sighting in _PASS_VERBS:
+        for words, sighting in PASS_VERBS:
             if not self.at(i, *words) or not self.classes:
                 continue
             k = i + len(words)
@@ -367,7 +219,7 @@ class _Parser:
             return 2
         if self.word(i - 1) in ("the", "a", "an", "nearest", "closest", "my", "main"):
             return 0  # "the nearest exit": a noun, not a verb
-        for words, sighting in _ARRIVE_LEAVE:
+        for words, sighting in ARRIVE_LEAVE_VERBS:
             if self.at(i, *words):  # "when did X leave": a time; "who came in": a change
                 self.time_of = self.time_of or sighting
                 self.arrival = "added" if sighting == "first" else "removed"
@@ -378,7 +230,7 @@ class _Parser:
         t = self.t
         j = i + 1 if self.at(i, "in") else i
         j = j + 1 if self.at(j, "the") or self.at(j, "my") else j
-        if self.word(j) in _FOV | {"front", "visible"} and (j > i or t[j] in ("visible", "front")):
+        if self.word(j) in FOV_WORDS | {"front", "visible"} and (j > i or t[j] in ("visible", "front")):
             if self.answer != "duration":  # "how long was X in view": time in view, not a filter
                 self.set("in_fov", True)
             return j - i + 1
@@ -398,13 +250,13 @@ class _Parser:
                 return 1 + to + target[1]
             return 1
         if self.at(i, "within") and (n := _number(self.word(i + 1))) is not None and t[i + 2:i + 3] and (
-            t[i + 2] in _LENGTH_UNITS
+            t[i + 2] in LENGTH_UNITS
         ):
             k = i + 3 + (1 if self.word(i + 3) in ("of", "from") else 0)
             target = self.target_at(k)
-            self.set("near", Near(target[0] if target else "me", n * _LENGTH_UNITS[t[i + 2]]))
+            self.set("near", Near(target[0] if target else "me", n * LENGTH_UNITS[t[i + 2]]))
             return k - i + (target[1] if target else 0)
-        for words, how in _NEAR_WORDS:
+        for words, how in NEAR_WORDS:
             if self.at(i, *words):
                 target = self.target_at(i + len(words))
                 if target is None or target[0] == "view" or (how != "near" and target[0] == "me"):
@@ -427,7 +279,7 @@ class _Parser:
         found = self.class_at(j + closest)
         if found is None:
             return 0
-        if found[0] in _VERTICAL:  # "pictures on the wall": touching it, not standing on it
+        if found[0] in VERTICAL_CLASSES:  # "pictures on the wall": touching it, not standing on it
             self.set("near", Near(found[0], self.cfg.support_gap_m))
         else:
             self.set("on", On(found[0], closest))
@@ -448,22 +300,22 @@ class _Parser:
         if self.at(i, "in", "motion"):
             self.set("state", "dynamic")
             return 2
-        if self.t[i] in _MOVING | _STATIC:
-            self.set("state", "dynamic" if self.t[i] in _MOVING else "static")
+        if self.t[i] in MOVING_WORDS | STATIC_WORDS:
+            self.set("state", "dynamic" if self.t[i] in MOVING_WORDS else "static")
             return 1
         return 0
 
     def confidence(self, i: int) -> int:
         """"confidence above 0.5", "more than 50% confidence", "at least 80 % sure"."""
-        k = i + (1 if self.word(i) in _CONFIDENCE else 0)
-        while self.word(k) in _AT_LEAST:
+        k = i + (1 if self.word(i) in CONFIDENCE_WORDS else 0)
+        while self.word(k) in AT_LEAST_WORDS:
             k += 1
         n = _number(self.word(k))
         if n is None:
             return 0
         k += 1
-        if self.word(i) not in _CONFIDENCE:  # the number first: the confidence word must follow
-            if self.word(k) not in _CONFIDENCE:
+        if self.word(i) not in CONFIDENCE_WORDS:  # the number first: the confidence word must follow
+            if self.word(k) not in CONFIDENCE_WORDS:
                 return 0
             k += 1
         self.set("min_confidence", n)
@@ -472,8 +324,8 @@ class _Parser:
     def order(self, i: int) -> int:
         """"sorted by distance", "by time", "most recent first": the order of the answer."""
         k = i + (1 if self.word(i) in ("sorted", "ordered", "sort", "order", "ranked") else 0)
-        if self.word(k) == "by" and self.word(k + 1) in _ORDERS:
-            self.set("sort", _ORDERS[self.word(k + 1)])
+        if self.word(k) == "by" and self.word(k + 1) in ORDER_WORDS:
+            self.set("sort", ORDER_WORDS[self.word(k + 1)])
             return k + 2 - i
         if self.at(i, "most", "recent", "first") or self.at(i, "latest", "first"):
             self.set("sort", "last_seen")
@@ -591,8 +443,9 @@ class _Parser:
 
 def keywords() -> set[str]:
     """Every word the grammar reads besides class words (for suggestions)."""
-    words = set(FILLER) | set(_LENGTH_UNITS) | _MOVING | _STATIC | _ME | _FOV | set(tokens(UNDERSTOOD))
-    for table in (_QUESTIONS, _CHANGES, _PASS_VERBS, _ARRIVE_LEAVE):
+    words = set(FILLER) | set(LENGTH_UNITS) | MOVING_WORDS | STATIC_WORDS | ME_WORDS | FOV_WORDS
+    words |= set(tokens(UNDERSTOOD))
+    for table in (QUESTION_PHRASES, CHANGE_WORDS, PASS_VERBS, ARRIVE_LEAVE_VERBS):
         for phrase, _kind in table:
             words.update(phrase)
     return words | set(TIME_UNITS_S) | {"closest", "nearest", "within", "beside", "nearby", "confidence"}
