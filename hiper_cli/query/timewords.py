@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 
 from hiper_cli.errors import QueryError
@@ -401,7 +401,3 @@ def time_window(text: str, now_s: float, *, now_window_s: float = 2.0, recent_s:
         raise QueryError(f"empty time; write e.g. {TIME_PHRASES}")
     return window
 
-
-def with_anchors_resolved(window: TimeWindow, since_s: float | None, until_s: float | None) -> TimeWindow:
-    """``window`` with its event bounds replaced by the stamps they resolved to."""
-    return replace(window, since_event=None, until_event=None) & TimeWindow(since_s, until_s)
