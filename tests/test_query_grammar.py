@@ -130,3 +130,112 @@ def test_unknown_words_are_quoted_with_a_suggestion():
         parse("cups in the kitchen")
     with pytest.raises(QueryError, match="empty query"):
         parse("   ")
+
+
+@pytest.mark.parametrize(
+    ("words", "answer", "classes"),
+    [
+        ("count the chairs", "count", ("chair",)),
+        ("number of chairs?", "count", ("chair",)),
+        ("where's the table?", "location", ("table",)),
+        ("wheres my cup", "location", ("cup",)),
+        ("last time a person was seen", "time", ("person",)),
+        ("when did the person pass the table", "time", ("person",)),
+        ("Is anyone here?", "yes_no", ("person",)),
+        ("could you show me the chairs", "list", ("chair",)),
+        ("can you count the cups for me", "count", ("cup",)),
+        ("any ppl near me?", "yes_no", ("person",)),
+    ],
+)
+def test_common_phrasings(words, answer, classes):
+    parsed = parse(words, now_s=NOW)
+    assert (parsed.answer, parsed.spec.classes) == (answer, classes)
+
+
+def test_change_words_and_their_default_window():
+    moved = parse("what moved in the last 5 seconds", now_s=NOW).spec
+    assert (moved.change, moved.since_s) == ("moved", NOW - 5)
+    recent = parse("what moved recently", now_s=NOW).spec
+    assert (recent.change, recent.since_s) == ("moved", NOW - 600)
+    new = parse("anything new", now_s=NOW).spec  # no time: the recent window
+    assert (new.change, new.layer, new.since_s) == ("added", "foreground", NOW - 600)
+    assert parse("what is missing", now_s=NOW).spec.change == "removed"
+    # asked "when", an appearance is a first sighting, not a filter
+    when = parse("when did the cup appear", now_s=NOW)
+    assert (when.answer, when.time_of, when.spec.change) == ("time", "first", None)
+
+
+def test_passing_entering_and_leaving():
+    passed = parse("when did the person pass the table").spec
+    assert passed.passed_here and passed.near == Near("table", 1.0)
+    entered = parse("when did the person reach the couch")
+    assert entered.spec.passed_here and entered.time_of == "first"
+    view = parse("when did the person leave the view")
+    assert (view.answer, view.time_of, view.spec.passed_here) == ("time", "last", False)
+    assert parse("when did someone come in").time_of == "first"
+    assert parse("when was somebody near the couch").spec.passed_here  # a time near X: a pass
+
+
+def test_event_bounds_are_kept_for_the_answer():
+    parsed = parse("cups seen after the person left", now_s=NOW)
+    assert (parsed.since_event.class_name, parsed.since_event.sighting) == ("person", "last")
+    arrived = parse("what was on the table before someone arrived", now_s=NOW)
+    assert (arrived.until_event.class_name, arrived.until_event.sighting) == ("person", "first")
+    assert arrived.spec.on == On("table", False)
+
+
+@pytest.mark.parametrize(
+    ("words", "suggestion"),
+    [
+        ("count chiars", "count chairs"),
+        ("hwo many chairs", "how many chairs"),
+        ("whats on teh table", "what is on the table"),
+        ("wher is the couch", "where is the couch"),
+        ("show me the refridgerator", "show me the refrigerator"),
+        ("cups in the kitchen", "cups"),
+        ("is the door open", "is the door"),
+    ],
+)
+def test_suggestions_are_near_relative_to_the_word_length(words, suggestion):
+    with pytest.raises(QueryError, match=f'did you mean "{suggestion}"'):
+        parse(words)
+
+
+def test_no_far_fetched_suggestion_and_no_class_for_a_place():
+    from hiper_cli.query.suggest import nearest_word
+
+    assert nearest_word("count") is None or nearest_word("count") != "computer"
+    assert nearest_word("kitchen") is None
+    assert nearest_word("open") is None  # not "oven": a short word's typo keeps its letters
+    assert nearest_word("chiars") == "chairs"
+    with pytest.raises(QueryError, match=r'"kitchen": hiper keeps no named places') as err:
+        parse("anything new in the kitchen")
+    assert "kite" not in str(err.value) and 'did you mean "anything new"' in str(err.value)
+    with pytest.raises(QueryError, match=r'cannot read "forklift".*did you mean "where is the chair"'):
+        parse("where is the forklift")
+
+
+def test_random_word_salad_never_crashes_and_every_suggestion_parses():
+    """Seeded word salad from the grammar's own words, numbers, clock times and places: each
+    query parses or is refused with a QueryError; a suggested question parses."""
+    import random
+    import re
+
+    from hiper_cli.query.grammar import keywords
+    from hiper_cli.query.vocabulary import class_words
+
+    rng = random.Random(7)
+    words = [
+        *sorted(keywords() | set(class_words())),
+        *("10:00", "25:00", "3pm", "5", "0.5", "2.5m", "kitchen", "xyz", "?", "'s", "-", "1e309", "-3"),
+    ]
+    for _ in range(800):
+        text = " ".join(rng.choice(words) for _ in range(rng.randint(1, 8)))
+        try:
+            parse(text, now_s=NOW)
+        except QueryError as err:
+            found = re.search(r'did you mean "([^"]*)"\?', str(err))
+            if found:
+                parse(found.group(1), now_s=NOW)
+    with pytest.raises(QueryError, match="leave no time between them"):
+        parse("cups after 11:00 before 10:00", now_s=NOW)

@@ -1,5 +1,6 @@
 """Times as an agent writes them, resolved by the server so an agent never does date
-arithmetic: a stamp (s), "now", "10 minutes ago", "last 10 minutes", "10:30", or ISO 8601."""
+arithmetic: a stamp (s), "now", "10 minutes ago", "last 10 minutes", "10:30", ISO 8601, or
+any time phrase of the query grammar ("today", "this morning", "since 9am": its start)."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ __all__ = ["TIME_HELP", "resolve_span_s", "resolve_time"]
 
 TIME_HELP = (
     "a stamp in seconds, 'now', a relative time ('10 minutes ago', 'last 10 minutes', '2 h'), "
-    "a time of day 'HH:MM' (UTC) or an ISO 8601 date-time; the server resolves it against the "
-    "knowledge base's now"
+    "a time of day 'HH:MM' (UTC), an ISO 8601 date-time or a phrase such as 'today' or 'this "
+    "morning' (its start); the server resolves it against the knowledge base's now"
 )
 _UNITS = {
     "s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0,
@@ -50,9 +51,16 @@ def resolve_time(value: Any, now_s: float) -> float:
         text.endswith(" ago")
     ):
         return now_s - resolve_span_s(text)
-    from hiper_cli.query.grammar import parse_time
+    from hiper_cli.query.timewords import clock_stamp, time_window
 
-    stamp = parse_time(text, now_s)
-    if stamp is None:
+    stamp = clock_stamp(text, now_s)
+    if stamp is not None:
+        return stamp
+    try:
+        window = time_window(text, now_s)
+    except QueryError:
+        window = None
+    bound = None if window is None else window.since_s if window.since_s is not None else window.until_s
+    if bound is None:
         raise QueryError(f"time {value!r}: expected {TIME_HELP}")
-    return stamp
+    return bound

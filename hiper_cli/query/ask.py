@@ -3,10 +3,13 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
+from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query import engine
 from hiper_cli.query import geometry as geo
@@ -14,10 +17,23 @@ from hiper_cli.query.engine import Context, make_context
 from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
 from hiper_cli.query.results import Answer, AnswerKind, GoalPose, Hit, TimeValue, ago_text
 from hiper_cli.query.spec import QueryConfig
-from hiper_cli.query.verbs import passed_here, when
+from hiper_cli.query.timewords import TimeAnchor, TimeWindow
+from hiper_cli.query.verbs import passes, when
 from hiper_cli.query.vocabulary import plural
 
-__all__ = ["answer", "ask", "goal_for"]
+__all__ = ["answer", "ask", "goal_for", "resolve_events"]
+
+
+def _changed(n: int, names: str, change: str) -> str:
+    """A change answer's words: "2 new chairs", "nothing moved", "1 cup gone"."""
+    if n == 0 and names in ("instances", "objects"):
+        return {"added": "nothing new"}.get(change, f"nothing {_CHANGED[change]}")
+    if change == "added":
+        return f"{n or 'no'} new {names}"
+    return f"{n or 'no'} {names} {_CHANGED[change]}"
+
+
+_CHANGED = {"added": "new", "removed": "gone", "moved": "moved", "any": "changed"}
 
 
 def goal_for(ctx: Context, hit: Hit) -> GoalPose:
@@ -37,6 +53,33 @@ def _describe(hit: Hit, now_s: float) -> str:
     )
 
 
+def _passed(
+    ctx: Context, parsed: ParsedQuery, make: Callable[..., Answer], what: Callable[[int], str]
+) -> Answer:
+    """The answer to "when did X pass|enter|leave Y", "did anyone pass here", "how many
+    people passed by": from the observations near the target (``verbs.passes``)."""
+    spec, kind = parsed.spec, parsed.answer
+    r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
+    place = "here" if spec.near is None or spec.near.target == "me" else f"the {spec.near.target}"
+    found = passes(ctx, spec, parsed.time_of)
+    if kind == "count":
+        return make(count=len(found), text=f"{len(found)} {what(len(found))} within {r:g} m of {place}")
+    if not found:
+        return make(value=False if kind == "yes_no" else None, count=0 if kind == "list" else None,
+                    text=f"no {what(0)} observed within {r:g} m of {place}")
+    uuids = [uuid for _stamp, uuid in found][: ctx.config.max_hits]
+    hits = engine.hits(ctx, engine.candidates_of(ctx, uuids))
+    stamp, hit = found[0][0], hits[0]
+    verb = "first came" if parsed.time_of == "first" else "last passed"
+    return make(
+        hits=tuple(hits) if kind == "list" else (hit,),
+        count=len(found) if kind == "list" else None,
+        time=TimeValue(stamp, ctx.now_s),
+        value=True if kind == "yes_no" else None,
+        text=f"{hit.class_name} {verb} within {r:g} m of {place} {ago_text(stamp, ctx.now_s)}",
+    )
+
+
 def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
     """The answer to a parsed query in a context (reference pose, now)."""
     spec = parsed.spec
@@ -48,18 +91,7 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         return ", ".join(c if n == 1 else plural(c) for c in names)
 
     if spec.passed_here:
-        found = passed_here(ctx, spec)
-        r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
-        if found is None:
-            return make(value=False if kind == "yes_no" else None,
-                        text=f"no {what(0)} observed within {r:g} m of here")
-        stamp, hit = found
-        return make(
-            hits=(hit,),
-            time=TimeValue(stamp, ctx.now_s),
-            value=True if kind == "yes_no" else None,
-            text=f"{hit.class_name} last passed within {r:g} m of here {ago_text(stamp, ctx.now_s)}",
-        )
+        return _passed(ctx, parsed, make, what)
     cands = engine.select(ctx, spec)
     if kind == "count":
         return make(count=len(cands), text=f"{len(cands)} {what(len(cands))}")
@@ -72,6 +104,11 @@ def answer(ctx: Context, parsed: ParsedQuery) -> Answer:
         )
     total = len(cands)
     found_hits = engine.hits(ctx, cands.take(np.arange(min(total, ctx.config.max_hits))))
+    if spec.change is not None and (kind == "list" or not found_hits):
+        text = _changed(total, what(total), spec.change)
+        text += (": " + "; ".join(_describe(h, ctx.now_s) for h in found_hits[:3])) if found_hits else ""
+        text += f"; +{total - 3} more" if total > 3 else ""
+        return make(hits=tuple(found_hits), count=total, text=text)
     if not found_hits:
         return make(count=0, text=f"no {what(0)} found")
     first = found_hits[0]
@@ -116,4 +153,37 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
-    return answer(ctx, with_limit(parse(text, now_s=ctx.now_s, config=ctx.config), limit))
+    envs = kb.environments()
+    whole = [envs[0].name] if len(envs) == 1 else []  # "in the house": the KB's one place
+    parsed = with_limit(parse(text, now_s=ctx.now_s, config=ctx.config, whole_place=whole), limit)
+    return answer(ctx, resolve_events(ctx, parsed))
+
+
+def _event_stamp(ctx: Context, anchor: TimeAnchor) -> float:
+    """The stamp of an event: the earliest first sighting or the latest last sighting (up to
+    now) of the anchor's class."""
+    idx = ctx.index
+    rows = np.flatnonzero((idx.classes == anchor.class_name) & (idx.first_s <= ctx.now_s))
+    if len(rows) == 0:
+        raise QueryError(
+            f'no {anchor.class_name} was seen by {ctx.now_s:g} s, so "{anchor.words()}" names no time; '
+            "ask without it, or with a clock time such as 'since 10:00'"
+        )
+    if anchor.sighting == "first":
+        return float(idx.first_s[rows].min())
+    return float(np.minimum(idx.last_s[rows], ctx.now_s).max())
+
+
+def resolve_events(ctx: Context, parsed: ParsedQuery) -> ParsedQuery:
+    """``parsed`` with its event bounds ("after the person left") turned into stamps."""
+    if parsed.since_event is None and parsed.until_event is None:
+        return parsed
+    window = TimeWindow(parsed.spec.since_s, parsed.spec.until_s)
+    if parsed.since_event is not None:
+        window = window & TimeWindow(_event_stamp(ctx, parsed.since_event), None)
+    if parsed.until_event is not None:
+        window = window & TimeWindow(None, _event_stamp(ctx, parsed.until_event))
+    if window.since_s is not None and window.until_s is not None and window.since_s > window.until_s:
+        raise QueryError(f'"{parsed.text}": the time window starts after it ends; nothing can be in it')
+    spec = dataclasses.replace(parsed.spec, since_s=window.since_s, until_s=window.until_s)
+    return dataclasses.replace(parsed, spec=spec)

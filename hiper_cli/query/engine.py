@@ -124,11 +124,7 @@ def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
     window, confidence). An instance whose place a later session saw empty (``vacated_s``)
     was there until then: a window starting (or, without a start, ending) later leaves it out."""
     idx = ctx.index
-    until = spec.until_s if spec.until_s is not None else ctx.now_s
-    mask = (idx.first_s <= until) & (idx.confidence >= spec.min_confidence)
-    mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
-    if spec.since_s is not None:
-        mask &= idx.last_s >= spec.since_s
+    mask = _window_mask(ctx, spec) & (idx.confidence >= spec.min_confidence)
     if spec.classes:
         mask &= np.isin(idx.classes, list(spec.classes))
     if spec.layer is not None:
@@ -136,6 +132,22 @@ def prefilter(ctx: Context, spec: QuerySpec) -> Candidates:
     if spec.state is not None:
         mask &= idx.states == spec.state
     return Candidates(idx, np.flatnonzero(mask))
+
+
+def _window_mask(ctx: Context, spec: QuerySpec) -> np.ndarray:
+    """Seen at some time in [since, until] and not vacated by then; for a change, the change
+    in the window: first seen in it ("added"), vacated in it ("removed"), moving while seen
+    in it ("moved"), or any of these ("any")."""
+    idx = ctx.index
+    until = spec.until_s if spec.until_s is not None else ctx.now_s
+    since = spec.since_s if spec.since_s is not None else -np.inf
+    removed = (idx.vacated_s >= since) & (idx.vacated_s <= until) & (idx.first_s <= until)
+    if spec.change == "removed":
+        return removed
+    mask = (idx.first_s <= until) & (idx.last_s >= since)
+    mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
+    added, moved = mask & (idx.first_s >= since), mask & (idx.states == "dynamic")
+    return {"added": added, "moved": moved, "any": added | moved | removed}.get(spec.change or "", mask)
 
 
 def details(ctx: Context, uuid: str) -> dict[str, Any] | None:
@@ -198,7 +210,10 @@ def select(ctx: Context, spec: QuerySpec) -> Candidates:
     idx = ctx.index
     # Ties (two cups last seen in one frame) go to the nearer, then the later seen, never to
     # the index's order (uuids): the same question gets the same answer in every run.
-    distance_m = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
+    if spec.rank_from is not None:
+        cands, distance_m = _distances_from(ctx, cands, spec.rank_from)
+    else:
+        distance_m = geo.footprint_distance_m(ctx.xy, cands.centers, cands.extents)
     if spec.sort in (None, "distance"):
         order = np.lexsort((-cands.last_s, distance_m))
     elif spec.sort == "last_seen":
@@ -211,6 +226,19 @@ def select(ctx: Context, spec: QuerySpec) -> Candidates:
     if spec.limit is not None:
         cands = cands.take(np.arange(min(spec.limit, len(cands))))
     return cands
+
+
+def _distances_from(ctx: Context, cands: Candidates, class_name: str) -> tuple[Candidates, np.ndarray]:
+    """The candidates other than the instances of ``class_name``, and each one's horizontal
+    gap (m) to the nearest of those instances (inf when there is none)."""
+    targets = supports(ctx, class_name)
+    cands = cands.take(~np.isin(cands.rows, targets.rows))
+    gap_m = np.full(len(cands), np.inf)
+    for k in range(len(targets)):
+        lo, hi = cands.centers[:, :2], targets.centers[k, :2]
+        gap = np.maximum(np.abs(lo - hi) - (cands.extents[:, :2] + targets.extents[k, :2]) / 2.0, 0.0)
+        gap_m = np.minimum(gap_m, np.linalg.norm(gap, axis=1))
+    return cands, gap_m
 
 
 def supports_of(ctx: Context, cands: Candidates) -> list[Support | None]:

@@ -1,233 +1,120 @@
-"""Plain-words queries ("cups in FOV", "how many chairs", "when did a person last pass here")
-parsed into a typed ``ParsedQuery`` by a small deterministic grammar: no language model.
+"""Plain-words queries ("cups in FOV", "count the chairs", "what moved in the last 5 seconds",
+"when did the person pass the table") parsed into a typed ``ParsedQuery`` by a small
+deterministic grammar: no language model.
 
-Tokens are read left to right; each position tries the phrase rules below (questions, time,
-space, state, confidence, a number, a class phrase of up to three words); filler words are
-skipped. A word no rule reads is an error that quotes it, lists what is understood and
-suggests the nearest query that parses.
+Words are normalised (case, contractions, punctuation, "5min"), then read left to right; at
+each position the phrase rules below try in turn: question words (what answer is wanted),
+time phrases (``timewords.py``), change words (new, gone, moved), passing (pass, enter, leave
+a place), space, state, confidence, a number, a class phrase of up to three words. Filler
+words are skipped. A word no rule reads makes the query a refusal (``suggest.py``) that quotes
+it and offers a question that parses.
 """
 
 from __future__ import annotations
 
-import difflib
 import math
-import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from datetime import UTC, datetime, timedelta
 from typing import Any
 
 from hiper_cli.errors import QueryError
+from hiper_cli.query.phrases import (
+    ARRIVE_LEAVE_VERBS,
+    AT_LEAST_WORDS,
+    AUX_WORDS,
+    CHANGE_WORDS,
+    CONFIDENCE_WORDS,
+    FILLER,
+    FOV_WORDS,
+    LENGTH_UNITS,
+    ME_WORDS,
+    MOVING_WORDS,
+    NEAR_WORDS,
+    NUMBER_WORDS,
+    ORDER_WORDS,
+    PASS_VERBS,
+    QUESTION_PHRASES,
+    REQUEST_WORDS,
+    SEEN_WORDS,
+    SIGHTING_VERBS,
+    STATIC_WORDS,
+    VERTICAL_CLASSES,
+    tokens,
+)
 from hiper_cli.query.results import ANSWER_KINDS
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
-from hiper_cli.query.vocabulary import ANY_FOREGROUND, class_words, resolve_class, singular
+from hiper_cli.query.suggest import refusal
+from hiper_cli.query.timewords import TIME_UNITS_S, TimeAnchor, TimeWindow, clock_stamp, read_time_phrase
+from hiper_cli.query.vocabulary import ANY_FOREGROUND, PLACE_WORDS, plural, resolve_class, singular
 
-__all__ = ["UNDERSTOOD", "ParsedQuery", "parse", "parse_time", "with_limit"]
+__all__ = ["FILLER", "UNDERSTOOD", "ParsedQuery", "keywords", "parse", "parse_time", "tokens", "with_limit"]
 
 UNDERSTOOD = (
     "classes (cup, chair, person, table, bottle, ... singular or plural; synonyms such as mug, sofa, "
-    "people; 'objects' for all); space: in FOV, closest/nearest, within R m of X|me, near X, "
-    "on the (closest) X, pass here; time: now, last N seconds|minutes|hours, since HH:MM, "
-    "between HH:MM and HH:MM, before/after HH:MM, today, yesterday, last seen, first seen; "
-    "state: moving, static; questions: how many, where, when, how long, is there, go to"
+    "fridge, desk, people, someone; 'objects'/'anything' for all); space: in FOV, closest/nearest, "
+    "within R m of X|me, near X, on the (closest) X, here; time: now, recently, in the last N "
+    "seconds|minutes|hours, N minutes ago, since|before|after HH:MM or an event ('after the person "
+    "left'), between A and B, today, yesterday, last seen, first seen; change: new, gone, moved; "
+    "passing: pass|enter|leave X|here; state: moving, static; questions: how many/count/number of, "
+    "where, when/last time, how long, is there/any/did, go to"
 )
-FILLER = frozenset(
-    [
-        "the",
-        "a",
-        "an",
-        "of",
-        "is",
-        "are",
-        "was",
-        "were",
-        "be",
-        "been",
-        "did",
-        "do",
-        "does",
-        "there",
-        "that",
-        "which",
-        "what",
-        "who",
-        "show",
-        "list",
-        "find",
-        "me",
-        "give",
-        "tell",
-        "all",
-        "any",
-        "some",
-        "please",
-        "currently",
-        "in",
-        "at",
-        "with",
-        "and",
-        "by",
-    ]
-)
-_TIME_UNITS = {
-    "s": 1,
-    "sec": 1,
-    "secs": 1,
-    "second": 1,
-    "seconds": 1,
-    "min": 60,
-    "mins": 60,
-    "minute": 60,
-    "minutes": 60,
-    "h": 3600,
-    "hr": 3600,
-    "hrs": 3600,
-    "hour": 3600,
-    "hours": 3600,
-    "d": 86400,
-    "day": 86400,
-    "days": 86400,
-}
-_LENGTH_UNITS = {
-    "m": 1.0,
-    "meter": 1.0,
-    "meters": 1.0,
-    "metre": 1.0,
-    "metres": 1.0,
-    "cm": 0.01,
-    "ft": 0.3048,
-    "feet": 0.3048,
-    "foot": 0.3048,
-}
-_MOVING = {"moving", "walking", "dynamic", "running", "driving"}
-_STATIC = {"static", "still", "stationary", "parked", "standing"}
-_ME = {"me", "here", "robot", "you", "us"}
-_FOV = {"fov", "view", "sight"}
-_KEYWORDS = (
-    set(_TIME_UNITS)
-    | set(_LENGTH_UNITS)
-    | _MOVING
-    | _STATIC
-    | _ME
-    | _FOV
-    | set(FILLER)
-    | set(
-        [
-            "how",
-            "many",
-            "long",
-            "where",
-            "when",
-            "go",
-            "to",
-            "navigate",
-            "take",
-            "closest",
-            "nearest",
-            "within",
-            "near",
-            "next",
-            "beside",
-            "around",
-            "on",
-            "first",
-            "last",
-            "past",
-            "seen",
-            "since",
-            "between",
-            "before",
-            "after",
-            "today",
-            "yesterday",
-            "now",
-            "visible",
-            "front",
-            "pass",
-            "passed",
-            "confidence",
-            "above",
-            "over",
-            "least",
-            "field",
-        ]
-    )
-)
-
-
 @dataclass(frozen=True)
 class ParsedQuery:
     """A plain-words query as data: the answer kind, the selection and, for time answers,
-    which sighting ("last" or "first")."""
+    which sighting ("last" or "first"). ``since_event``/``until_event``: window bounds set by
+    an event ("after the person left"), resolved against the knowledge base by the answer."""
 
     text: str
     answer: str
     spec: QuerySpec
     time_of: str = "last"
+    since_event: TimeAnchor | None = None
+    until_event: TimeAnchor | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"answer": self.answer, "time_of": self.time_of, "spec": self.spec.to_dict()}
-
-
-def _tokens(text: str) -> list[str]:
-    text = text.lower().replace("field of view", "fov").replace("in front of", "front")
-    text = re.sub(r"(\d)(m|cm|s|min|h|ft)\b", r"\1 \2", text)
-    return [t for t in re.split(r"[\s,;!?\"']+", text) if t]
+        out: dict[str, Any] = {"answer": self.answer, "time_of": self.time_of, "spec": self.spec.to_dict()}
+        for key, anchor in (("since_event", self.since_event), ("until_event", self.until_event)):
+            if anchor is not None:
+                out[key] = {"class": anchor.class_name, "sighting": anchor.sighting}
+        return out
 
 
 def _number(token: str) -> float | None:
     try:
         value = float(token.rstrip("%"))
     except ValueError:
-        return {"one": 1.0, "two": 2.0, "three": 3.0, "five": 5.0, "ten": 10.0}.get(token)
+        return NUMBER_WORDS.get(token)
     return value / 100.0 if token.endswith("%") else value if math.isfinite(value) else None
 
 
-def _clock(token: str, now_s: float) -> float | None:
-    """'10:00', '9:30:15', '3pm', '10am' on the UTC day of ``now`` (the day before when that
-    would be after now), or an ISO date-time; as a stamp (s)."""
-    match = re.fullmatch(r"(\d{1,2})(?::(\d{2}))?(?::(\d{2}))?(am|pm)?", token)
-    if match and (match.group(2) or match.group(4)):
-        hour, minute, second = int(match.group(1)), int(match.group(2) or 0), int(match.group(3) or 0)
-        if match.group(4) == "pm" and hour < 12:
-            hour += 12
-        if match.group(4) == "am" and hour == 12:
-            hour = 0
-        if hour > 23 or minute > 59 or second > 59:
-            return None
-        day = datetime.fromtimestamp(now_s, UTC).replace(hour=0, minute=0, second=0, microsecond=0)
-        stamp = (day + timedelta(hours=hour, minutes=minute, seconds=second)).timestamp()
-        return stamp - 86400 if stamp > now_s else stamp
-    try:
-        when = datetime.fromisoformat(token.upper())
-    except ValueError:
-        return None
-    return (when if when.tzinfo else when.replace(tzinfo=UTC)).timestamp()
-
-
-def _not_a_time(token: str) -> None:
-    """Raise for a token written like a clock time that is none ("25:00", "10:75"); any other
-    word after "since"/"before" is left to the rest of the grammar."""
-    if re.fullmatch(r"\d{1,2}(:\d{1,2}){1,2}(am|pm)?|\d{1,2}(am|pm)", token):
-        raise QueryError(f'"{token}" is not a time of day; write HH:MM or HH:MM:SS from 00:00 to 23:59:59, '
-                         'or 3pm, or an ISO date-time such as 2026-12-07T10:00')
-
-
 class _Parser:
-    def __init__(self, text: str, now_s: float, config: QueryConfig) -> None:
-        self.text, self.now_s, self.cfg = text, now_s, config
-        self.t = _tokens(text)
+    def __init__(
+        self, text: str, now_s: float, config: QueryConfig, whole_place: frozenset[str] = frozenset()
+    ) -> None:
+        self.text, self.now_s, self.cfg, self.whole_place = text, now_s, config, whole_place
+        self.t = tokens(text)
         self.answer: str | None = None
-        self.time_of = "last"
+        self.ask_yes_no = False  # "is the cup on the table": yes/no unless a question word says otherwise
+        self.request = False
+        self.time_of: str | None = None
+        self.window = TimeWindow()
         self.fields: dict[str, Any] = {}
         self.classes: list[str] = []
         self.plural = False
+        self.passed = False
+        self.implies_time = False  # "pass the table", "leave", "last time": a time is asked for
+        self.change: str | None = None
+        self.arrival: str | None = None  # "came in", "left": a change unless a time or place is asked
         self.unknown: list[str] = []
+        self.places: list[str] = []
 
     # -- helpers ---------------------------------------------------------------------------
 
+    def word(self, i: int) -> str:
+        return self.t[i] if 0 <= i < len(self.t) else ""
+
     def at(self, i: int, *words: str) -> bool:
-        return all(i + k < len(self.t) and self.t[i + k] == w for k, w in enumerate(words))
+        return all(self.word(i + k) == w for k, w in enumerate(words))
 
     def set(self, key: str, value: Any) -> None:
         self.fields[key] = value
@@ -242,143 +129,168 @@ class _Parser:
         return None
 
     def target_at(self, i: int) -> tuple[str, int] | None:
-        """'me'/'here' or a class phrase (after optional 'the'/'a'), and the tokens used."""
-        j = i + 1 if self.at(i, "the") or self.at(i, "a") or self.at(i, "an") else i
-        if j < len(self.t) and self.t[j] in _ME:
+        """'me'/'here', 'view', or a class phrase (after optional 'the'/'a'/'my'), and the
+        tokens used."""
+        j = i + 1 if self.word(i) in ("the", "a", "an", "my", "your") else i
+        if self.word(j) in ME_WORDS:
             return "me", j - i + 1
+        if self.word(j) in FOV_WORDS:
+            return "view", j - i + 1
         found = self.class_at(j)
         return (found[0], j - i + found[1]) if found else None
 
     # -- rules: each returns the number of tokens it read (0: not this rule) ----------------
 
     def questions(self, i: int) -> int:
-        for words, kind in (
-            (("how", "many"), "count"),
-            (("how", "long"), "duration"),
-            (("where",), "location"),
-            (("when",), "time"),
-            (("is", "there"), "yes_no"),
-            (("are", "there"), "yes_no"),
-            (("was", "there"), "yes_no"),
-            (("were", "there"), "yes_no"),
-            (("go", "to"), "goal"),
-            (("navigate", "to"), "goal"),
-            (("take", "me", "to"), "goal"),
-            (("drive", "to"), "goal"),
-        ):
+        for words, kind in QUESTION_PHRASES:
             if self.at(i, *words):
                 self.answer = self.answer or kind
                 return len(words)
-        if i == 0 and self.t[0] in ("is", "are", "any", "was", "were"):
-            self.answer = "yes_no"
+        if self.at(i, "last", "time") or self.at(i, "first", "time"):
+            self.implies_time = True
+            self.time_of = self.time_of or self.word(i)
+            return 2
+        if i == 0 and self.word(0) in AUX_WORDS:
+            self.ask_yes_no = True
+            return 1
+        if self.word(i) in REQUEST_WORDS and not self.at(i, "show", "up"):  # "could you list ...": not yes/no
+            self.request = True
+            return 1
+        if self.word(i) == "see" and not {"did", "have", "had", "last", "first"} & set(self.t[:i]):
+            self.set("in_fov", True)  # "do you see", "what can you see": in view now
+            self.ask_yes_no = self.ask_yes_no or self.t[:i] == ["you"]  # "you see any cup?"
             return 1
         return 0
 
     def times(self, i: int) -> int:
+        found = read_time_phrase(self.t, i, self.now_s, now_window_s=self.cfg.now_window_s,
+                                 recent_s=self.cfg.recent_s)
+        if found is not None:
+            self.window = self.window & found[0]
+            return found[1]
         t = self.t
-        if self.at(i, "last", "seen") or self.at(i, "first", "seen"):
+        for words, sighting in SIGHTING_VERBS:  # "when did you start seeing the couch"
+            if self.at(i, *words):
+                self.time_of = sighting
+                self.set("sort", f"{sighting}_seen")
+                return len(words)
+        if self.word(i) in ("last", "first") and self.word(i + 1) in SEEN_WORDS:
             self.time_of = t[i]
             self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
             return 2
-        if i < len(t) and t[i] in ("last", "past"):
-            n = _number(t[i + 1]) if i + 1 < len(t) else None
-            k = i + (2 if n is not None else 1)
-            if k < len(t) and t[k] in _TIME_UNITS:
-                self.set("since_s", self.now_s - (n if n is not None else 1.0) * _TIME_UNITS[t[k]])
-                return k - i + 1
-            if t[i] == "last":  # "when did a person last pass here"
-                self.set("sort", "last_seen")
-                return 1
-            return 0
-        if i < len(t) and t[i] in ("since", "after", "before") and i + 1 < len(t):
-            stamp = _clock(t[i + 1], self.now_s)
-            if stamp is None:
-                _not_a_time(t[i + 1])
-                return 0
-            self.set("until_s" if t[i] == "before" else "since_s", stamp)
-            return 2
-        if self.at(i, "between") and i + 3 < len(t) and t[i + 2] in ("and", "to"):
-            a, b = _clock(t[i + 1], self.now_s), _clock(t[i + 3], self.now_s)
-            if a is None or b is None:
-                _not_a_time(t[i + 1] if a is None else t[i + 3])
-                return 0
-            self.set("since_s", min(a, b))
-            self.set("until_s", max(a, b))
-            return 4
-        if i < len(t) and t[i] in ("today", "yesterday"):
-            day = datetime.fromtimestamp(self.now_s, UTC).replace(hour=0, minute=0, second=0, microsecond=0)
-            start = day.timestamp() - (86400 if t[i] == "yesterday" else 0)
-            self.set("since_s", start)
-            self.set("until_s", min(start + 86400, self.now_s))
+        if self.word(i) in ("last", "first"):  # "when did a person last pass here", "first see"
+            self.set("sort", "last_seen" if t[i] == "last" else "first_seen")
+            self.time_of = self.time_of or t[i]
             return 1
-        if (i < len(t) and t[i] in ("now",)) or self.at(i, "right", "now"):
-            self.set("since_s", self.now_s - self.cfg.now_window_s)
-            return 2 if t[i] == "right" else 1
+        return 0
+
+    def changes(self, i: int) -> int:
+        for words, kind in CHANGE_WORDS:
+            if self.at(i, *words):
+                self.change = self.change or kind
+                return len(words)
+        return 0
+
+    def passes(self, i: int) -> int:
+        """"pass|enter|leave X|here|view", and without a place "come in", "leave". The mover
+        is named before the verb ("when did the person pass the table"); without one it is
+        no passing ("where did I leave my phone"), and "left" after "is" means remaining."""
+        if self.word(i) == "left" and self.word(i - 1) in ("is", "are", "was", "were", "anything"):
+            return 0
+        for words, sighting in PASS_VERBS:
+            if not self.at(i, *words) or not self.classes:
+                continue
+            k = i + len(words)
+            k += 1 if self.word(k) in ("by", "past", "near", "through", "into", "at") else 0
+            target = self.target_at(k)
+            if target is None:
+                continue
+            self.implies_time = True
+            if target[0] == "view":  # entering or leaving the view: the first or last sighting
+                self.time_of = self.time_of or sighting
+            else:
+                self.passed = True
+                self.time_of = self.time_of or sighting
+                self.set("near", Near(target[0], self.cfg.pass_radius_m))
+            return k - i + target[1]
+        if self.at(i, "pass", "by") or self.at(i, "passed", "by"):  # by here
+            self.passed = self.implies_time = True
+            self.set("near", Near("me", self.cfg.pass_radius_m))
+            return 2
+        if self.word(i - 1) in ("the", "a", "an", "nearest", "closest", "my", "main"):
+            return 0  # "the nearest exit": a noun, not a verb
+        for words, sighting in ARRIVE_LEAVE_VERBS:
+            if self.at(i, *words):  # "when did X leave": a time; "who came in": a change
+                self.time_of = self.time_of or sighting
+                self.arrival = "added" if sighting == "first" else "removed"
+                return len(words)
         return 0
 
     def space(self, i: int) -> int:
         t = self.t
         j = i + 1 if self.at(i, "in") else i
-        j = j + 1 if self.at(j, "the") else j
-        if j < len(t) and t[j] in _FOV | {"front", "visible"} and (j > i or t[j] in ("visible", "front")):
+        j = j + 1 if self.at(j, "the") or self.at(j, "my") else j
+        if self.word(j) in FOV_WORDS | {"front", "visible"} and (j > i or t[j] in ("visible", "front")):
             if self.answer != "duration":  # "how long was X in view": time in view, not a filter
                 self.set("in_fov", True)
             return j - i + 1
-        n = _number(t[i]) if i < len(t) else None
-        if n is not None and i + 1 < len(t) and t[i + 1] in ("closest", "nearest"):
+        n = _number(self.word(i))
+        if n is not None and self.word(i + 1) in ("closest", "nearest"):
             self.set("sort", "distance")
             self.set("limit", max(1, int(n)))
             return 2
-        if i < len(t) and t[i] in ("closest", "nearest"):
+        if self.word(i) in ("closest", "nearest"):
             self.set("sort", "distance")
             self.fields.setdefault("limit", 1)
+            # "the chair closest to the door", "the cup nearest the sink": ranked from the door
+            to = 1 if self.word(i + 1) in ("to", "from") else 0
+            target = self.target_at(i + 1 + to) if to or self.classes else None
+            if target is not None and target[0] not in ("me", "view"):
+                self.set("rank_from", target[0])
+                return 1 + to + target[1]
             return 1
-        if (
-            self.at(i, "within")
-            and i + 2 < len(t)
-            and (n := _number(t[i + 1])) is not None
-            and t[i + 2] in _LENGTH_UNITS
+        if self.at(i, "within") and (n := _number(self.word(i + 1))) is not None and t[i + 2:i + 3] and (
+            t[i + 2] in LENGTH_UNITS
         ):
-            k = i + 3 + (1 if i + 3 < len(t) and t[i + 3] in ("of", "from") else 0)
-            target = self.target_at(k) if k < len(t) else None
-            self.set("near", Near(target[0] if target else "me", n * _LENGTH_UNITS[t[i + 2]]))
+            k = i + 3 + (1 if self.word(i + 3) in ("of", "from") else 0)
+            target = self.target_at(k)
+            self.set("near", Near(target[0] if target else "me", n * LENGTH_UNITS[t[i + 2]]))
             return k - i + (target[1] if target else 0)
-        for words in (("near",), ("close", "to"), ("next", "to"), ("beside",), ("around",)):
+        for words, how in NEAR_WORDS:
             if self.at(i, *words):
                 target = self.target_at(i + len(words))
-                if target is None:
-                    return 0
-                self.set("near", Near(target[0], self.cfg.near_radius_m))
+                if target is None or target[0] == "view" or (how != "near" and target[0] == "me"):
+                    continue
+                if how == "with" and not self.classes:
+                    continue
+                if words == ("from",) and target[0] == "me":  # "visible from here": the viewpoint
+                    return 1 + target[1]
+                radius_m = {"near": self.cfg.near_radius_m, "inside": 0.0}.get(how, self.cfg.support_gap_m)
+                self.set("near", Near(target[0], radius_m))
                 return len(words) + target[1]
-        if self.at(i, "on"):
-            j = i + 1 + (1 if self.at(i + 1, "the") or self.at(i + 1, "a") else 0)
-            closest = j < len(t) and t[j] in ("closest", "nearest")
-            found = self.class_at(j + closest)
-            if found is None:
-                return 0
+        return self.support(i) or self.nearby(i)
+
+    def support(self, i: int) -> int:
+        if not (self.at(i, "on") or self.at(i, "on", "top", "of")):
+            return 0
+        j = i + (3 if self.at(i, "on", "top", "of") else 1)
+        j += 1 if self.word(j) in ("the", "a", "an") else 0
+        closest = self.word(j) in ("closest", "nearest")
+        found = self.class_at(j + closest)
+        if found is None:
+            return 0
+        if found[0] in VERTICAL_CLASSES:  # "pictures on the wall": touching it, not standing on it
+            self.set("near", Near(found[0], self.cfg.support_gap_m))
+        else:
             self.set("on", On(found[0], closest))
-            return j + closest + found[1] - i
-        passes: tuple[tuple[str, ...], ...] = (
-            ("pass", "here"),
-            ("passed", "here"),
-            ("pass", "by", "here"),
-            ("passed", "by", "here"),
-            ("come", "by", "here"),
-            ("came", "by", "here"),
-            ("walk", "by", "here"),
-            ("walked", "by", "here"),
-            ("pass", "by"),
-            ("passed", "by"),
-            ("been", "here"),
-        )
-        for phrase in passes:
-            if self.at(i, *phrase):
-                self.set("passed_here", True)
-                self.answer = self.answer or "time"
-                return len(phrase)
-        if self.at(i, "here"):
-            self.set("near", Near("me", self.cfg.near_radius_m))
-            return 1
+        return j + closest + found[1] - i
+
+    def nearby(self, i: int) -> int:
+        """"here", "nearby", "around", "close by": near the reference pose."""
+        for words in (("here",), ("nearby",), ("close", "by"), ("around",), ("near", "by"), ("near",)):
+            if self.at(i, *words):
+                self.fields.setdefault("near", Near("me", self.cfg.near_radius_m))
+                return len(words)
         return 0
 
     def state(self, i: int) -> int:
@@ -388,45 +300,77 @@ class _Parser:
         if self.at(i, "in", "motion"):
             self.set("state", "dynamic")
             return 2
-        if self.t[i] in _MOVING | _STATIC:
-            self.set("state", "dynamic" if self.t[i] in _MOVING else "static")
+        if self.t[i] in MOVING_WORDS | STATIC_WORDS:
+            self.set("state", "dynamic" if self.t[i] in MOVING_WORDS else "static")
             return 1
         return 0
 
     def confidence(self, i: int) -> int:
-        if self.t[i] not in ("confidence", "confident"):
-            return 0
-        k = i + 1
-        while k < len(self.t) and self.t[k] in ("above", "over", "at", "least", ">", ">=", "of"):
+        """"confidence above 0.5", "more than 50% confidence", "at least 80 % sure"."""
+        k = i + (1 if self.word(i) in CONFIDENCE_WORDS else 0)
+        while self.word(k) in AT_LEAST_WORDS:
             k += 1
-        n = _number(self.t[k]) if k < len(self.t) else None
+        n = _number(self.word(k))
         if n is None:
             return 0
+        k += 1
+        if self.word(i) not in CONFIDENCE_WORDS:  # the number first: the confidence word must follow
+            if self.word(k) not in CONFIDENCE_WORDS:
+                return 0
+            k += 1
         self.set("min_confidence", n)
-        return k - i + 1
+        return k - i
+
+    def order(self, i: int) -> int:
+        """"sorted by distance", "by time", "most recent first": the order of the answer."""
+        k = i + (1 if self.word(i) in ("sorted", "ordered", "sort", "order", "ranked") else 0)
+        if self.word(k) == "by" and self.word(k + 1) in ORDER_WORDS:
+            self.set("sort", ORDER_WORDS[self.word(k + 1)])
+            return k + 2 - i
+        if self.at(i, "most", "recent", "first") or self.at(i, "latest", "first"):
+            self.set("sort", "last_seen")
+            return 3 if self.word(i) == "most" else 2
+        if self.at(i, "most", "recently") or self.at(i, "most", "recent"):
+            self.set("sort", "last_seen")
+            return 2
+        return 0
 
     def noun(self, i: int) -> int:
         n = _number(self.t[i])
-        if n is not None and i + 1 < len(self.t) and self.class_at(i + 1) and n >= 1 and n == int(n):
+        if n is not None and self.class_at(i + 1) and n >= 1 and n == int(n):
             self.set("limit", int(n))
             return 1
         found = self.class_at(i)
         if found is None:
+            if self.t[i] == "who":
+                self.classes.append("person")
+                return 1
             return 0
         self.classes.append(found[0])
         self.plural = self.plural or found[2]
         return found[1]
 
+    def place(self, i: int) -> int:
+        """A room or area name. The name of the whole place the KB holds ("in the house" when
+        its one environment is "house") asks about all of it; any other is refused with a
+        note that hiper keeps no named places (never read as a class spelled alike)."""
+        for n in (2, 1):
+            phrase = " ".join(self.t[i : i + n])
+            if len(self.t[i : i + n]) < n:
+                continue
+            if phrase in self.whole_place:
+                return n
+            if phrase in PLACE_WORDS:
+                self.places.append(phrase)
+                return n
+        return 0
+
     # -- the parse -------------------------------------------------------------------------
 
-    def run(self, *, suggest: bool = True) -> ParsedQuery:
+    def read(self) -> None:
         rules: list[Callable[[int], int]] = [
-            self.questions,
-            self.times,
-            self.space,
-            self.state,
-            self.confidence,
-            self.noun,
+            self.questions, self.times, self.changes, self.passes, self.space, self.state,
+            self.confidence, self.order, self.noun, self.place,
         ]
         i = 0
         while i < len(self.t):
@@ -436,68 +380,93 @@ class _Parser:
                     self.unknown.append(self.t[i])
                 used = 1
             i += used
-        if self.unknown:
-            raise QueryError(
-                _unknown_message(self.text, self.unknown, self.now_s, self.cfg)
-                if suggest
-                else f"cannot read {self.unknown}"
-            )
+
+    def run(self, *, suggest: bool = True) -> ParsedQuery:
         if not self.t:
             raise QueryError(
                 f'empty query; ask e.g. "cups in FOV" or "how many chairs"; understood: {UNDERSTOOD}'
             )
+        self.read()
+        if self.unknown or self.places:
+            words = [*self.unknown, *self.places]
+            if not suggest:
+                raise QueryError(f"cannot read {words}")
+            raise QueryError(refusal(self.text, self.t, self.unknown, self.places, self.example(),
+                                     lambda q: _parses(q, self.now_s, self.cfg), UNDERSTOOD))
         return self.build()
+
+    def example(self) -> str:
+        """A question that parses, built from what was understood (the fallback suggestion)."""
+        name = next((c for c in self.classes if c != ANY_FOREGROUND), "chair")
+        return {
+            "count": f"how many {plural(name)}",
+            "location": f"where is the {name}",
+            "time": f"when was the {name} last seen",
+            "duration": f"how long was the {name} in view",
+            "yes_no": f"is there a {name}",
+            "goal": f"go to the {name}",
+        }.get(self.answer or "", "what moved recently" if self.change else f"{plural(name)} in view")
 
     def build(self) -> ParsedQuery:
         f = dict(self.fields)
-        passed = f.pop("passed_here", False)
         layer = None
         classes = tuple(dict.fromkeys(c for c in self.classes if c != ANY_FOREGROUND))
         if ANY_FOREGROUND in self.classes and not classes:
             layer = "foreground"
-        answer = self.answer or "list"
+        yes_no = self.ask_yes_no and not self.request
+        answer = self.answer or ("yes_no" if yes_no else "time" if self.implies_time else "list")
+        time_of = self.time_of or "last"
+        change = self.change or (self.arrival if answer in ("list", "yes_no", "count") else None)
+        if answer == "time" and change in ("added", "removed"):
+            time_of, change = ("first" if change == "added" else "last"), None
+        # "when was someone near the couch": the time of the sighting near it, as for "pass"
+        passed = self.passed or (answer == "time" and isinstance(f.get("near"), Near))
+        window = self.window
+        if change is not None and window.is_open:  # "anything new": new within the recent window
+            window = TimeWindow(self.now_s - self.cfg.recent_s, None)
+        if window.since_s is not None and window.until_s is not None and window.since_s > window.until_s:
+            raise QueryError(f'the times in "{self.text}" leave no time between them (the window would '
+                             'start after it ends); ask e.g. "people between 9:00 and 11:00"')
         if answer in ("location", "time", "duration", "goal") and not self.plural:
             f.setdefault("limit", 1)
         if answer == "goal":
             f.setdefault("sort", "distance")
         if answer in ("time", "duration") and not passed:
-            f.setdefault("sort", "first_seen" if self.time_of == "first" else "last_seen")
+            f.setdefault("sort", "first_seen" if time_of == "first" else "last_seen")
         if answer == "location" and "sort" not in f:
             f["sort"] = "last_seen"
-        spec = QuerySpec(classes=classes, layer=layer, passed_here=passed, **f)
+        spec = QuerySpec(classes=classes, layer=layer, passed_here=passed, since_s=window.since_s,
+                         until_s=window.until_s, change=change, **f)
         assert answer in ANSWER_KINDS
-        return ParsedQuery(self.text, answer, spec, self.time_of)
+        return ParsedQuery(self.text, answer, spec, time_of, window.since_event, window.until_event)
 
 
-def parse(text: str, *, now_s: float = 0.0, config: QueryConfig | None = None) -> ParsedQuery:
-    """Parse a plain-words query; ``now_s`` anchors relative times ("last 10 minutes")."""
-    return _Parser(text, now_s, config or QueryConfig()).run()
+def keywords() -> set[str]:
+    """Every word the grammar reads besides class words (for suggestions)."""
+    words = set(FILLER) | set(LENGTH_UNITS) | MOVING_WORDS | STATIC_WORDS | ME_WORDS | FOV_WORDS
+    words |= set(tokens(UNDERSTOOD))
+    for table in (QUESTION_PHRASES, CHANGE_WORDS, PASS_VERBS, ARRIVE_LEAVE_VERBS):
+        for phrase, _kind in table:
+            words.update(phrase)
+    return words | set(TIME_UNITS_S) | {"closest", "nearest", "within", "beside", "nearby", "confidence"}
 
 
-def _vocabulary() -> list[str]:
-    words = set(_KEYWORDS)
-    for phrase in class_words():
-        words.update(phrase.split())
-    return sorted(words)
-
-
-def _unknown_message(text: str, unknown: list[str], now_s: float, cfg: QueryConfig) -> str:
-    vocab = _vocabulary()
-    fixed = []
-    for token in _tokens(text):
-        if token in unknown:
-            close = difflib.get_close_matches(token, vocab, n=1, cutoff=0.6)
-            if close:
-                fixed.append(close[0])
-        else:
-            fixed.append(token)
-    suggestion = " ".join(fixed)
+def _parses(text: str, now_s: float, cfg: QueryConfig) -> bool:
+    """Whether ``text`` parses and asks about something (a class, a place, a change)."""
     try:
-        _Parser(suggestion, now_s, cfg).run(suggest=False)
+        spec = _Parser(text, now_s, cfg).run(suggest=False).spec
     except QueryError:
-        suggestion = "cups in FOV"
-    quoted = ", ".join(f'"{w}"' for w in dict.fromkeys(unknown))
-    return f'cannot read {quoted} in "{text}"; did you mean "{suggestion}"? hiper understands: {UNDERSTOOD}'
+        return False
+    return bool(spec.classes or spec.layer or spec.change or spec.near or spec.on or spec.in_fov)
+
+
+def parse(
+    text: str, *, now_s: float = 0.0, config: QueryConfig | None = None, whole_place: Sequence[str] = ()
+) -> ParsedQuery:
+    """Parse a plain-words query; ``now_s`` anchors relative times ("last 10 minutes");
+    ``whole_place``: names of the whole place asked about ("house"), read as no filter."""
+    names = frozenset(" ".join(tokens(name)) for name in whole_place)
+    return _Parser(text, now_s, config or QueryConfig(), names).run()
 
 
 def with_limit(parsed: ParsedQuery, limit: int | None) -> ParsedQuery:
@@ -508,4 +477,4 @@ def with_limit(parsed: ParsedQuery, limit: int | None) -> ParsedQuery:
 def parse_time(text: str, now_s: float) -> float | None:
     """A time of day ('10:00', '3pm', on the UTC day of ``now_s``) or an ISO date-time, as a
     stamp (s); None when it is neither."""
-    return _clock(text.strip().lower(), now_s)
+    return clock_stamp(text.strip().lower(), now_s)

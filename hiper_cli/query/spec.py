@@ -13,11 +13,14 @@ from typing import Any, Literal
 from hiper_cli.errors import QueryError
 from hiper_cli.query.geometry import Frustum
 
-__all__ = ["SORTS", "STATES", "Near", "On", "QueryConfig", "QuerySpec"]
+__all__ = ["CHANGES", "SORTS", "STATES", "Near", "On", "QueryConfig", "QuerySpec"]
 
 Sort = Literal["distance", "last_seen", "first_seen", "confidence"]
 SORTS: tuple[str, ...] = ("distance", "last_seen", "first_seen", "confidence")
 STATES: tuple[str, ...] = ("static", "dynamic")
+# What changed about an instance in the time window: first seen in it ("added"), its place seen
+# empty in it ("removed", ``vacated_s``), it moved while seen in it ("moved": dynamic), or any.
+CHANGES: tuple[str, ...] = ("added", "removed", "moved", "any")
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,7 @@ class QueryConfig:
     support_classes: tuple[str, ...] = ("table",)
     goal_standoff_m: float = 0.6
     now_window_s: float = 2.0
+    recent_s: float = 600.0
     view_gap_s: float = 1.0
     max_hits: int = 50
 
@@ -67,7 +71,10 @@ class On:
 @dataclass(frozen=True)
 class QuerySpec:
     """Which instances a query selects. Empty ``classes`` = any class (of ``layer`` if set).
-    Times are stamps (s): an instance passes when it was seen at some time in [since, until]."""
+    Times are stamps (s): an instance passes when it was seen at some time in [since, until];
+    with ``change`` (``CHANGES``) when that change happened in [since, until] instead.
+    ``rank_from``: a class; sort "distance" then measures from the nearest instance of it
+    ("the chair closest to the door"), not from the reference pose."""
 
     classes: tuple[str, ...] = ()
     layer: str | None = None
@@ -79,12 +86,16 @@ class QuerySpec:
     near: Near | None = None
     on: On | None = None
     passed_here: bool = False
+    change: str | None = None
     sort: str | None = None
+    rank_from: str | None = None
     limit: int | None = None
 
     def __post_init__(self) -> None:
         if self.state is not None and self.state not in STATES:
             raise QueryError(f"state {self.state!r}: expected one of {', '.join(STATES)}")
+        if self.change is not None and self.change not in CHANGES:
+            raise QueryError(f"change {self.change!r}: expected one of {', '.join(CHANGES)}")
         if self.sort is not None and self.sort not in SORTS:
             raise QueryError(f"sort {self.sort!r}: expected one of {', '.join(SORTS)}")
         if self.layer is not None and self.layer not in ("background", "foreground"):

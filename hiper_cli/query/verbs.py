@@ -1,5 +1,5 @@
 """The query verbs of the library, the same ones the CLI, the grammar and (later) the MCP tools
-use: ``find``, ``count``, ``last_seen``, ``when``, ``passed_here``, ``trajectory``.
+use: ``find``, ``count``, ``last_seen``, ``when``, ``passes``/``passed_here``, ``trajectory``.
 
 Each takes the knowledge base, what to look for (a class name or words such as "mugs",
 "people", "objects"), filters, and where the query is asked from (``pose`` x, y, z, yaw, or
@@ -8,6 +8,7 @@ the robot's pose at ``at_s``; ``now_s`` defaults to the KB's last stamp).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -20,7 +21,7 @@ from hiper_cli.query.results import Hit, Sighting, Trajectory
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
 from hiper_cli.query.vocabulary import ANY_FOREGROUND, CLASS_NAMES, resolve_class
 
-__all__ = ["count", "find", "last_seen", "passed_here", "spec_for", "trajectory", "when"]
+__all__ = ["count", "find", "last_seen", "passed_here", "passes", "spec_for", "trajectory", "when"]
 
 Pose = tuple[float, float, float, float]
 
@@ -181,23 +182,49 @@ def when(
     )
 
 
-def passed_here(ctx: Context, spec: QuerySpec) -> tuple[float, Hit] | None:
-    """The last time an instance of ``spec`` was observed within the config's
-    ``pass_radius_m`` (horizontally) of the reference position, and that instance."""
+def passes(ctx: Context, spec: QuerySpec, sighting: str = "last") -> list[tuple[float, str]]:
+    """The instances of ``spec`` observed within ``spec.near`` (default: the config's
+    ``pass_radius_m`` of the reference position) horizontally, in ``spec``'s time window: near
+    the reference position when the target is "me", else near the footprint of any instance of
+    the target class (the target's own observations aside). One (stamp, uuid) per instance,
+    its last time there (``sighting`` "first": its first), latest (earliest) first."""
     r = spec.near.radius_m if spec.near is not None else ctx.config.pass_radius_m
-    x, y = ctx.reference.x_m, ctx.reference.y_m
+    target = spec.near.target if spec.near is not None else "me"
+    if target == "me":
+        places = [(np.array([ctx.reference.x_m, ctx.reference.y_m]), np.zeros(2))]
+        own: set[str] = set()
+    else:
+        sup = engine.supports(ctx, target)
+        places = [(sup.centers[k, :2], sup.extents[k, :2]) for k in range(len(sup))]
+        own = set(sup.uuids)
+    unwindowed = replace(spec, since_s=None, until_s=None, change=None, near=None, passed_here=False)
+    allowed = set(engine.prefilter(ctx, unwindowed).uuids) - own
     until = spec.until_s if spec.until_s is not None else ctx.now_s
-    best: tuple[float, str] | None = None
-    for class_name in spec.classes or (None,):
-        for p in ctx.kb.observations_near((x - r, y - r, -1e6), (x + r, y + r, 1e6), class_name):
-            ok = (p.center_map_m[0] - x) ** 2 + (p.center_map_m[1] - y) ** 2 <= r * r
-            ok = ok and p.stamp_s <= until and (spec.since_s is None or p.stamp_s >= spec.since_s)
-            if ok and p.instance_uuid and (best is None or p.stamp_s > best[0]):
-                best = (p.stamp_s, p.instance_uuid)
-    if best is None:
+    since = spec.since_s if spec.since_s is not None else -np.inf
+    best: dict[str, float] = {}
+    for center, extent in places:
+        lo, hi = center - extent / 2.0 - r, center + extent / 2.0 + r
+        for class_name in spec.classes or (None,):
+            for p in ctx.kb.observations_near((lo[0], lo[1], -1e6), (hi[0], hi[1], 1e6), class_name):
+                if p.instance_uuid not in allowed or not since <= p.stamp_s <= until:
+                    continue
+                gap = np.maximum(np.abs(np.asarray(p.center_map_m[:2]) - center) - extent / 2.0, 0.0)
+                if float(np.hypot(*gap)) > r:
+                    continue
+                held = best.get(p.instance_uuid)
+                if held is None or (p.stamp_s > held if sighting == "last" else p.stamp_s < held):
+                    best[p.instance_uuid] = p.stamp_s
+    found = sorted(((stamp, uuid) for uuid, stamp in best.items()), reverse=sighting == "last")
+    return found
+
+
+def passed_here(ctx: Context, spec: QuerySpec, sighting: str = "last") -> tuple[float, Hit] | None:
+    """The latest (``sighting`` "first": the earliest) of ``passes``, with its instance."""
+    found = passes(ctx, spec, sighting)
+    if not found:
         return None
-    found = engine.hits(ctx, engine.candidates_of(ctx, [best[1]]))
-    return (best[0], found[0]) if found else None
+    hits = engine.hits(ctx, engine.candidates_of(ctx, [found[0][1]]))
+    return (found[0][0], hits[0]) if hits else None
 
 
 def trajectory(kb: KnowledgeBase, uuid: str) -> Trajectory:

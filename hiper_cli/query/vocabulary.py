@@ -5,7 +5,10 @@ from __future__ import annotations
 
 from functools import cache
 
-__all__ = ["ANY_FOREGROUND", "CLASS_NAMES", "class_words", "counted", "plural", "resolve_class", "singular"]
+__all__ = [
+    "ANY_FOREGROUND", "CLASS_NAMES", "PLACE_WORDS", "class_words", "counted", "plural", "resolve_class",
+    "singular",
+]
 
 COCO = (
     "person",
@@ -138,6 +141,27 @@ SYNONYMS = {
     "staircase": "stairs",
     "stair": "stairs",
     "lady": "person",
+    "everyone": "person",
+    "everybody": "person",
+    "guy": "person",
+    "visitor": "person",
+    "worker": "person",
+    "customer": "person",
+    "walker": "person",
+    "telly": "tv",
+    "tv screen": "tv",
+    "flatscreen": "tv",
+    "coffee table": "table",
+    "side table": "table",
+    "kitchen table": "table",
+    "workbench": "table",
+    "freezer": "refrigerator",
+    "coffee cup": "cup",
+    "coffee mug": "cup",
+    "water bottle": "bottle",
+    "office chair": "chair",
+    "doorway": "door",
+    "everything": ANY_FOREGROUND,
     "object": ANY_FOREGROUND,
     "objects": ANY_FOREGROUND,
     "thing": ANY_FOREGROUND,
@@ -146,6 +170,18 @@ SYNONYMS = {
     "something": ANY_FOREGROUND,
     "stuff": ANY_FOREGROUND,
 }
+# Names of places (rooms, areas): a query naming one is refused with a note that hiper keeps no
+# named places, never read as a class that happens to be spelled alike ("kitchen" is no "kite").
+PLACE_WORDS = frozenset(
+    [
+        "kitchen", "bedroom", "bathroom", "office", "hallway", "hall", "corridor", "lobby", "garage",
+        "lab", "laboratory", "warehouse", "aisle", "room", "rooms", "entrance", "entryway", "reception",
+        "storeroom", "basement", "attic", "garden", "yard", "upstairs", "downstairs", "corner", "area",
+        "zone", "house", "home", "building", "store", "shop", "bookstore", "living room",
+        "dining room", "meeting room", "break room", "conference room", "loading dock", "back room",
+        "stockroom", "canteen", "cafeteria", "lounge", "porch", "balcony", "place", "places",
+    ]
+)
 IRREGULAR_PLURALS = {
     "people": "people",
     "men": "men",
