@@ -149,3 +149,12 @@ def test_convert_degrade_bad_flags_give_one_line_errors(tmp_path, args, message)
     assert result.exit_code != 0
     assert message in result.output
     assert "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("name", ["structured-light", "tof", "stereo"])
+def test_no_return_outside_the_profiles_range(name):
+    profile = get_profile(name)
+    for z in (profile.min_range_m * 0.8, profile.max_range_m * 1.1):
+        depth = np.full((CAMERA.height, CAMERA.width), z, dtype=np.float32)
+        out = degrade_depth(depth, None, CAMERA, profile, np.random.default_rng(0))
+        assert (out == 0).mean() > 0.97

@@ -29,12 +29,13 @@ from hiper_cli.sensor.poses import drifting_poses
 from hiper_cli.sensor.profiles import SensorProfile
 from hiper_cli.types import Frame
 
-__all__ = ["DegradeResult", "DegradedLog", "degrade_frame", "degrade_log", "pose_error"]
+__all__ = ["DegradeResult", "DegradedLog", "degrade_frame", "degrade_log", "luma", "pose_error"]
 
 _POSE_STREAM = 0x5E50  # the pose source's own random stream, apart from the frames'
 
 
-def _luma(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+def luma(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """Grey level (ITU-R 601) of an RGB image: a stand-in for the IR reflectance."""
     grey = rgb[..., 0] * 0.299 + rgb[..., 1] * 0.587 + rgb[..., 2] * 0.114
     return grey.astype(np.uint8)
 
@@ -42,7 +43,7 @@ def _luma(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
 def degrade_frame(frame: Frame, flow_px_per_s: NDArray[np.float64], profile: SensorProfile,
                   rng: np.random.Generator, *, jpeg: bool = True) -> Frame:
     """``frame`` with the profile's depth and colour artefacts (the pose is left as it is)."""
-    depth = degrade_depth(frame.depth_m, _luma(frame.rgb), frame.camera, profile, rng)
+    depth = degrade_depth(frame.depth_m, luma(frame.rgb), frame.camera, profile, rng)
     rgb = degrade_rgb(frame.rgb, flow_px_per_s, profile, jpeg=jpeg)
     return replace(frame, rgb=rgb, depth_m=depth)
 
