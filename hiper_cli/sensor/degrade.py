@@ -29,7 +29,8 @@ from hiper_cli.sensor.poses import drifting_poses
 from hiper_cli.sensor.profiles import SensorProfile
 from hiper_cli.types import Frame
 
-__all__ = ["DegradeResult", "DegradedLog", "degrade_frame", "degrade_log", "luma", "pose_error"]
+__all__ = ["DegradeResult", "DegradedLog", "degrade_frame", "degrade_log", "luma", "pose_error",
+           "write_trajectory"]
 
 _POSE_STREAM = 0x5E50  # the pose source's own random stream, apart from the frames'
 
@@ -120,7 +121,8 @@ class DegradeResult:
                 "pose_error": self.pose_error, "gt_copied": self.gt_copied}
 
 
-def _write_trajectory(path: Path, stamps_s: NDArray[np.float64], T_map_cam: NDArray[np.float64]) -> None:
+def write_trajectory(path: Path, stamps_s: NDArray[np.float64], T_map_cam: NDArray[np.float64]) -> None:
+    """A TUM trajectory file: ``stamp tx ty tz qx qy qz qw`` per pose (the exact one, beside a log)."""
     lines = ["# exact trajectory (T_map_cam) of the degraded log", "# timestamp tx ty tz qx qy qz qw"]
     for stamp, T in zip(stamps_s, T_map_cam, strict=True):
         values = (*T[:3, 3], *matrix_to_quat_xyzw(T[:3, :3]))
@@ -140,7 +142,7 @@ def degrade_log(reader: LogReader, out: str | Path, profile: SensorProfile, seed
     if copied:
         shutil.copytree(source_gt, gt, dirs_exist_ok=True)
     gt.mkdir(exist_ok=True)
-    _write_trajectory(gt / "groundtruth.txt", log.stamps_s, log.T_map_cam_true)
+    write_trajectory(gt / "groundtruth.txt", log.stamps_s, log.T_map_cam_true)
     errors = pose_error(log.T_map_cam_true, log.T_map_cam_est)
     (gt / "sensor.json").write_text(json.dumps(
         {"profile": profile.to_dict(), "seed": seed, "source": str(reader.info().path),
