@@ -18,7 +18,7 @@ import pytest
 from hiper_cli.perceive.logs import open_log
 from hiper_cli.sensor import get_profile
 from hiper_cli.sensor.degrade import DegradedLog, luma
-from hiper_cli.sensor.depth import depth_edges, error_std_m, incidence_deg, projector_shadow
+from hiper_cli.sensor.depth import depth_edges, error_std_m, grazing_dropout, incidence_deg, projector_shadow
 from hiper_cli.types import Frame
 
 WORLDS = Path(os.environ.get("HIPER_WORLDS", "") or
@@ -63,8 +63,11 @@ def test_depth_error_follows_the_model_within_10_percent_per_range_bin():
 
 
 def _certain_drops(clean: Frame) -> np.ndarray:
-    return ((clean.depth_m <= 0) | projector_shadow(clean.depth_m, clean.camera.fx, PROFILE.baseline_m)
-            | (incidence_deg(clean.depth_m, clean.camera) > PROFILE.grazing_deg))
+    return (clean.depth_m <= 0) | projector_shadow(clean.depth_m, clean.camera.fx, PROFILE.baseline_m)
+
+
+def _grazing(clean: Frame) -> np.ndarray:
+    return grazing_dropout(PROFILE, incidence_deg(clean.depth_m, clean.camera))
 
 
 def test_dark_surfaces_lose_the_profiles_share_of_pixels():
@@ -72,7 +75,7 @@ def test_dark_surfaces_lose_the_profiles_share_of_pixels():
     for clean, degraded in _pairs():
         z = clean.depth_m
         dark = (luma(clean.rgb) < PROFILE.dark_luma) & (z > 0.6) & (z < 4.5)
-        dark &= ~_certain_drops(clean) & ~_near_edges(z)
+        dark &= ~_certain_drops(clean) & ~_near_edges(z) & (_grazing(clean) == 0)
         dark_pixels += int(dark.sum())
         dark_missing += int((dark & (degraded.depth_m == 0)).sum())
     assert dark_pixels > 20_000
@@ -84,8 +87,9 @@ def test_share_of_missing_pixels_is_what_the_parameters_predict():
     for clean, degraded in _pairs():
         z, grey = clean.depth_m, luma(clean.rgb)
         certain = _certain_drops(clean) | (z > PROFILE.max_range_m) | ((z > 0) & (z < PROFILE.min_range_m))
-        chance = np.where(grey < PROFILE.dark_luma, PROFILE.dark_dropout,
-                          np.where(grey > PROFILE.glossy_luma, PROFILE.glossy_dropout, 0.0))
+        lit = np.where(grey < PROFILE.dark_luma, PROFILE.dark_dropout,
+                       np.where(grey > PROFILE.glossy_luma, PROFILE.glossy_dropout, 0.0))
+        chance = 1 - (1 - lit) * (1 - _grazing(clean))
         predicted += float(np.where(certain, 1.0, chance).mean())
         measured += float((degraded.depth_m == 0).mean())
     frames = len(_pairs())

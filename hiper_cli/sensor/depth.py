@@ -17,8 +17,8 @@ from numpy.typing import NDArray
 from hiper_cli.sensor.profiles import SensorProfile
 from hiper_cli.types import CameraIntrinsics
 
-__all__ = ["axial_sigma_m", "degrade_depth", "depth_edges", "error_std_m", "incidence_deg",
-           "projector_shadow", "quantisation_step_m"]
+__all__ = ["axial_sigma_m", "degrade_depth", "depth_edges", "error_std_m", "grazing_dropout",
+           "incidence_deg", "projector_shadow", "quantisation_step_m"]
 
 FloatImage = NDArray[np.float32]
 BoolImage = NDArray[np.bool_]
@@ -118,6 +118,12 @@ def incidence_deg(depth_m: FloatImage, camera: CameraIntrinsics) -> NDArray[np.f
     return np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), 0.0, 1.0)))
 
 
+def grazing_dropout(profile: SensorProfile, incidence: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Chance of no return at ``incidence`` degrees: 0 up to ``grazing_deg``, 1 from ``grazing_full_deg``."""
+    span = max(profile.grazing_full_deg - profile.grazing_deg, 1e-6)
+    return np.clip((incidence - profile.grazing_deg) / span, 0.0, 1.0)
+
+
 def _blocks(shape: tuple[int, int], block_px: int, rng: np.random.Generator) -> NDArray[np.float64]:
     """Uniform numbers constant over ``block_px`` squares: dropouts come as blobs, not single pixels."""
     h, w = shape
@@ -159,7 +165,7 @@ def degrade_depth(depth_m: FloatImage, luma: NDArray[np.uint8] | None, camera: C
     if profile.shadows and profile.baseline_m > 0:
         drop |= projector_shadow(depth_m, camera.fx, profile.baseline_m)
     if profile.grazing_deg < 90:
-        drop |= incidence_deg(depth_m, camera) > profile.grazing_deg
+        drop |= rng.random(z.shape) < grazing_dropout(profile, incidence_deg(depth_m, camera))
     if luma is not None and (profile.dark_dropout > 0 or profile.glossy_dropout > 0):
         chance = _blocks(z.shape, profile.dropout_block_px, rng)
         drop |= (luma < profile.dark_luma) & (chance < profile.dark_dropout)

@@ -8,18 +8,18 @@ structured-light (Kinect v1 / Asus Xtion):
   range 0.45-5.0 m [KE12: 0.5-5 m]; axial σ_z = 0.0012 + 0.0019 (z - 0.4)² m [N12, 10-60° incidence];
   disparity quantised to 1/8 px with f = 585.6 px, b = 0.075 m [KE12]; projector 0.075 m along +x
   casts shadows [KE12]; 30 % of edge pixels (a step > 10 % of the depth) fly; dropouts: dark
-  (luma < 20) 50 %, glossy (luma > 250) 60 %, incidence > 75° [KE12, N12]; colour shifted 3, 2 px
+  (luma < 20) 50 %, glossy (luma > 250) 60 %, incidence 75°-88°: 0-100 % [KE12, N12]; colour shifted 3, 2 px
   against depth [SP11: factory registration off by a few px]; rolling shutter 30 ms, exposure 15 ms;
   JPEG 75 (a compressed image topic).
 tof (Kinect v2 / Azure Kinect):
   range 0.5-4.5 m [MS]; σ_z = 0.0015 - 0.0005 z + 0.0003 z² m [F15]; no quantisation (phase) and
   no shadows (emitter beside the lens); 90 % of edge pixels fly (mixed phase, multipath) [F15];
-  dark 70 %, glossy 60 %, incidence > 70° [F15]; colour 2, 1 px; 20 ms readout, 10 ms exposure; JPEG 80.
+  dark 70 %, glossy 60 %, incidence 70°-85° [F15]; colour 2, 1 px; 20 ms readout, 10 ms exposure; JPEG 80.
 stereo (RealSense D435, active IR stereo):
   range 0.28-6.0 m [D4: min-Z 0.28 m at 640×480]; 0.08 px disparity noise, so σ_z = 0.08 z² / (f b),
   with f = 382 px, b = 0.050 m and 1/32 px quantisation [D4]; the second imager 0.050 m along +x
   cannot see behind near edges (shadows); 50 % of edge pixels fly (the matching window straddles the
-  edge); dark/textureless 40 %, glossy 50 %, incidence > 75°; colour 1, 1 px; 15 ms readout, 8 ms
+  edge); dark/textureless 40 %, glossy 50 %, incidence 75°-88°; colour 1, 1 px; 15 ms readout, 8 ms
   exposure; JPEG 80.
 Pose source (all but ideal): 4 mm and 0.15° of noise, drift 0.5 % of the distance and 0.1°/m
   (ORB-SLAM2 reaches ~1 % RMSE on TUM RGB-D sequences) - see ``hiper_cli.sensor.poses``.
@@ -72,7 +72,8 @@ class SensorProfile:
     dark_dropout: float = 0.0
     glossy_luma: float = 250.0
     glossy_dropout: float = 0.0
-    grazing_deg: float = 90.0
+    grazing_deg: float = 90.0  # returns start to drop at this incidence ...
+    grazing_full_deg: float = 90.0  # ... and all are lost from this one (linear between)
     dropout_block_px: int = 4
     misregistration_px: tuple[float, float] = (0.0, 0.0)
     readout_s: float = 0.0
@@ -130,18 +131,19 @@ PROFILES: dict[str, SensorProfile] = {
         min_range_m=0.45, max_range_m=5.0, noise_c0_m=0.0012 + 0.0019 * 0.16, noise_c1=-0.0019 * 0.8,
         noise_c2_per_m=0.0019, disparity_focal_px=585.6, disparity_step_px=1 / 8, baseline_m=0.075,
         shadows=True, flying_fraction=0.3, dark_dropout=0.5, glossy_dropout=0.6, grazing_deg=75.0,
-        misregistration_px=(3.0, 2.0), readout_s=0.030, exposure_s=0.015, jpeg_quality=75, **_POSE),
+        grazing_full_deg=88.0, misregistration_px=(3.0, 2.0), readout_s=0.030, exposure_s=0.015,
+        jpeg_quality=75, **_POSE),
     "tof": SensorProfile(
         "tof", "Kinect v2 / Azure Kinect: flying pixels, dark-surface dropouts, no shadows",
         min_range_m=0.5, max_range_m=4.5, noise_c0_m=0.0015, noise_c1=-0.0005, noise_c2_per_m=0.0003,
-        flying_fraction=0.9, dark_dropout=0.7, glossy_dropout=0.6, grazing_deg=70.0,
+        flying_fraction=0.9, dark_dropout=0.7, glossy_dropout=0.6, grazing_deg=70.0, grazing_full_deg=85.0,
         misregistration_px=(2.0, 1.0), readout_s=0.020, exposure_s=0.010, jpeg_quality=80, **_POSE),
     "stereo": SensorProfile(
         "stereo", "RealSense D435: disparity noise growing with z², occlusion shadows, textureless holes",
         min_range_m=0.28, max_range_m=6.0, disparity_sigma_px=0.08, disparity_focal_px=382.0,
         disparity_step_px=1 / 32, baseline_m=0.050, shadows=True, flying_fraction=0.5, dark_dropout=0.4,
-        glossy_dropout=0.5, grazing_deg=75.0, misregistration_px=(1.0, 1.0), readout_s=0.015,
-        exposure_s=0.008, jpeg_quality=80, **_POSE),
+        glossy_dropout=0.5, grazing_deg=75.0, grazing_full_deg=88.0, misregistration_px=(1.0, 1.0),
+        readout_s=0.015, exposure_s=0.008, jpeg_quality=80, **_POSE),
 }
 
 
