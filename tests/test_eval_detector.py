@@ -98,3 +98,19 @@ def test_yolox_finds_about_7_of_the_27_nameable_objects_of_the_bookstore():
     total = result.to_dict()["total"]
     assert total["seen_clearly"] == 27  # the reference scorer's nameable objects seen clearly
     assert abs(total["found"] - 7) <= 2  # counted independently: 7
+
+
+def test_eval_scene_prints_the_ceiling_beside_hipers_recall(tmp_path):
+    runner = CliRunner()
+    kb = tmp_path / "fx.hiper"
+    perceived = runner.invoke(app, ["perceive", str(FIXTURE), "--kb", str(kb), "--detector", "truth"])
+    assert perceived.exit_code == 0, perceived.output
+    scene = ["eval", "scene", str(FIXTURE), "--kb", str(kb), "--ceiling", "truth"]
+    result = runner.invoke(app, [*scene, "--json"])
+    assert result.exit_code == 0, result.output
+    ceiling = json.loads(result.output)["detector_ceiling"]
+    assert (ceiling["seen_clearly"], ceiling["detector_found"]) == (4, 3)
+    assert ceiling["hiper_found_of_detector_found"] <= ceiling["detector_found"]
+    assert ceiling["per_class"]["table"]["detector_found"] == 0  # tables: hiper finds them as planes
+    text = runner.invoke(app, scene)
+    assert "the detector (truth) alone 3" in " ".join(text.output.split())

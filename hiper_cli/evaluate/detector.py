@@ -187,7 +187,8 @@ def detector_ceiling(log: str | Path, reader: LogReader, detector: Detector, *, 
 
 def recall_beside_ceiling(ceiling: DetectorCeiling, matched_truth_ids: list[int]) -> dict[str, Any]:
     """hiper's recall of the nameable objects seen clearly (matched with the right class by the
-    scene scoring), beside how many of them the detector found at all, per class and in total."""
+    scene scoring), beside how many of them the detector found at all, per class and in total.
+    hiper can pass the ceiling only where it needs no detection: a table found as a plane."""
     matched = set(matched_truth_ids)
     per_class: dict[str, dict[str, int]] = {}
     for o in ceiling.objects:
