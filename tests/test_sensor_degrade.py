@@ -158,3 +158,22 @@ def test_no_return_outside_the_profiles_range(name):
         depth = np.full((CAMERA.height, CAMERA.width), z, dtype=np.float32)
         out = degrade_depth(depth, None, CAMERA, profile, np.random.default_rng(0))
         assert (out == 0).mean() > 0.97
+
+
+def test_degrade_worlds_script_makes_a_copy_of_every_world(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    worlds = tmp_path / "worlds"
+    worlds.mkdir()
+    (worlds / "house_small").symlink_to(FIXTURE)
+    (worlds / "not_a_log").mkdir()
+    script = Path(__file__).resolve().parents[1] / "scripts" / "degrade_worlds.sh"
+    env = {**os.environ, "HIPER_WORLDS": str(worlds), "PYTHON": sys.executable}
+    done = subprocess.run([str(script), str(tmp_path / "out"), "tof", "2"], env=env, capture_output=True,
+                          text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "out" / "house_small-tof.json").read_text())
+    assert report["profile"] == "tof" and report["seed"] == 2 and report["frames_written"] == 60
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["house_small-tof", "house_small-tof.json"]
