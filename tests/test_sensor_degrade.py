@@ -177,3 +177,14 @@ def test_degrade_worlds_script_makes_a_copy_of_every_world(tmp_path):
     report = json.loads((tmp_path / "out" / "house_small-tof.json").read_text())
     assert report["profile"] == "tof" and report["seed"] == 2 and report["frames_written"] == 60
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["house_small-tof", "house_small-tof.json"]
+
+
+def test_a_bag_can_be_degraded_too(tmp_path):
+    runner = CliRunner()
+    bag = tmp_path / "fx.bag"
+    assert runner.invoke(app, ["convert", str(FIXTURE), str(bag), "--to", "rosbag1"]).exit_code == 0
+    result = runner.invoke(app, ["convert", str(bag), str(tmp_path / "deg"), "--degrade", "stereo", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["frames_written"] == 60 and report["gt_copied"] is False
+    assert (tmp_path / "deg" / "gt" / "groundtruth.txt").is_file()
