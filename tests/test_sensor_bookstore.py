@@ -54,7 +54,8 @@ def test_depth_error_follows_the_model_within_10_percent_per_range_bin():
         index = np.digitize(z[ok], bins) - 1
         inside = (index >= 0) & (index < len(bins) - 1)
         np.add.at(squared, index[inside], ((y - z)[ok] ** 2)[inside])
-        np.add.at(model, index[inside], (error_std_m(PROFILE, z[ok]) ** 2)[inside])
+        incidence = incidence_deg(clean.depth_m, clean.camera)[ok]
+        np.add.at(model, index[inside], (error_std_m(PROFILE, z[ok], incidence) ** 2)[inside])
         np.add.at(count, index[inside], 1)
     assert np.all(count > 10_000), count
     ratio = np.sqrt(squared / count) / np.sqrt(model / count)

@@ -23,12 +23,22 @@ __all__ = ["axial_sigma_m", "degrade_depth", "depth_edges", "error_std_m", "graz
 FloatImage = NDArray[np.float32]
 BoolImage = NDArray[np.bool_]
 NORMAL_STEP_PX = 3
+MAX_NOISE_INCIDENCE_DEG = 89.0  # the incidence term grows without bound towards 90°
 
 
-def axial_sigma_m(profile: SensorProfile, z_m: NDArray[np.floating]) -> NDArray[np.float64]:
-    """Gaussian depth noise σ (m) at range ``z_m``, before disparity quantisation."""
+def axial_sigma_m(profile: SensorProfile, z_m: NDArray[np.floating],
+                  incidence: NDArray[np.floating] | None = None) -> NDArray[np.float64]:
+    """Gaussian depth noise σ (m) at range ``z_m`` and ``incidence`` (deg), before quantisation.
+
+    The incidence term is Nguyen's (and Fankhauser's) ``noise_angle_m z^p θ² / (π/2 − θ)²``.
+    """
     z = np.asarray(z_m, dtype=np.float64)
     sigma = np.maximum(profile.noise_c0_m + profile.noise_c1 * z + profile.noise_c2_per_m * z * z, 0.0)
+    if incidence is not None and profile.noise_angle_m > 0:
+        theta = np.radians(np.clip(np.asarray(incidence, dtype=np.float64), 0.0, MAX_NOISE_INCIDENCE_DEG))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(z > 0, np.power(np.where(z > 0, z, 1.0), profile.noise_angle_z_power), 0.0)
+        sigma = sigma + profile.noise_angle_m * scale * theta**2 / (np.pi / 2 - theta) ** 2
     if profile.disparity_sigma_px > 0 and profile.disparity_focal_px > 0 and profile.baseline_m > 0:
         fb = profile.disparity_focal_px * profile.baseline_m
         from_disparity = profile.disparity_sigma_px * z * z / fb
@@ -44,10 +54,11 @@ def quantisation_step_m(profile: SensorProfile, z_m: NDArray[np.floating]) -> ND
     return z * z * profile.disparity_step_px / (profile.disparity_focal_px * profile.baseline_m)
 
 
-def error_std_m(profile: SensorProfile, z_m: NDArray[np.floating]) -> NDArray[np.float64]:
+def error_std_m(profile: SensorProfile, z_m: NDArray[np.floating],
+                incidence: NDArray[np.floating] | None = None) -> NDArray[np.float64]:
     """The documented model of the added depth error: √(σ_z² + step²/12) (noise, then quantisation)."""
     step = quantisation_step_m(profile, z_m)
-    return np.sqrt(axial_sigma_m(profile, z_m) ** 2 + step * step / 12.0)
+    return np.sqrt(axial_sigma_m(profile, z_m, incidence) ** 2 + step * step / 12.0)
 
 
 def projector_shadow(depth_m: FloatImage, fx: float, baseline_m: float) -> BoolImage:
@@ -132,10 +143,11 @@ def _blocks(shape: tuple[int, int], block_px: int, rng: np.random.Generator) -> 
     return np.repeat(np.repeat(coarse, b, axis=0), b, axis=1)[:h, :w]
 
 
-def _noisy(depth_m: FloatImage, profile: SensorProfile, rng: np.random.Generator) -> NDArray[np.float64]:
+def _noisy(depth_m: FloatImage, incidence: NDArray[np.float64] | None, profile: SensorProfile,
+           rng: np.random.Generator) -> NDArray[np.float64]:
     """Axial Gaussian noise, then disparity quantisation."""
     z = depth_m.astype(np.float64)
-    z = z + axial_sigma_m(profile, z) * rng.standard_normal(z.shape)
+    z = z + axial_sigma_m(profile, z, incidence) * rng.standard_normal(z.shape)
     if profile.quantised:
         fb = profile.disparity_focal_px * profile.baseline_m
         with np.errstate(divide="ignore"):
@@ -160,12 +172,14 @@ def degrade_depth(depth_m: FloatImage, luma: NDArray[np.uint8] | None, camera: C
         flying = edge & (rng.random(z.shape) < profile.flying_fraction)
         mix = rng.random(z.shape).astype(np.float32)
         z = np.where(flying, mix * z + (1 - mix) * across, z).astype(np.float32)
-    noisy = _noisy(z, profile, rng)
+    needs_angle = profile.grazing_deg < 90 or profile.noise_angle_m > 0
+    incidence = incidence_deg(depth_m, camera) if needs_angle else None
+    noisy = _noisy(z, incidence, profile, rng)
     drop = ~valid | (noisy < profile.min_range_m) | (noisy > profile.max_range_m)
     if profile.shadows and profile.baseline_m > 0:
         drop |= projector_shadow(depth_m, camera.fx, profile.baseline_m)
-    if profile.grazing_deg < 90:
-        drop |= rng.random(z.shape) < grazing_dropout(profile, incidence_deg(depth_m, camera))
+    if incidence is not None and profile.grazing_deg < 90:
+        drop |= rng.random(z.shape) < grazing_dropout(profile, incidence)
     if luma is not None and (profile.dark_dropout > 0 or profile.glossy_dropout > 0):
         chance = _blocks(z.shape, profile.dropout_block_px, rng)
         drop |= (luma < profile.dark_luma) & (chance < profile.dark_dropout)

@@ -5,16 +5,17 @@ a real sensor of that kind delivers. Every value below is named after what it mo
 from a datasheet or a published noise model:
 
 structured-light (Kinect v1 / Asus Xtion):
-  range 0.45-5.0 m [KE12: 0.5-5 m]; axial σ_z = 0.0012 + 0.0019 (z - 0.4)² m [N12, 10-60° incidence];
-  disparity quantised to 1/8 px with f = 585.6 px, b = 0.075 m [KE12]; projector 0.075 m along +x
-  casts shadows [KE12]; 30 % of edge pixels (a step > 10 % of the depth) fly; dropouts: dark
-  (luma < 20) 50 %, glossy (luma > 250) 60 %, incidence 75°-88°: 0-100 % [KE12, N12]; colour shifted 3, 2 px
-  against depth [SP11: factory registration off by a few px]; rolling shutter 30 ms, exposure 15 ms;
-  JPEG 75 (a compressed image topic).
+  range 0.45-5.0 m [KE12: 0.5-5 m]; axial σ_z = 0.0012 + 0.0019 (z - 0.4)² + 0.0001 z^-½ θ²/(π/2 - θ)²
+  m, θ the incidence [N12]; disparity quantised to 1/8 px with f = 585.6 px, b = 0.075 m [KE12];
+  projector 0.075 m along +x casts shadows [KE12]; 30 % of edge pixels (a step > 10 % of the depth)
+  fly; dropouts: dark (luma < 20) 50 %, glossy (luma > 250) 60 %, incidence 75°-88°: 0-100 %
+  [KE12, N12]; colour shifted 3, 2 px against depth [SP11: factory registration off by a few px];
+  rolling shutter 30 ms, exposure 15 ms; JPEG 75 (a compressed image topic).
 tof (Kinect v2 / Azure Kinect):
-  range 0.5-4.5 m [MS]; σ_z = 0.0015 - 0.0005 z + 0.0003 z² m [F15]; no quantisation (phase) and
-  no shadows (emitter beside the lens); 90 % of edge pixels fly (mixed phase, multipath) [F15];
-  dark 70 %, glossy 60 %, incidence 70°-85° [F15]; colour 2, 1 px; 20 ms readout, 10 ms exposure; JPEG 80.
+  range 0.5-4.5 m [MS]; σ_z = 0.0015 - 0.0005 z + 0.0003 z² + 0.0001 z^1.5 θ²/(π/2 - θ)² m [F15];
+  no quantisation (phase) and no shadows (emitter beside the lens); 90 % of edge pixels fly (mixed
+  phase, multipath) [F15]; dark 70 %, glossy 60 %, incidence 70°-85° [F15]; colour 2, 1 px;
+  20 ms readout, 10 ms exposure; JPEG 80.
 stereo (RealSense D435, active IR stereo):
   range 0.28-6.0 m [D4: min-Z 0.28 m at 640×480]; 0.08 px disparity noise, so σ_z = 0.08 z² / (f b),
   with f = 382 px, b = 0.050 m and 1/32 px quantisation [D4]; the second imager 0.050 m along +x
@@ -61,6 +62,8 @@ class SensorProfile:
     noise_c0_m: float = 0.0
     noise_c1: float = 0.0
     noise_c2_per_m: float = 0.0
+    noise_angle_m: float = 0.0  # incidence term: noise_angle_m z^noise_angle_z_power θ²/(π/2-θ)²
+    noise_angle_z_power: float = 0.0
     disparity_sigma_px: float = 0.0
     disparity_focal_px: float = 0.0
     disparity_step_px: float = 0.0
@@ -129,13 +132,15 @@ PROFILES: dict[str, SensorProfile] = {
     "structured-light": SensorProfile(
         "structured-light", "Kinect v1 / Asus Xtion: projector shadows, disparity steps, dropouts",
         min_range_m=0.45, max_range_m=5.0, noise_c0_m=0.0012 + 0.0019 * 0.16, noise_c1=-0.0019 * 0.8,
-        noise_c2_per_m=0.0019, disparity_focal_px=585.6, disparity_step_px=1 / 8, baseline_m=0.075,
+        noise_c2_per_m=0.0019, noise_angle_m=0.0001, noise_angle_z_power=-0.5,
+        disparity_focal_px=585.6, disparity_step_px=1 / 8, baseline_m=0.075,
         shadows=True, flying_fraction=0.3, dark_dropout=0.5, glossy_dropout=0.6, grazing_deg=75.0,
         grazing_full_deg=88.0, misregistration_px=(3.0, 2.0), readout_s=0.030, exposure_s=0.015,
         jpeg_quality=75, **_POSE),
     "tof": SensorProfile(
         "tof", "Kinect v2 / Azure Kinect: flying pixels, dark-surface dropouts, no shadows",
         min_range_m=0.5, max_range_m=4.5, noise_c0_m=0.0015, noise_c1=-0.0005, noise_c2_per_m=0.0003,
+        noise_angle_m=0.0001, noise_angle_z_power=1.5,
         flying_fraction=0.9, dark_dropout=0.7, glossy_dropout=0.6, grazing_deg=70.0, grazing_full_deg=85.0,
         misregistration_px=(2.0, 1.0), readout_s=0.020, exposure_s=0.010, jpeg_quality=80, **_POSE),
     "stereo": SensorProfile(
