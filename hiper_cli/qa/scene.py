@@ -76,7 +76,9 @@ def _tum(path: Path) -> list[list[str]]:
 
 
 def _last_pose(log: Path) -> tuple[float, float, float, float]:
-    rows = _tum(log / "groundtruth.txt")
+    # a log recorded through a sensor profile keeps its exact trajectory in gt/ (hiper_cli.sensor)
+    exact = log / "gt" / "groundtruth.txt"
+    rows = _tum(exact if exact.is_file() else log / "groundtruth.txt")
     tx, ty, tz, qx, qy, qz, qw = (float(v) for v in rows[-1][1:8])
     from scipy.spatial.transform import Rotation
 
