@@ -711,11 +711,7 @@ class Tracker:
                 newer = newer_match(new, [*live, *self.dormant], cfg, moving, pair)
                 if newer is not None:  # the older one asked: the newer folds into it
                     fold(new, newer)
-                    self.absorbed.append(newer.uuid)
-                    aliases[newer.uuid] = new
-                    for uuid, target in aliases.items():
-                        if target is newer:
-                            aliases[uuid] = new
+                    self._absorbed_by(newer, new, aliases)
                     (self.dormant if newer in self.dormant else self.tracks).remove(newer)
                 continue
             if found is None:
@@ -725,11 +721,7 @@ class Tracker:
                 fold(old, new)
             else:
                 absorb(old, new, kind, stale_rows(new, old, cfg) if kind == RESUME else 0)
-            self.absorbed.append(new.uuid)
-            aliases[new.uuid] = old
-            for uuid, target in aliases.items():  # a track absorbed earlier into ``new``
-                if target is new:
-                    aliases[uuid] = old
+            self._absorbed_by(new, old, aliases)
             index = self.tracks.index(new)
             if kind != DUPLICATE and old in self.dormant:
                 self.dormant.remove(old)
@@ -737,6 +729,15 @@ class Tracker:
             else:
                 del self.tracks[index]
         return aliases
+
+    def _absorbed_by(self, gone: Track, target: Track, aliases: dict[str, Track]) -> None:
+        """List ``gone`` as absorbed into ``target``, and point the tracks absorbed earlier into
+        ``gone`` to ``target`` too."""
+        self.absorbed.append(gone.uuid)
+        aliases[gone.uuid] = target
+        for uuid, was in aliases.items():
+            if was is gone:
+                aliases[uuid] = target
 
     def _retire(self, track: Track) -> None:
         """Keep a closed confirmed track for stitching: a static one (it stays where it is) or
