@@ -65,6 +65,7 @@ OPTION_RANGES: dict[str, Range] = {
     "width": PIXELS, "height": PIXELS, "width_px": PIXELS, "height_px": PIXELS,
     "depth_scale": Range(1e-3, 1e7),
     "max_dt_s": Range(0.0, 60.0),
+    "pose_drift": Range(0.0, 1.0),  # hiper convert --degrade: metres of drift per metre travelled
     "mapping_hz": Range(0.0, 1000.0, lo_open=True), "keyframe_hz": Range(0.0, 1000.0, lo_open=True),
     # hiper analyze
     "hours": Range(0.0, 1000.0, lo_open=True), "resolution_m": Range(0.001, 10.0),

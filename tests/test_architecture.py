@@ -57,6 +57,9 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # the simulator writes logs (perceive.logs writers), never reads a knowledge base
     "sim": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
             "hiper_cli.reanchor", "hiper_cli.evaluate", *_UI),
+    # sensor profiles: what a real camera and pose source make of a log (reads and writes logs)
+    "sensor": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
+               "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     # scoring perception against simulator truth
     "evaluate": ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
                  "hiper_cli.reanchor", *_UI),

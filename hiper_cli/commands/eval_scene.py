@@ -20,7 +20,9 @@ from hiper_cli.commands.eval import eval_app
         "and print Table II (background: semantic and static/dynamic precision, distance error, "
         "coverage of the observed wall and floor pieces) and Table III (foreground: TP/FP/FN per "
         "class, classified precision, centre error, "
-        "unknown instances on no real object, person instances per person, walker speed).\n\n"
+        "unknown instances on no real object, person instances per person, walker speed). With "
+        "--ceiling DETECTOR it also runs that detector (hiper eval detector) and prints hiper's recall "
+        "of the nameable objects seen clearly beside the detector's own.\n\n"
         "Example: hiper perceive ../shared/worlds/bookstore --kb bs.hiper && "
         "hiper eval scene ../shared/worlds/bookstore --kb bs.hiper"
     ),
@@ -29,6 +31,8 @@ def eval_scene(
     log: Annotated[Path, typer.Argument(help="A log with a realistic world's gt/ folder.")],
     kb: KbOption = DEFAULT_KB,
     kb_docs: KbDocsOption = None,
+    ceiling: str | None = typer.Option(
+        None, "--ceiling", help="Also score this detector's own recall (yolox, onnx:PATH, log, truth)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     from hiper_cli.errors import LogError
@@ -46,10 +50,21 @@ def eval_scene(
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         instances = knowledge.instances()
     data = score_scene(truth, surfaces, instances)
+    if ceiling is not None:
+        data["detector_ceiling"] = _ceiling(log, ceiling, data["foreground"]["matched_truth_ids"])
     if json_out:
         print_json(data)
         return
     show_scene_eval(data)
+
+
+def _ceiling(log: Path, detector: str, matched_truth_ids: list[int]) -> dict[str, Any]:
+    from hiper_cli.evaluate.detector import detector_ceiling, recall_beside_ceiling
+    from hiper_cli.perceive.detect import make_detector
+    from hiper_cli.perceive.logs import open_log
+
+    result = detector_ceiling(log, open_log(log), make_detector(detector, log_path=log))
+    return {**recall_beside_ceiling(result, matched_truth_ids), "detector": detector}
 
 
 def _f(value: Any) -> str:
@@ -79,6 +94,11 @@ def show_scene_eval(data: dict[str, Any]) -> None:
     for name, c in f["per_class"].items():
         out.print(f"  {name:<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
     out.print(f"  unmatched, by what they lie on: {f['unmatched']}")
+    c = data.get("detector_ceiling")
+    if c is not None:
+        out.print(f"  nameable objects seen clearly: hiper {c['hiper_found']} of {c['seen_clearly']}, the "
+                  f"detector ({c['detector']}) alone {c['detector_found']} (its ceiling); hiper keeps "
+                  f"{c['hiper_found_of_detector_found']} of the detector's {c['detector_found']}")
     out.print(f"  centre error (static, matched) mean/median {_f(f['centre_error_mean_m'])} / "
               f"{_f(f['centre_error_median_m'])} m; walkers matched {f['walkers_matched']}, speed mean "
               f"{_f(f['walker_speed_mean_mps'])} m/s, error {_f(f['walker_speed_error_mps'])} m/s")

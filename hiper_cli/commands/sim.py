@@ -13,7 +13,8 @@ from hiper_cli.commands._render import HiperTyper, console, frame_progress, prin
 HELP = (
     "Simulate a robot driving through a house, hospital or office: a TUM RGB-D log (rgb, depth, poses) "
     "plus ground truth in OUT/gt (instances, people tracks, per-pixel ids, noisy truth detections). A "
-    "mapping phase without people comes first.\n\n"
+    "mapping phase without people comes first. --sensor records it as a real camera and pose "
+    "source would (structured-light by default; ideal gives the exact render).\n\n"
     "Example: hiper sim --world hospital --seconds 60 --seed 1 -o out/hospital"
 )
 Out = Annotated[Path, typer.Option("--out", "-o", help="Output folder (created; must be empty).")]
@@ -39,6 +40,9 @@ def sim(
         0.05, "--false-positives", help="Truth detector: random false boxes per image (mean)."),
     confusion: float = typer.Option(0.03, "--confusion", help="Truth detector: chance of a wrong class."),
     png_compression: int = typer.Option(3, "--png-compression", help="PNG compression level 0-9."),
+    sensor: str = typer.Option(
+        "structured-light", "--sensor", help="Sensor profile: structured-light, tof, stereo or ideal (exact "
+        "depth with --depth-noise, exact poses); see docs/sensors.md."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Write into a non-empty output folder."),
     as_json: bool = JSON_OPTION,
 ) -> None:
@@ -47,7 +51,8 @@ def sim(
     config = SimConfig.from_flat(
         rate_hz=rate_hz, mapping_s=mapping_s, width_px=width, height_px=height, max_range_m=max_range_m,
         speed_mps=speed_mps, depth_noise=depth_noise, miss_rate=miss_rate, jitter_frac=jitter,
-        false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression)
+        false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression,
+        sensor=sensor)
     screen = console()
     with frame_progress(f"sim {world}", screen, enabled=not as_json) as bar:
         result = simulate(world, seconds, seed, out, config, overwrite=overwrite,
@@ -58,6 +63,7 @@ def sim(
     screen.print(
         f"[green]wrote[/] {result.out}: {result.frames} frames of {result.world} (seed {result.seed}), "
         f"mapping {result.mapping_s:.1f} s then {result.people} people; {result.instances} instances; "
+        f"{result.sensor} sensor; "
         f"{result.frames_per_s:.1f} frames/s"
     )
 

@@ -253,6 +253,7 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
         "walkers_matched": len(speeds),
         "walker_speed_mean_mps": float(np.mean([s for s, _ in speeds])) if speeds else None,
         "walker_speed_error_mps": float(np.mean([abs(s - v) for s, v in speeds])) if speeds else None,
+        "matched_truth_ids": sorted(used),
     }
 
 

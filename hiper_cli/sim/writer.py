@@ -3,7 +3,9 @@
 Timeline: stamps ``k / rate_hz`` from 0; the mapping phase (no people, carts still) lasts
 ``mapping_s``, then the operation phase adds the people and lets the carts move. Output:
 the TUM RGB-D folder (written by ``TumWriter``) plus ``gt/`` as specified in
-``hiper_cli.perceive.logs.truth``.
+``hiper_cli.perceive.logs.truth``. A ``sensor`` profile other than ``ideal`` records the
+exact render as that sensor would (``hiper_cli.sensor``): the log's ``groundtruth.txt`` is
+then the drifting pose estimate and ``gt/groundtruth.txt`` the exact trajectory.
 """
 
 from __future__ import annotations
@@ -14,14 +16,18 @@ import math
 import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from hiper_cli.errors import ConfigError, LogError
 from hiper_cli.model import Box3D
+from hiper_cli.sensor import SensorProfile, get_profile
+from hiper_cli.sensor.colour import image_flow_px_per_s
+from hiper_cli.sensor.degrade import degrade_frame, pose_error, write_trajectory
+from hiper_cli.sensor.poses import PoseSource
 from hiper_cli.sim.meshes import Mesh, human, rot_z
 from hiper_cli.sim.noise import NoiseModel, detect
 from hiper_cli.sim.people import Carts, Crowd, SocialForceConfig
@@ -32,7 +38,11 @@ from hiper_cli.sim.worlds import World, make_world
 
 __all__ = ["SimConfig", "SimResult", "simulate"]
 
+if TYPE_CHECKING:
+    from hiper_cli.types import Frame
+
 _STRIDES = 9  # leg poses per person, from -1 to 1
+_POSE_STREAM, _SENSOR_STREAM = 0x5E50, 0x5E51  # the sensor's random streams, apart from the render's
 
 
 @dataclass(frozen=True)
@@ -46,6 +56,7 @@ class SimConfig:
     people: SocialForceConfig = field(default_factory=SocialForceConfig)
     noise: NoiseModel = field(default_factory=NoiseModel)
     png_compression: int = 3
+    sensor: str = "ideal"  # a hiper_cli.sensor profile; not ideal: it replaces render.noise
 
     @classmethod
     def from_flat(
@@ -53,11 +64,11 @@ class SimConfig:
         height_px: int = 480, max_range_m: float = 5.0, speed_mps: float = 0.6, depth_noise: bool = True,
         miss_rate: float = 0.1, jitter_frac: float = 0.05, false_positives_per_image: float = 0.05,
         confusion_rate: float = 0.03,
-        png_compression: int = 3,
+        png_compression: int = 3, sensor: str = "ideal",
     ) -> SimConfig:
         """The configuration from the flat choices ``hiper sim`` offers (the rest at defaults)."""
         return cls(
-            rate_hz=rate_hz, mapping_s=mapping_s, png_compression=png_compression,
+            rate_hz=rate_hz, mapping_s=mapping_s, png_compression=png_compression, sensor=sensor,
             render=RenderConfig(width=width_px, height=height_px, max_range_m=max_range_m,
                                 noise=DepthNoise() if depth_noise else DepthNoise.off()),
             route=RouteConfig(speed_mps=speed_mps),
@@ -82,6 +93,7 @@ class SimResult:
     instances: int
     people: int
     elapsed_s: float
+    sensor: str = "ideal"
 
     @property
     def frames_per_s(self) -> float:
@@ -99,6 +111,7 @@ class SimResult:
             "people": self.people,
             "elapsed_s": round(self.elapsed_s, 3),
             "frames_per_s": round(self.frames_per_s, 2),
+            "sensor": self.sensor,
         }
 
 
@@ -136,6 +149,10 @@ def simulate(
     cfg = config or SimConfig()
     if seconds <= 0 or cfg.rate_hz <= 0:
         raise ConfigError(f"seconds={seconds}, rate_hz={cfg.rate_hz}: both must be positive")
+    profile = get_profile(cfg.sensor)
+    sensor = _SensorRecorder(profile, seed)
+    if profile.name != "ideal":
+        cfg = replace(cfg, render=replace(cfg.render, noise=DepthNoise.off()))
     w = make_world(world, seed) if isinstance(world, str) else world
     mapping_s = cfg.mapping_for(seconds)
     if not 0 <= mapping_s <= seconds:
@@ -236,7 +253,7 @@ def simulate(
                             (i for i, _ in dynamic))
             detections = detect(image.ids, classes, cfg.noise, rng, picture_ids)
             det_fh.write(json.dumps({"stamp_s": round(float(t), 6), "detections": detections}) + "\n")
-            frame = Frame(
+            frame = sensor.record(Frame(
                 stamp_s=float(t),
                 rgb=image.rgb,
                 depth_m=image.depth_m,
@@ -244,7 +261,7 @@ def simulate(
                 T_map_cam=T,
                 pose_id=k,
                 source=f"sim:{w.name}:{k}",
-            )
+            ))
             if pending is not None:
                 pending.result()
             pending = pool.submit(_save, frame, image.ids)
@@ -259,6 +276,7 @@ def simulate(
         out_csv.writerow(["stamp_s", "id", "x", "y", "z", "vx", "vy", "vz"])
         out_csv.writerows(tracks_rows)
     (gt / "noise.json").write_text(json.dumps(cfg.noise.to_dict(), indent=2) + "\n")
+    sensor.write_truth(gt)
     (gt / "world.json").write_text(
         json.dumps(_world_doc(w, crowd, carts, first_box, cfg, stamps, op_start), indent=1) + "\n"
     )
@@ -280,7 +298,45 @@ def simulate(
         len(w.objects) + len(crowd.specs) + len(carts.specs),
         len(crowd.specs),
         elapsed,
+        profile.name,
     )
+
+
+class _SensorRecorder:
+    """Turns each rendered frame into what ``profile``'s sensor records; keeps the true poses."""
+
+    def __init__(self, profile: SensorProfile, seed: int) -> None:
+        self.profile = profile
+        self.seed = seed
+        self.poses = PoseSource(profile, np.random.default_rng([seed, _POSE_STREAM]))
+        self.stamps_s: list[float] = []
+        self.T_true: list[np.ndarray] = []
+        self.T_est: list[np.ndarray] = []
+
+    def record(self, frame: Frame) -> Frame:
+        if self.profile.name == "ideal":
+            return frame
+        flow = np.zeros(2)
+        if self.T_true:
+            flow = image_flow_px_per_s(self.T_true[-1], frame.T_map_cam, frame.stamp_s - self.stamps_s[-1],
+                                       frame.camera, frame.depth_m)
+        rng = np.random.default_rng([self.seed, frame.pose_id, _SENSOR_STREAM])
+        out = degrade_frame(frame, flow, self.profile, rng)
+        T_est = self.poses.next(frame.T_map_cam)
+        self.stamps_s.append(frame.stamp_s)
+        self.T_true.append(frame.T_map_cam)
+        self.T_est.append(T_est)
+        return replace(out, T_map_cam=T_est)
+
+    def write_truth(self, gt: Path) -> None:
+        """``gt/groundtruth.txt`` (the exact trajectory) and ``gt/sensor.json``; nothing when ideal."""
+        if self.profile.name == "ideal":
+            return
+        true, est = np.array(self.T_true), np.array(self.T_est)
+        write_trajectory(gt / "groundtruth.txt", np.array(self.stamps_s), true)
+        (gt / "sensor.json").write_text(json.dumps(
+            {"profile": self.profile.to_dict(), "seed": self.seed, "pose_error": pose_error(true, est)},
+            indent=2) + "\n")
 
 
 def _world_doc(

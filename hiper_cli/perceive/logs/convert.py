@@ -54,12 +54,14 @@ def bag_layout(to: str, rgb_format: str = "raw", depth_encoding: str = "16UC1",
 
 
 def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayout | None = None,
-                overwrite: bool = False, on_frame: Callable[[Frame], None] | None = None) -> ConvertResult:
+                overwrite: bool = False, on_frame: Callable[[Frame], None] | None = None,
+                rgb_jpeg_quality: int | None = None) -> ConvertResult:
     """Write every readable frame of ``reader`` (a ``LogReader``) to ``out`` in format ``to``.
 
     ``layout`` sets the bag topics, frames and encodings; ``overwrite`` lets a TUM output
     reuse a non-empty folder (bags are never overwritten). TUM output stores depth at
-    5000 units per metre (the TUM convention; depths beyond 13.1 m become invalid).
+    5000 units per metre (the TUM convention; depths beyond 13.1 m become invalid) and colour as
+    PNG, or as JPEG at ``rgb_jpeg_quality``.
     """
     if to not in CONVERT_TARGETS:
         raise ConfigError(f"--to {to}: unknown format; expected one of {', '.join(CONVERT_TARGETS)}")
@@ -84,7 +86,8 @@ def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayou
     written = 0
     try:
         if to == "tum":
-            writer = TumWriter(partial, replace(camera, depth_scale=TUM_DEPTH_SCALE))
+            writer = TumWriter(partial, replace(camera, depth_scale=TUM_DEPTH_SCALE),
+                               rgb_jpeg_quality=rgb_jpeg_quality)
         else:
             writer = BagWriter(partial, to, camera, layout or BagLayout())
         with writer:

@@ -1,7 +1,8 @@
 """Write ``Frame``s as a TUM RGB-D folder that ``open_log`` reads back.
 
-Layout: ``rgb/<stem>.png`` (8-bit colour), ``depth/<stem>.png`` (uint16, metres ×
-``camera.depth_scale``; depths beyond 65535 units or invalid become 0), ``rgb.txt``,
+Layout: ``rgb/<stem>.png`` (8-bit colour; ``.jpg`` when ``rgb_jpeg_quality`` is given),
+``depth/<stem>.png`` (uint16, metres × ``camera.depth_scale``; depths beyond 65535 units or
+invalid become 0), ``rgb.txt``,
 ``depth.txt`` (``stamp path``), ``groundtruth.txt`` (TUM trajectory of ``T_map_cam``),
 ``camera.json`` and, when any frame carries detections, ``detections.jsonl``.
 ``<stem>`` is the stamp with six decimals; ``write`` returns it so callers can put
@@ -41,9 +42,11 @@ def depth_to_uint16(depth_m: NDArray[np.float32], depth_scale: float) -> NDArray
 class TumWriter:
     """Writes a TUM RGB-D folder frame by frame; the text files are flushed after every frame."""
 
-    def __init__(self, root: str | Path, camera: CameraIntrinsics, *, overwrite: bool = False) -> None:
+    def __init__(self, root: str | Path, camera: CameraIntrinsics, *, overwrite: bool = False,
+                 rgb_jpeg_quality: int | None = None) -> None:
         self.root = Path(root)
         self.camera = camera
+        self.rgb_jpeg_quality = rgb_jpeg_quality
         if self.root.exists() and any(self.root.iterdir()) and not overwrite:
             raise LogError(f"{self.root}: folder exists and is not empty; choose another output or "
                            "pass --overwrite")
@@ -74,11 +77,14 @@ class TumWriter:
             raise LogError(f"{self.root}: frame is {frame.width}×{frame.height} but the writer's camera is "
                            f"{self.camera.width}×{self.camera.height}")
         stem = f"{frame.stamp_s:.6f}"
-        rgb_name, depth_name = f"rgb/{stem}.png", f"depth/{stem}.png"
+        rgb_ext = "png" if self.rgb_jpeg_quality is None else "jpg"
+        rgb_name, depth_name = f"rgb/{stem}.{rgb_ext}", f"depth/{stem}.png"
         depth_units = depth_to_uint16(frame.depth_m, self.camera.depth_scale)
-        for name, image in ((rgb_name, np.ascontiguousarray(frame.rgb[:, :, ::-1])),
-                            (depth_name, depth_units)):
-            if not cv2.imwrite(str(self.root / name), image):
+        quality = self.rgb_jpeg_quality
+        rgb_params = [] if quality is None else [cv2.IMWRITE_JPEG_QUALITY, quality]
+        for name, image, params in ((rgb_name, np.ascontiguousarray(frame.rgb[:, :, ::-1]), rgb_params),
+                                    (depth_name, depth_units, [])):
+            if not cv2.imwrite(str(self.root / name), image, params):
                 raise LogError(f"{self.root / name}: cannot write the image; check the disk and permissions")
         T = frame.T_map_cam
         values = (*T[:3, 3], *matrix_to_quat_xyzw(T[:3, :3]))
