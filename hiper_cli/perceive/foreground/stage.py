@@ -24,7 +24,7 @@ from hiper_cli.learned import (
     SizeFeature,
     feature_from_analysis,
 )
-from hiper_cli.model import Box3D, Instance, Observation
+from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.amodal import (
     FLOOR_STANDING,
@@ -638,6 +638,9 @@ class ForegroundStage:
         inst.box = box
         inst.last_seen_s = track.last_update_s
         inst.state = state  # type: ignore[assignment]
+        # motion needs evidence: a static object stood at its fused centre all along, whatever
+        # the filter read from its partial views (its stored speed is 0, its path a point)
+        inst.data["trajectory"] = track.trajectory if state == "dynamic" else at_rest(track.trajectory, box)
         inst.confidence = track.confidence
         inst.data["closed"] = track.closed
         if track.closed and self._stays(inst) and (points := self._surfaces.of(track.uuid)):
@@ -741,6 +744,17 @@ def _timings(clock: list[float], detect_s: float, seg: Any) -> dict[str, float]:
         }
     )
     return timings
+
+
+def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
+    """Trajectory rows of an object that did not move: one per row of ``rows`` (the stamps it was
+    seen at), each at the centre of ``box`` with no velocity."""
+    if not rows:
+        return []
+    out = np.zeros((len(rows), len(rows[0])), dtype=np.float64)
+    out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
+    out[:, ROW_POSITION] = box.center_m
+    return out.tolist()
 
 
 def _wall_boxes(world: World) -> list[Box3D]:
