@@ -42,7 +42,7 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
-from hiper_cli.perceive.foreground.moving import is_dynamic, is_static
+from hiper_cli.perceive.foreground.moving import has_moved, is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
@@ -619,7 +619,7 @@ class ForegroundStage:
         )
 
     def _instance(self, track: Track) -> Instance:
-        state = "dynamic" if is_dynamic(track, self.tracker.config) else "static"
+        state = "dynamic" if has_moved(track, self.tracker.config) else "static"
         box = self._box(track)
         inst = self._instances.get(track.uuid)
         if inst is None:
