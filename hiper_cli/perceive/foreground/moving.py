@@ -19,7 +19,7 @@ from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.config import TrackerConfig
 
 if TYPE_CHECKING:
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
 __all__ = ["has_moved", "is_dynamic", "is_static", "note_travel", "was_moving"]
 
