@@ -138,3 +138,33 @@ def test_only_the_cli_imports_the_bench():
             continue
         offenders = [p for p in _modules(unit) if any(n.startswith("hiper_cli.bench") for n in _imports(p))]
         assert not offenders, f"{unit} imports hiper_cli.bench: {offenders}"
+
+
+def _imports_within(folder: pathlib.Path, prefix: str) -> dict[str, set[str]]:
+    """Module -> the modules of ``prefix`` it imports, type-only imports included."""
+    graph: dict[str, set[str]] = {}
+    for path in folder.rglob("*.py"):
+        name = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
+        graph[name] = {
+            node.module for node in ast.walk(ast.parse(path.read_text()))
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith(prefix)
+        }
+    return graph
+
+
+def test_the_foreground_stage_has_no_import_cycle():
+    """Issue 53: its parts import the track (``track.py``), not the tracker that runs them."""
+    graph = _imports_within(PACKAGE / "perceive" / "foreground", "hiper_cli.perceive.foreground")
+    done: set[str] = set()
+
+    def visit(name: str, path: tuple[str, ...]) -> None:
+        if name in path:
+            raise AssertionError(f"import cycle: {' -> '.join((*path[path.index(name):], name))}")
+        if name in done:
+            return
+        for dep in sorted(graph.get(name, ())):
+            visit(dep, (*path, name))
+        done.add(name)
+
+    for name in sorted(graph):
+        visit(name, ())

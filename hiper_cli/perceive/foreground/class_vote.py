@@ -21,20 +21,55 @@ record, merge and read them. ``Track._class_name`` caches the winner; ``record``
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
-
-if TYPE_CHECKING:
-    from hiper_cli.perceive.foreground.tracking import Measurement, Track
 
 __all__ = ["UNKNOWN", "absorb_votes", "record", "search_class", "winner"]
 
 UNKNOWN = "unknown"
+
+
+class Vote(Protocol):
+    """What one observation tells the vote (a ``track.Measurement``)."""
+
+    @property
+    def class_name(self) -> str: ...
+    @property
+    def score(self) -> float: ...
+    @property
+    def longest_m(self) -> float | None: ...
+    @property
+    def full_view(self) -> bool: ...
+    @property
+    def named_within(self) -> frozenset[str]: ...
+    @property
+    def detection_index(self) -> int | None: ...
+
+
+class Track(Protocol):
+    """The tallies of a track the vote keeps and reads (a ``track.Track``): typed here, so that
+    the vote needs nothing of the tracker's."""
+
+    class_votes: dict[str, float]
+    class_counts: dict[str, int]
+    class_longest_m: dict[str, float]
+    full_views: int
+    full_named: dict[str, int]
+    detected_classes: set[str]
+    min_class_observations: int
+    min_class_share: float
+    size_tolerance: float | None
+    refused_min_views: int
+    refused_max_share: float
+    _class_name: str | None
+
+    @property
+    def class_name(self) -> str: ...
 MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
 
 
-def record(track: Track, m: Measurement, unknown_vote_weight: float) -> None:
+def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
     """Count ``m``'s class in the track's tallies."""
     weight = unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
     track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight

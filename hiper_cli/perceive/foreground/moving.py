@@ -19,9 +19,9 @@ from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.config import TrackerConfig
 
 if TYPE_CHECKING:
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
-__all__ = ["is_dynamic", "is_static", "note_travel", "was_moving"]
+__all__ = ["has_moved", "is_dynamic", "is_static", "note_travel", "was_moving"]
 
 
 def is_static(track: Track, config: TrackerConfig) -> bool:
@@ -81,6 +81,17 @@ def is_dynamic(track: Track, config: TrackerConfig) -> bool:
     if track.class_name in config.walker_classes or track.class_name == UNKNOWN:
         return track.travelled
     return track.travelled and track.seen.moved()
+
+
+def has_moved(track: Track, config: TrackerConfig) -> bool:
+    """Whether the instance is ``dynamic``: it moved while seen (``is_dynamic``), or, not of a
+    walking class, its observed surface left where it was (``SeenBox.moved``: the boxes of its
+    first and last blobs apart, no view reaching both) even if its filter never showed it
+    travelling (a part of a walker tracked as ``unknown``). Anything else is ``static`` and
+    stores no motion (``stage.at_rest``): the filter's velocity alone is no evidence."""
+    if is_dynamic(track, config):
+        return True
+    return track.class_name not in config.walker_classes and track.seen.moved()
 
 
 def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:

@@ -250,7 +250,29 @@ def refine_blobs(
     boxes = np.asarray(detection_boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0 or not blobs:
         return [b for b in blobs if not b.fragment]
-    step = config.pixel_step
+    image = (width, height)
+    out, changed = _split_all(blobs, boxes, classes, config, image)
+    if size_tolerance is not None:
+        out, changed = carve_small(out, changed, boxes, classes, config, size_tolerance, width, height)
+    if config.trim_iou < 1.0:
+        _trim_all(out, changed, boxes, config, image)
+    if config.detection_join and len(out) >= 2:
+        out, changed = _join_all(out, changed, boxes, config, image)
+    whole_blobs = [i for i, b in enumerate(out) if not b.fragment]
+    out, changed = [out[i] for i in whole_blobs], [changed[i] for i in whole_blobs]
+    if config.background_filter and support_boxes_map:
+        for blob, was_changed in zip(out, changed, strict=True):
+            if was_changed:
+                blob.support_z_m = support_below(blob, support_boxes_map, config, height)
+    return out
+
+
+def _split_all(
+    blobs: Sequence[Blob], boxes: FloatArray, classes: Sequence[str], config: RefineConfig,
+    image: tuple[int, int],
+) -> tuple[list[Blob], list[bool]]:
+    """The blobs split by the detection boxes (``detection_split``; else only twins of a class,
+    ``split_twins``), and per blob out whether it is new."""
     areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
     twins_on = config.split_twins and len(classes) == len(boxes)
 
@@ -272,60 +294,75 @@ def refine_blobs(
             out.append(blob)
             changed.append(False)
         else:
-            out.extend(sub_blob(blob, g, step, width, height) for g in groups)
+            out.extend(sub_blob(blob, g, config.pixel_step, *image) for g in groups)
             changed.extend([True] * len(groups))
-    if size_tolerance is not None:
-        out, changed = carve_small(out, changed, boxes, classes, config, size_tolerance, width, height)
+    return out, changed
+
+
+def _trim_all(
+    out: list[Blob], changed: list[bool], boxes: FloatArray, config: RefineConfig, image: tuple[int, int]
+) -> None:
+    """Trim each blob to the detection box it mostly lies in (``_trim``), in place."""
+    step = config.pixel_step
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
-    pad = np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
-    grown = boxes + pad
-    if config.trim_iou < 1.0:
-        sign = np.array([-1.0, -1.0, 1.0, 1.0])
-        trim_pad = np.tile(size * config.trim_margin_frac + step, 2) * sign
-        step_pad = step * sign
-        ious = iou_matrix(np.array([blob.image_box_xyxy for blob in out]).reshape(-1, 4), boxes)
-        for i, blob in enumerate(out):
-            if blob.fragment:
-                continue
-            keep = _trim(blob, ious[i], boxes, boxes + trim_pad, step_pad, config)
-            if keep is not None:
-                out[i] = sub_blob(blob, keep, step, width, height)
-                changed[i] = True
-    if config.detection_join and len(out) >= 2:
-        owners = [_owner(b, grown, areas, config) for b in out]
-        by_owner: dict[int, list[int]] = {}
-        for i, k in enumerate(owners):
-            if k is not None:
-                by_owner.setdefault(k, []).append(i)
-        drop: set[int] = set()
-        extra: list[Blob] = []
-        for k, members in by_owner.items():
-            if len(members) < 2:
-                continue
-            members = sorted(members, key=lambda i: -len(out[i].points_cam))
-            merged: list[list[int]] = []
-            for i in members:  # greedy: join the first group with a close member
-                for group in merged:
-                    if any(_close(out[i], out[j], config) for j in group) and _fits_better(
-                        [out[j] for j in group], out[i], boxes[k], config
-                    ):
-                        group.append(i)
-                        break
-                else:
-                    merged.append([i])
-            for group in merged:
-                if len(group) > 1:
-                    drop.update(group)
-                    whole = concat_blobs([out[j] for j in group], step, width, height)
-                    whole.fragment = len(whole.points_cam) < config.min_cluster_points
-                    extra.append(whole)
-        if drop:
-            out = [b for i, b in enumerate(out) if i not in drop] + extra
-            changed = [c for i, c in enumerate(changed) if i not in drop] + [True] * len(extra)
-    whole_blobs = [i for i, b in enumerate(out) if not b.fragment]
-    out, changed = [out[i] for i in whole_blobs], [changed[i] for i in whole_blobs]
-    if config.background_filter and support_boxes_map:
-        for blob, was_changed in zip(out, changed, strict=True):
-            if was_changed:
-                blob.support_z_m = support_below(blob, support_boxes_map, config, height)
-    return out
+    sign = np.array([-1.0, -1.0, 1.0, 1.0])
+    trim_pad = np.tile(size * config.trim_margin_frac + step, 2) * sign
+    step_pad = step * sign
+    ious = iou_matrix(np.array([blob.image_box_xyxy for blob in out]).reshape(-1, 4), boxes)
+    for i, blob in enumerate(out):
+        if blob.fragment:
+            continue
+        keep = _trim(blob, ious[i], boxes, boxes + trim_pad, step_pad, config)
+        if keep is not None:
+            out[i] = sub_blob(blob, keep, step, *image)
+            changed[i] = True
+
+
+def _join_all(
+    out: list[Blob], changed: list[bool], boxes: FloatArray, config: RefineConfig, image: tuple[int, int]
+) -> tuple[list[Blob], list[bool]]:
+    """Blobs (fragments too) that one detection box owns (``_owner``) joined where close and the
+    union fits the box better (``_close``, ``_fits_better``; greedy, largest first)."""
+    step = config.pixel_step
+    areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+    size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
+    grown = boxes + np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
+    by_owner: dict[int, list[int]] = {}
+    for i, blob in enumerate(out):
+        k = _owner(blob, grown, areas, config)
+        if k is not None:
+            by_owner.setdefault(k, []).append(i)
+    drop: set[int] = set()
+    extra: list[Blob] = []
+    for k, members in by_owner.items():
+        if len(members) < 2:
+            continue
+        largest_first = sorted(members, key=lambda i: -len(out[i].points_cam))
+        for group in _close_groups(out, largest_first, boxes[k], config):
+            if len(group) > 1:
+                drop.update(group)
+                whole = concat_blobs([out[j] for j in group], step, *image)
+                whole.fragment = len(whole.points_cam) < config.min_cluster_points
+                extra.append(whole)
+    if not drop:
+        return out, changed
+    return ([b for i, b in enumerate(out) if i not in drop] + extra,
+            [c for i, c in enumerate(changed) if i not in drop] + [True] * len(extra))
+
+
+def _close_groups(
+    out: list[Blob], members: list[int], box: FloatArray, config: RefineConfig
+) -> list[list[int]]:
+    """``members`` (indices into ``out``) in groups: each joins the first group with a close
+    member whose union fits ``box`` better, else starts its own."""
+    merged: list[list[int]] = []
+    for i in members:
+        for group in merged:
+            if any(_close(out[i], out[j], config) for j in group) and _fits_better(
+                [out[j] for j in group], out[i], box, config
+            ):
+                group.append(i)
+                break
+        else:
+            merged.append([i])
+    return merged

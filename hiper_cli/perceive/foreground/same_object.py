@@ -27,10 +27,9 @@ module decides *when* and *which way* it is asked, and what "static" means for a
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from hiper_cli.model import ROW_STAMP
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
@@ -42,10 +41,11 @@ from hiper_cli.perceive.foreground.stitch import (
     footprint_share,
     provisional_class,
 )
+from hiper_cli.perceive.foreground.track import NamedBlob
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
 __all__ = ["APART_SETTLED_NAMED", "APART_SHARE", "GROWN_FACTOR", "STACKED_SHARE", "NamedBlob", "cut_in_two",
            "due", "fold", "footprint_m2", "newer_match", "seen_apart", "static_together"]
@@ -55,15 +55,6 @@ APART_SETTLED_NAMED = 10  # named frames of each track behind a "seen apart" tha
 STACKED_SHARE = 0.5  # of the narrower detection's width, in columns both cover: one above the other
 STAMP_DECIMALS = 4  # stamps of one frame agree to well within this (0.1 ms)
 GROWN_FACTOR = 1.5  # a static track's footprint this many times what it was when last offered
-
-
-class NamedBlob(NamedTuple):
-    """The blob a detection named in one frame: which detection, and the blob's map-frame box."""
-
-    detection: int
-    lower_m: NDArray[np.float64]
-    upper_m: NDArray[np.float64]
-    xyxy_px: NDArray[np.float64] | None = None  # the detection's image box
 
 
 def footprint_m2(track: Track) -> float:

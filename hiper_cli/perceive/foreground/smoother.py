@@ -16,7 +16,7 @@ from hiper_cli.model import ROW_STAMP, ROW_STATE
 from hiper_cli.perceive.foreground.motion import process_noise
 
 if TYPE_CHECKING:
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
 __all__ = ["smooth_trajectory"]
 

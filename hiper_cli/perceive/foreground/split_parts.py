@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 
 if TYPE_CHECKING:
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
 __all__ = ["HELD_SHARE", "held_tables", "last_box"]
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -23,7 +24,7 @@ from hiper_cli.learned import (
     SizeFeature,
     feature_from_analysis,
 )
-from hiper_cli.model import Box3D, Instance, Observation
+from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, make_detector
 from hiper_cli.perceive.foreground.amodal import (
     FLOOR_STANDING,
@@ -41,7 +42,7 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
 from hiper_cli.perceive.foreground.legs import drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
-from hiper_cli.perceive.foreground.moving import is_dynamic, is_static
+from hiper_cli.perceive.foreground.moving import has_moved, is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
@@ -281,38 +282,42 @@ class ForegroundStage:
             self._ahead[id(frame)] = (frame, self._submit(frame))
 
     def process(self, frame: Frame, world: World) -> FrameResult:
-        cfg = self.config
-        t_start = time.perf_counter()
-        future: Future[tuple[Detections, float]] | None = None
+        """One frame: segment the depth into blobs, name them with the detections, measure them
+        and track them (associate, fuse, move); the changed instances and their observations."""
+        clock = [time.perf_counter()]
+        future = self._detection_of(frame)
+        self._refresh_priors(world)
+        if self.config.reidentify:
+            self._look_for_earlier(frame, world)
+        scene = self._read_background(world)
+        blobs, seg = self._segment(frame, scene)
+        clock.append(time.perf_counter())
+        dets, detect_s = self._detections(frame, future)
+        clock.append(time.perf_counter())
+        hidden = self._hidden(frame)
+        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets, hidden)
+        clock.append(time.perf_counter())
+        observations, measurements, surfaces = self._measure(frame, scene, blobs, dets, found_tables)
+        clock.append(time.perf_counter())
+        instances, merged = self._track(frame, scene, (observations, measurements, surfaces), hidden)
+        clock.append(time.perf_counter())
+        return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
+                           timings_s=_timings(clock, detect_s, seg))
+
+    def _detection_of(self, frame: Frame) -> Future[tuple[Detections, float]] | None:
+        """The detector's work on ``frame``: started ahead by ``prepare``, started now in the
+        worker, or None (``detector_threads`` off: detect in this thread)."""
         ahead = self._ahead.pop(id(frame), None)
         if ahead is not None and ahead[0] is frame:
-            future = ahead[1]
-        elif cfg.detector_threads:
-            future = self._submit(frame)
-        self._refresh_priors(world)
-        if cfg.reidentify:
-            self._look_for_earlier(frame, world)
-        boxes = [inst.box for inst in world.background.values()] if cfg.background_filter else []
-        supports = support_boxes(world.background.values())
-        walls = self._walls = _wall_boxes(world)
-        tops = support_boxes(inst for inst in world.background.values() if inst.class_name == "table")
-        self._floor_z_m = floor_height_m(world.background.values())
-        self._floor_mapped = any(inst.class_name == "floor" for inst in world.background.values())
-        if cfg.background_filter and cfg.table_leg_band_m > 0:
-            for inst in world.background.values():
-                if inst.class_name == "table":
-                    boxes.extend(table_leg_boxes(inst.box, cfg.table_leg_band_m))
-        refine = cfg.detection_split or cfg.detection_join
-        blobs, seg = segment(
-            frame.depth_m, frame.camera, frame.T_map_cam, boxes, cfg, supports,
-            keep_fragments=cfg.detection_join,
-        )
-        tables = [inst.box for inst in world.background.values() if inst.class_name == "table"]
-        if cfg.background_filter:
-            blobs = drop_table_legs(
-                blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
-            )
-        t_seg = time.perf_counter()
+            return ahead[1]
+        return self._submit(frame) if self.config.detector_threads else None
+
+    def _detections(
+        self, frame: Frame, future: Future[tuple[Detections, float]] | None
+    ) -> tuple[Detections, float]:
+        """The frame's detections (waiting for the worker), with the classes the stage names,
+        one name per box and no object carried by a person; and the detector's time (s)."""
+        cfg = self.config
         if future is not None:
             try:
                 dets, detect_s = future.result()
@@ -325,30 +330,67 @@ class ForegroundStage:
         dets = one_name_per_box(dets, cfg.same_box_iou, cfg.walker_classes)
         dets = drop_carried(dets, cfg.carried_classes, cfg.walker_classes, cfg.carried_containment,
                             cfg.min_detection_score)
-        t_det = time.perf_counter()
+        return dets, detect_s
+
+    def _read_background(self, world: World) -> _Background:
+        """What the background layer knows now, as this frame's steps read it; the walls and the
+        floor's height are kept for the boxes of the instances (``_box``, ``_stands``)."""
+        cfg = self.config
+        background = list(world.background.values())
+        self._walls = _wall_boxes(world)
+        self._floor_z_m = floor_height_m(background)
+        self._floor_mapped = any(inst.class_name == "floor" for inst in background)
+        tables = [inst for inst in background if inst.class_name == "table"]
+        dropped = [inst.box for inst in background] if cfg.background_filter else []
+        if cfg.background_filter and cfg.table_leg_band_m > 0:
+            for inst in tables:
+                dropped.extend(table_leg_boxes(inst.box, cfg.table_leg_band_m))
+        return _Background(dropped, support_boxes(background), [inst.box for inst in tables],
+                           support_boxes(tables))
+
+    def _segment(self, frame: Frame, scene: _Background) -> tuple[list[Blob], Any]:
+        """The frame's blobs (``segment.py``), without the legs of mapped tables."""
+        cfg = self.config
+        blobs, seg = segment(
+            frame.depth_m, frame.camera, frame.T_map_cam, scene.dropped, cfg, scene.supports,
+            keep_fragments=cfg.detection_join,
+        )
+        if cfg.background_filter:
+            blobs = drop_table_legs(
+                blobs, scene.tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
+            )
+        return blobs, seg
+
+    def _split_and_refine(
+        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections, hidden: Any
+    ) -> tuple[list[Blob], list[Blob], Detections]:
+        """The blobs split from the tables the background has not mapped (``tables.py``), and
+        trimmed and joined with the detections (``refine.py``); those tables' blobs; the
+        detections without those that named a table (none names what remains of its blob)."""
+        cfg = self.config
+        width, height = frame.camera.width, frame.camera.height
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
-        found_tables: list[Blob] = []
-        hidden = self._hidden(frame)
         names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
+        found_tables: list[Blob] = []
         if cfg.background_filter:
-            blobs, found_tables, lookalikes = split_unseen_tables(
-                blobs, usable, names, cfg, frame.camera.width, frame.camera.height
-            )
-            if lookalikes:  # each named a table: none names what remains of its blob
+            blobs, found_tables, lookalikes = split_unseen_tables(blobs, usable, names, cfg, width, height)
+            if lookalikes:
                 dets, ok, usable, names = _without(dets, ok, np.flatnonzero(ok)[lookalikes])
-            found_tables = join_hidden_pieces(
-                found_tables, hidden, cfg, frame.camera.width, frame.camera.height
-            )
+            found_tables = join_hidden_pieces(found_tables, hidden, cfg, width, height)
             if cfg.table_rim_depth_m > 0:
-                blobs = drop_table_legs(
-                    blobs, tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height, rims=True
-                )
-        if refine:
-            blobs = refine_blobs(blobs, usable, cfg, frame.camera.width, frame.camera.height, supports,
-                                 classes=names,
+                blobs = drop_table_legs(blobs, scene.tables, cfg, cfg.pixel_step, width, height, rims=True)
+        if cfg.detection_split or cfg.detection_join:
+            blobs = refine_blobs(blobs, usable, cfg, width, height, scene.supports, classes=names,
                                  size_tolerance=cfg.class_size_tolerance if cfg.class_sizes else None)
-        t_refine = time.perf_counter()
+        return blobs, found_tables, dets
+
+    def _measure(
+        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections, found_tables: list[Blob]
+    ) -> tuple[list[Observation], list[Measurement], list[FloatArray | None]]:
+        """Per blob kept: its observation, its measurement for the tracker and its map points
+        (None for a walker's: no surface is kept of what moves)."""
+        cfg = self.config
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
             dets,
@@ -360,73 +402,99 @@ class ForegroundStage:
             matches = detected_blobs(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
-        surfaces: list[FloatArray | None] = []  # per observation: its blob's map points, not a walker's
+        surfaces: list[FloatArray | None] = []
         for blob, match in zip(blobs, matches, strict=True):
-            if cfg.couch_or_bed and match.class_name in (COUCH, BED):
-                match = self._couch_or_bed(match, blob)
             flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
-            longest = None
-            if match.detection_index is not None and cfg.class_sizes:
-                longest = longest_m(blob.points_map, float(blob.extent_map_m[2]))
-            if match.detection_index is not None and not (
-                self._fits_priors(match.class_name, blob, frame)
-                and self._stands(match.class_name, blob, flat)
-                and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
-                and (match.class_name not in cfg.fixture_classes
-                     or attached(blob.points_map, walls, tops, cfg.fixture_reach_m))
-            ):
-                match = Match(cfg.unknown_class, 0.0, None, match.iou)
-                longest = None
-            if longest is not None and min_longest_m(match.class_name, cfg.class_size_tolerance) > 0 and (
-                not inside_image(blob, cfg.pixel_step, frame.camera)
-                or occluded(blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step)
-            ):
-                longest = None  # cut by the border or hidden in part: no view of its whole length
+            match, longest = self._judged(frame, scene, blob, match, flat)
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
-            full = cfg.refused_min_views > 0 and in_full_view(
-                blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, cfg.full_view_min_px2
-            )
-            walker = match.class_name in cfg.walker_classes
-            named_px = None if match.detection_index is None else dets.xyxy[match.detection_index]
             observations.append(obs)
-            surfaces.append(None if walker else blob.points_map)
-            measurements.append(
-                Measurement(
-                    blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
-                    whole=match.detection_index is not None
-                    or seen_whole(blob, cfg, frame.camera, (frame.depth_m, frame.T_map_cam)),
-                    appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
-                    standing=self._standing_box(blob),  # a walking track takes any blob as standing
-                    bounds_map_m=_corners(blob),
-                    longest_m=longest,
-                    solid=not flat,
-                    detection_index=match.detection_index,
-                    detection_xyxy_px=named_px,
-                    viewpoint_map_m=frame.T_map_cam[:3, 3],
-                    top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
-                    and top_hidden(blob, frame.depth_m, cfg.pixel_step),
-                    bottom_hidden=cfg.complete_footprints and match.class_name in FLOOR_STANDING
-                    and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
-                    full_view=full,
-                    named_within=named_within(
-                        blob.image_box_xyxy, dets, min_score=cfg.min_detection_score,
-                        min_cover=cfg.full_view_cover,
-                    ) if full else frozenset(),
-                    cut_from_table_m=blob.cut_from_table_m,
-                )
-            )
+            surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
+            measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
         for blob in found_tables if cfg.unseen_table_instances else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
             surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
-        t_match = time.perf_counter()
+        return observations, measurements, surfaces
+
+    def _judged(
+        self, frame: Frame, scene: _Background, blob: Blob, match: Match, flat: bool
+    ) -> tuple[Match, float | None]:
+        """``match`` as the checks of a named class leave it (couch or bed; else ``unknown``
+        when the class's learned priors, standing, size or attachment rule the blob out), and
+        the blob's longest side when it tells the class's size (seen whole; else None)."""
+        cfg = self.config
+        if cfg.couch_or_bed and match.class_name in (COUCH, BED):
+            match = self._couch_or_bed(match, blob)
+        if match.detection_index is None:
+            return match, None
+        longest = longest_m(blob.points_map, float(blob.extent_map_m[2])) if cfg.class_sizes else None
+        if not (
+            self._fits_priors(match.class_name, blob, frame)
+            and self._stands(match.class_name, blob, flat)
+            and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
+            and (match.class_name not in cfg.fixture_classes
+                 or attached(blob.points_map, self._walls, scene.tops, cfg.fixture_reach_m))
+        ):
+            return Match(cfg.unknown_class, 0.0, None, match.iou), None
+        if longest is not None and min_longest_m(match.class_name, cfg.class_size_tolerance) > 0 and (
+            not inside_image(blob, cfg.pixel_step, frame.camera)
+            or occluded(blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step)
+        ):
+            longest = None  # cut by the border or hidden in part: no view of its whole length
+        return match, longest
+
+    def _measurement(
+        self, frame: Frame, blob: Blob, match: Match, dets: Detections,
+        seen: tuple[Observation, float | None, bool],
+    ) -> Measurement:
+        """The tracker's measurement of a blob; ``seen``: its observation, its longest side
+        (``_judged``) and whether it is flat (``solid.is_flat``)."""
+        cfg = self.config
+        obs, longest, flat = seen
+        full = cfg.refused_min_views > 0 and in_full_view(
+            blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, cfg.full_view_min_px2
+        )
+        walker = match.class_name in cfg.walker_classes
+        return Measurement(
+            blob.center_map_m, blob.extent_map_m, match.class_name, match.score, obs.uuid,
+            whole=match.detection_index is not None
+            or seen_whole(blob, cfg, frame.camera, (frame.depth_m, frame.T_map_cam)),
+            appearance=histogram(frame.rgb, blob.pixels_uv) if walker else None,
+            standing=self._standing_box(blob),  # a walking track takes any blob as standing
+            bounds_map_m=_corners(blob),
+            longest_m=longest,
+            solid=not flat,
+            detection_index=match.detection_index,
+            detection_xyxy_px=None if match.detection_index is None else dets.xyxy[match.detection_index],
+            viewpoint_map_m=frame.T_map_cam[:3, 3],
+            top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
+            and top_hidden(blob, frame.depth_m, cfg.pixel_step),
+            bottom_hidden=cfg.complete_footprints and match.class_name in FLOOR_STANDING
+            and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
+            full_view=full,
+            named_within=named_within(
+                blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=cfg.full_view_cover,
+            ) if full else frozenset(),
+            cut_from_table_m=blob.cut_from_table_m,
+        )
+
+    def _track(
+        self, frame: Frame, scene: _Background,
+        measured: tuple[list[Observation], list[Measurement], list[FloatArray | None]], hidden: Any,
+    ) -> tuple[list[Instance], list[str]]:
+        """Track the frame's measurements; their observations get their instance, the tracks'
+        surfaces their points. The instances changed and the uuids of those merged away (a
+        track stitched into another, one whose evidence failed, a table the background mapped)."""
+        cfg = self.config
+        observations, measurements, surfaces = measured
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
         tables_withdrawn = (
-            withdraw_mapped(self.tracker, tables, cfg.table_leg_reach_m) if cfg.unseen_table_instances else []
+            withdraw_mapped(self.tracker, scene.tables, cfg.table_leg_reach_m)
+            if cfg.unseen_table_instances else []
         )
         if tables_withdrawn:  # the background layer mapped them: its instance is the table
             changed = [t for t in changed if t.uuid not in tables_withdrawn]
@@ -445,27 +513,8 @@ class ForegroundStage:
         instances = [self._instance(t) for t in changed]
         # a track closed for good has its instance's surface already (tentative ones: none)
         self._surfaces.keep({t.uuid for t in (*self.tracker.tracks, *self.tracker.dormant)})
-        # a track stitched into another after it became an instance (merged away), one whose
-        # evidence failed (``unknown_evidence_held``), or a table the background mapped
         gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn, *pieces]
-        merged = [u for u in gone if self._instances.pop(u, None) is not None]
-        t_end = time.perf_counter()
-        timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}
-        timings.update(
-            {
-                "foreground_segment_s": t_seg - t_start,
-                "foreground_detect_s": detect_s,
-                "foreground_detect_wait_s": t_det - t_seg,
-                "foreground_refine_s": t_refine - t_det,
-                "foreground_match_s": t_match - t_refine,
-                "foreground_track_s": t_end - t_match,
-                "foreground_s": t_end - t_start,
-                "foreground_points": float(seg.points),
-                "foreground_points_after_background": float(seg.after_background),
-            }
-        )
-        return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
-                           timings_s=timings)
+        return instances, [u for u in gone if self._instances.pop(u, None) is not None]
 
     def finish(self, world: World) -> FrameResult:
         tracks = [*self.tracker.tracks, *self.tracker.dormant]
@@ -570,7 +619,7 @@ class ForegroundStage:
         )
 
     def _instance(self, track: Track) -> Instance:
-        state = "dynamic" if is_dynamic(track, self.tracker.config) else "static"
+        state = "dynamic" if has_moved(track, self.tracker.config) else "static"
         box = self._box(track)
         inst = self._instances.get(track.uuid)
         if inst is None:
@@ -589,6 +638,9 @@ class ForegroundStage:
         inst.box = box
         inst.last_seen_s = track.last_update_s
         inst.state = state  # type: ignore[assignment]
+        # motion needs evidence: a static object stood at its fused centre all along, whatever
+        # the filter read from its partial views (its stored speed is 0, its path a point)
+        inst.data["trajectory"] = track.trajectory if state == "dynamic" else at_rest(track.trajectory, box)
         inst.confidence = track.confidence
         inst.data["closed"] = track.closed
         if track.closed and self._stays(inst) and (points := self._surfaces.of(track.uuid)):
@@ -661,6 +713,48 @@ def _without(
     kept = dets.subset(keep)
     ok = ok[keep]
     return kept, ok, kept.xyxy[ok], [n for n, k in zip(kept.class_names, ok, strict=True) if k]
+
+
+@dataclass(frozen=True)
+class _Background:
+    """The background layer as one frame's foreground steps read it (map frame)."""
+
+    dropped: list[Box3D]  # boxes whose points are background (with the bands of table legs)
+    supports: list[Box3D]  # floors and table tops objects stand on (``support_boxes``)
+    tables: list[Box3D]  # the mapped tables' boxes
+    tops: list[Box3D]  # the mapped tables' tops
+
+
+def _timings(clock: list[float], detect_s: float, seg: Any) -> dict[str, float]:
+    """The frame's timings (s) from the ``process`` clock: start, segmented, detected, refined,
+    measured, tracked."""
+    start, segmented, detected, refined, measured, tracked = clock
+    timings = {f"foreground_{k}": v for k, v in seg.timings_s.items()}
+    timings.update(
+        {
+            "foreground_segment_s": segmented - start,
+            "foreground_detect_s": detect_s,
+            "foreground_detect_wait_s": detected - segmented,
+            "foreground_refine_s": refined - detected,
+            "foreground_match_s": measured - refined,
+            "foreground_track_s": tracked - measured,
+            "foreground_s": tracked - start,
+            "foreground_points": float(seg.points),
+            "foreground_points_after_background": float(seg.after_background),
+        }
+    )
+    return timings
+
+
+def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
+    """Trajectory rows of an object that did not move: one per row of ``rows`` (the stamps it was
+    seen at), each at the centre of ``box`` with no velocity."""
+    if not rows:
+        return []
+    out = np.zeros((len(rows), len(rows[0])), dtype=np.float64)
+    out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
+    out[:, ROW_POSITION] = box.center_m
+    return out.tolist()
 
 
 def _wall_boxes(world: World) -> list[Box3D]:

@@ -37,7 +37,7 @@ from hiper_cli.perceive.foreground.class_vote import UNKNOWN, absorb_votes
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.config import TrackerConfig
-    from hiper_cli.perceive.foreground.tracking import Track
+    from hiper_cli.perceive.foreground.track import Track
 
 __all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "common_distance_m", "find_target", "footprint_share",
            "gap_ok", "provisional_class", "stale_rows"]

@@ -304,9 +304,9 @@ def open_bag(path: Path, kind: str, *, poses: Trajectory | None, camera: CameraI
         reader.close()
 
 
-def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory | None,
-           camera: CameraIntrinsics | None, max_dt_s: float, topics: BagTopics) -> BagReader:
-    found = _collect(reader)
+def _image_topics(path: Path, found: dict[str, Any], reader: Any, topics: BagTopics) -> tuple[str, str]:
+    """The colour and depth image topics: as given, else the colour-looking image topic and
+    the depth-looking one nearest its name; their first messages read, their encodings checked."""
     images = [t for t in found.values() if t.msgtype in (IMAGE, COMPRESSED)]
     for t in images:
         t.first = _first(reader, t.topic)
@@ -327,10 +327,15 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
         if found[topic].first is None:
             found[topic].first = _first(reader, topic)
         _check_encoding(found[topic], role, path)
-    camera_frame = (topics.camera_frame or str(found[rgb_topic].first.header.frame_id)).lstrip("/")
-    sources = {"rgb": f"{path} {rgb_topic}", "depth": f"{path} {depth_topic}"}
+    return rgb_topic, depth_topic
 
-    # camera intrinsics
+
+def _intrinsics(path: Path, found: dict[str, Any], reader: Any, topics: BagTopics,
+                camera: CameraIntrinsics | None, images: tuple[str, str], sources: dict[str, str]
+                ) -> CameraIntrinsics:
+    """The camera's intrinsics (given, else from the CameraInfo topic nearest the colour topic;
+    ``sources["camera"]`` says which), checked against the sizes of the ``images`` topics."""
+    rgb_topic, depth_topic = images
     if camera is None:
         infos = [t.topic for t in found.values() if t.msgtype == CAMERA_INFO]
         info_topic = _pick(path, found, topics.info_topic, (CAMERA_INFO,), "info", _near(rgb_topic, infos))
@@ -351,16 +356,25 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
         raise LogError(f"{path}: colour topic '{rgb_topic}' is {rgb_size[0]}×{rgb_size[1]} but the "
                        f"intrinsics ({sources['camera']}) are for {camera.width}×{camera.height}; pass "
                        "--info-topic of the colour camera or the right --camera")
+    return camera
 
-    # colour and depth stamps (headers only), detections, poses: one pass
+
+_PoseRows = dict[str, list[tuple[float, NDArray[np.float64], str]]]
+
+
+def _read_headers(
+    reader: Any, ros1: bool, path: Path, found: dict[str, Any], images: tuple[str, str], det_topic: str | None
+) -> tuple[dict[str, list[float]], dict[str, list[tuple[int, int]]], TfTree, _PoseRows,
+           list[tuple[float, Detections]]]:
+    """One pass over the bag: the colour and depth stamps (headers only) and places (bag time,
+    rank), the tf tree, the pose rows per topic and the detections."""
     wanted_types = {TF, ODOMETRY, DETECTIONS, *POSE_TYPES}
-    stream = {t.topic for t in found.values() if t.msgtype in wanted_types} | {rgb_topic, depth_topic}
-    det_topic = _pick(path, found, topics.detections_topic, (DETECTIONS,), "detections")
-    stamps: dict[str, list[float]] = {rgb_topic: [], depth_topic: []}
-    places: dict[str, list[tuple[int, int]]] = {rgb_topic: [], depth_topic: []}  # (bag time, rank)
+    stream = {t.topic for t in found.values() if t.msgtype in wanted_types} | set(images)
+    stamps: dict[str, list[float]] = {topic: [] for topic in images}
+    places: dict[str, list[tuple[int, int]]] = {topic: [] for topic in images}  # (bag time, rank)
     ranks: dict[tuple[str, int], int] = {}
     tf = TfTree()
-    pose_rows: dict[str, list[tuple[float, NDArray[np.float64], str]]] = {}
+    pose_rows: _PoseRows = {}
     det_rows: list[tuple[float, Detections]] = []
     conns = [c for c in reader.connections if c.topic in stream]
     for conn, time_ns, raw in reader.messages(connections=conns):
@@ -385,7 +399,19 @@ def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory 
             pose = msg.pose.pose if hasattr(msg.pose, "covariance") else msg.pose
             pose_rows.setdefault(conn.topic, []).append(
                 (_stamp(msg.header), pose_msg_to_matrix(pose, where), ""))
+    return stamps, places, tf, pose_rows, det_rows
 
+
+def _index(path: Path, kind: str, reader: Any, ros1: bool, *, poses: Trajectory | None,
+           camera: CameraIntrinsics | None, max_dt_s: float, topics: BagTopics) -> BagReader:
+    found = _collect(reader)
+    rgb_topic, depth_topic = _image_topics(path, found, reader, topics)
+    camera_frame = (topics.camera_frame or str(found[rgb_topic].first.header.frame_id)).lstrip("/")
+    sources = {"rgb": f"{path} {rgb_topic}", "depth": f"{path} {depth_topic}"}
+    camera = _intrinsics(path, found, reader, topics, camera, (rgb_topic, depth_topic), sources)
+    det_topic = _pick(path, found, topics.detections_topic, (DETECTIONS,), "detections")
+    stamps, places, tf, pose_rows, det_rows = _read_headers(reader, ros1, path, found,
+                                                            (rgb_topic, depth_topic), det_topic)
     rgb_s = np.array(stamps[rgb_topic])
     depth_s = np.array(stamps[depth_topic])
     rgb_order, depth_order = np.argsort(rgb_s, kind="stable"), np.argsort(depth_s, kind="stable")
