@@ -32,6 +32,9 @@ def mcp_command(
         Path | None,
         typer.Option("--out", "-o", help="Folder for the heatmap tool's files (default: a temp dir)."),
     ] = None,
+    timeout_s: Annotated[
+        float, typer.Option("--timeout", help="Give up on a sparql tool query after this many seconds.")
+    ] = 30.0,
 ) -> None:
     """Serve the query verbs as MCP tools (find, count, last_seen, when, trajectory, workspace,
     describe, features, heatmap, sparql, ask) and resources (vocabulary, summary); read-only.
@@ -46,7 +49,7 @@ def mcp_command(
     require_mcp()
     address = _host_port(http) if http is not None else None
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
-        ctx = ToolContext(knowledge, out_dir)
+        ctx = ToolContext(knowledge, out_dir, timeout_s)
         if address is None:
             run_stdio(ctx)
             return
