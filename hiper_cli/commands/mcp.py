@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
+from hiper_cli.commands._render import safe_text
 from hiper_cli.errors import ConfigError
 
 __all__ = ["register"]
@@ -56,7 +57,7 @@ def mcp_command(
         import sys
 
         def ready() -> None:
-            print(f"hiper mcp: serving {knowledge.location} at http://{address[0]}:{address[1]}/mcp",
+            print(f"hiper mcp: serving {safe_text(knowledge.location, markup=False)} at http://{address[0]}:{address[1]}/mcp",
                   file=sys.stderr, flush=True)
 
         with contextlib.suppress(KeyboardInterrupt):
