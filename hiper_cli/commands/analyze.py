@@ -104,7 +104,7 @@ def features_command(
     from hiper_cli.analyze import learn_features
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         window = _window(knowledge, t_from, t_to, last, daily)
         report, stored = learn_features(knowledge, class_name or None, window, store=not no_store)
     plot_path = None
@@ -155,7 +155,7 @@ def heatmap_command(
     from hiper_cli.analyze import generate_heatmap
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         window = _window(knowledge, t_from, t_to, last, daily)
         result = generate_heatmap(
             knowledge, class_name, window, out_dir, env_name=env, map_yaml=map_yaml, inverse=inverse
@@ -199,7 +199,7 @@ def map_command(
     from hiper_cli.analyze import export_map
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         data = export_map(knowledge, out, env_name=env, map_yaml=map_yaml, resolution_m=resolution_m)
     if as_json:
         print_json(data)
