@@ -84,7 +84,8 @@ EDITED_EXPORTS: dict[str, Callable[[dict[str, Any]], Any]] = {
     "coordinate-huge": _raw('"center_m": [', '"center_m": [1' + "0" * 400 + ", "),
     "class-lone-surrogate": _raw('"class": "', '"class": "\\ud800'),
     "class-too-long": _first("class", "x" * 5000),
-    "observation-stamp-text": lambda d: d["observations"][0].__setitem__("stamp_s", "noon"),
+    "last-seen-text": _first("last_seen_s", "noon"),
+    "observation-uuids-not-uuids": _first("observation_uuids", ["x"]),
 }
 
 

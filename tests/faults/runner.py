@@ -17,6 +17,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -288,18 +289,20 @@ def _kill_command(kind: str, ws: Workspace) -> list[str]:
 
 
 KILL_ATTEMPTS = 3
+_TIMING = threading.Lock()
 KILLS_SPREAD = 10  # the moments of one kind are spread over this many slices of its run
 
 
 def _duration(kind: str, repo: Path, cache: Path) -> float:
     """Seconds an uninterrupted run of the kill case's command takes here (measured once)."""
     timing = cache / f"duration-{kind}.txt"
-    if not timing.is_file():
-        with tempfile.TemporaryDirectory(prefix="hiper-time-") as tmp:
-            ws = Workspace(Path(tmp), cache, repo)
-            result = run_hiper(repo, _kill_command(kind, ws), ws.root, 300.0)
-        timing.write_text(str(result.seconds))
-    return float(timing.read_text())
+    with _TIMING:  # measured once, by one thread: the others wait for it
+        if not timing.is_file():
+            with tempfile.TemporaryDirectory(prefix="hiper-time-") as tmp:
+                ws = Workspace(Path(tmp), cache, repo)
+                result = run_hiper(repo, _kill_command(kind, ws), ws.root, 300.0)
+            timing.write_text(str(result.seconds))
+        return float(timing.read_text())
 
 
 def kill_case(kind: str, index: int, repo: Path, cache: Path, totals: dict[str, Any]) -> Outcome:

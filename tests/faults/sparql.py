@@ -119,12 +119,12 @@ def cases() -> list[Case]:
     out = [
         Case(f"sparql/{name}", "sparql", _query(text), "error",
              "refused from the parsed query: one line, no request reaches the listener",
-             prepare=prepare_listener, check=no_request)
+             prepare=prepare_listener, check=no_request, kb="unchanged")
         for name, text in SERVICE_SPELLINGS.items()
     ]
     out += [
         Case(f"sparql/{name}", "sparql", _query(text), "error", "refused: the scene graph is read-only",
-             prepare=prepare_listener, check=no_request)
+             prepare=prepare_listener, check=no_request, kb="unchanged")
         for name, text in UPDATES.items()
     ]
     out += [
