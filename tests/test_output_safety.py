@@ -107,3 +107,25 @@ def test_host_allow_list():
     assert not host_allowed("attacker.example:7879", loopback)
     assert not host_allowed(None, loopback)
     assert host_allowed("robot.lan", allowed_hosts("127.0.0.1", ["robot.lan"]))
+
+
+def test_parsing_is_safe_from_many_threads():
+    """rdflib's grammar is not thread-safe; a threaded server parses under a lock (without it,
+    concurrent parses fail with TypeError and good queries were refused)."""
+    import threading
+
+    errors: list[str] = []
+
+    def parse(query: str) -> None:
+        try:
+            readonly_form(query)
+        except QueryError as err:
+            errors.append(str(err))
+
+    threads = [threading.Thread(target=parse, args=(q,))
+               for q in ["SELECT (COUNT(*) AS ?n) WHERE { ?a ?b ?c . ?d ?e ?f }", "ASK {}"] * 10]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors

@@ -22,6 +22,9 @@ DEFAULT_TIMEOUT_S = 30.0
 _FORMS = {"SelectQuery": "SELECT", "AskQuery": "ASK", "ConstructQuery": "CONSTRUCT",
           "DescribeQuery": "DESCRIBE"}
 T = TypeVar("T")
+# rdflib's pyparsing grammar is not thread-safe (packrat cache, lazy module set-up): a threaded
+# server parses one query at a time (each takes milliseconds; evaluation stays parallel)
+_PARSING = threading.Lock()
 
 
 def readonly_form(sparql: str, prefixes: str = "") -> str:
@@ -31,19 +34,20 @@ def readonly_form(sparql: str, prefixes: str = "") -> str:
     from rdflib.plugins.sparql.parser import parseQuery, parseUpdate
 
     text = prefixes + sparql
-    try:
-        tree = parseQuery(text)
-    except (ParseBaseException, RecursionError, ValueError, TypeError) as err:
+    with _PARSING:
         try:
-            parseUpdate(text)
-        except (ParseBaseException, RecursionError, ValueError, TypeError):
-            raise QueryError(f"SPARQL query does not parse: {_one_line(err)}") from None
-        raise QueryError("SPARQL update refused: the scene graph is read-only here; send a SELECT, "
-                         "ASK, CONSTRUCT or DESCRIBE query") from None
-    try:
-        service = _has_service(tree)
-    except RecursionError:
-        raise QueryError("SPARQL query nested too deeply") from None
+            tree = parseQuery(text)
+        except (ParseBaseException, RecursionError, ValueError, TypeError) as err:
+            try:
+                parseUpdate(text)
+            except (ParseBaseException, RecursionError, ValueError, TypeError):
+                raise QueryError(f"SPARQL query does not parse: {_one_line(err)}") from None
+            raise QueryError("SPARQL update refused: the scene graph is read-only here; send a SELECT, "
+                             "ASK, CONSTRUCT or DESCRIBE query") from None
+        try:
+            service = _has_service(tree)
+        except RecursionError:
+            raise QueryError("SPARQL query nested too deeply") from None
     if service:
         raise QueryError("SPARQL SERVICE (federated query) refused: only this knowledge base is queried")
     return _FORMS.get(getattr(tree[1], "name", ""), "SELECT")

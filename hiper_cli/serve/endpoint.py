@@ -26,7 +26,7 @@ from typing import Any
 
 from hiper_cli.errors import ConfigError, HiperError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S
+from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S, readonly_form
 
 MAX_BODY_BYTES = 1 << 20  # a query is text: a megabyte is far beyond any real one
 READ_TIMEOUT_S = 10.0  # a client that declares more body than it sends is dropped after this
@@ -117,6 +117,7 @@ class SparqlEndpoint:
         self.timeout_s = timeout_s
         self.hosts = allowed_hosts(host, hosts)
         self._running = threading.BoundedSemaphore(MAX_RUNNING)
+        readonly_form("ASK {}")  # loads the SPARQL grammar now, not in the first requests' threads
         try:
             self._server = ThreadingHTTPServer((host, port), _handler(self))
         except (OSError, OverflowError) as err:

@@ -182,7 +182,8 @@ def _parallel(server: Server, ws: Workspace) -> None:
     thread.join(90)
     reply = slow.get("reply")
     server.expect(f"the slow query stopped by --timeout with 503 ({reply.status if reply else None}, "
-                  f"{reply.seconds if reply else 0:.1f} s)", reply is not None and reply.status == 503
+                  f"{reply.seconds if reply else 0:.1f} s, {reply.body[:200] if reply else ''!r})",
+                  reply is not None and reply.status == 503
                   and reply.seconds < 30)
 
 
