@@ -47,7 +47,7 @@ def test_fault_case(case: Case, outcomes: dict[str, Outcome]) -> None:
 
 
 @pytest.mark.parametrize("kind", KILL_KINDS)
-def test_kill_minus_nine_at_random_instants(kind: str, fault_cache: tuple[Path, dict[str, Any]]) -> None:
+def test_kill_minus_nine_at_ten_moments(kind: str, fault_cache: tuple[Path, dict[str, Any]]) -> None:
     cache, totals = fault_cache
     with ThreadPoolExecutor(WORKERS) as pool:
         runs = list(pool.map(lambda i: kill_case(kind, i, REPO, cache, totals), range(KILLS_PER_KIND)))

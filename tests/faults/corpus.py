@@ -34,5 +34,5 @@ def all_cases() -> list[Case]:
     return [case for category in CATEGORIES for case in category.cases()]
 
 
-KILL_KINDS = ("perceive", "export", "import", "analyze", "reanchor")
+KILL_KINDS = ("perceive", "export", "import", "analyze", "reanchor", "check")
 KILLS_PER_KIND = 10

@@ -279,6 +279,14 @@ def _kill_command(kind: str, ws: Workspace) -> list[str]:
         shutil.copy(ws.cache / "export.json", ws.root / "out.json")
         return ["export", str(ws.root / "out.json"), "--kb", values["kb"], "--format", "json",
                 "--observations"]
+    if kind == "startup":  # what every command pays before it touches the knowledge base
+        return ["kb", "info", "--help"]
+    if kind == "check":  # a damaged scene graph, rebuilt from the documents by kb check
+        from tests.faults.inputs import damage_graph
+
+        shutil.copytree(ws.cache / "template.hiper", ws.kb)
+        damage_graph(ws.kb, "sst")
+        return ["kb", "check", "--kb", values["kb"]]
     if kind == "analyze":
         shutil.copytree(ws.cache / "template.hiper", ws.kb)
         return ["analyze", "features", "--kb", values["kb"], "--json"]
@@ -306,7 +314,8 @@ def _duration(kind: str, repo: Path, cache: Path) -> float:
 
 
 def kill_case(kind: str, index: int, repo: Path, cache: Path, totals: dict[str, Any]) -> Outcome:
-    """Start a perceive, export, import, analyze or reanchor, kill -9 it at the ``index``-th of
+    """Start a perceive, export, import, analyze, reanchor or kb check (rebuilding a damaged
+    graph; a second kb check must finish the repair), kill -9 it at the ``index``-th of
     ten moments of its run, and check that the knowledge base reopens consistent (``kb check``)
     with nothing committed lost, and that an export target holds either the earlier export or a
     complete new one.
@@ -315,10 +324,12 @@ def kill_case(kind: str, index: int, repo: Path, cache: Path, totals: dict[str, 
     measured) is checked too, then tried again with an instant drawn within its own duration."""
     rng = random.Random(f"{kind}-{index}")
     duration = _duration(kind, repo, cache)
-    # ten moments spread over the run (the first ~0.4 s is Python starting), a little jitter
-    share = 0.25 + 0.7 * (index + rng.uniform(0.0, 1.0)) / max(1, KILLS_SPREAD)
+    # ten moments spread over the run after Python has started and imported hiper (a kill
+    # before that tests nothing), each jittered within its tenth
+    startup = min(_duration("startup", repo, cache), 0.8 * duration)
+    share = (index + rng.uniform(0.05, 0.95)) / max(1, KILLS_SPREAD)
     for _attempt in range(KILL_ATTEMPTS):
-        delay = min(share, 0.97) * duration
+        delay = startup + min(share, 0.97) * (duration - startup)
         outcome = _kill_once(kind, index, delay, repo, cache, totals)
         if outcome.verdict != "pass" or outcome.exit_code == -signal.SIGKILL:
             return outcome
@@ -354,7 +365,11 @@ def _kill_once(kind: str, index: int, delay: float, repo: Path, cache: Path,
             except (OSError, ValueError) as err_json:
                 problems.append(f"lost: the export file is damaged ({err_json})")
         elif ws.kb.exists() and (ws.kb / "documents.sqlite").exists():
-            problems += kb_problems(repo, ws.kb, ws.root, None)
+            if kind == "check":  # killed while rebuilding a damaged graph: the next check finishes it
+                repair = run_hiper(repo, ["kb", "check", "--kb", str(ws.kb)], ws.root, 120.0)
+                if repair.returncode != 0:
+                    problems.append(f"kb check after the kill failed: {_last_line(repair)}")
+            problems += kb_problems(repo, ws.kb, ws.root, totals if kind == "check" else None)
             if kind == "import":
                 state = kb_state(repo, ws.kb, ws.root)
                 if state and state["totals"]["instance"] not in (0, totals["totals"]["instance"]):
