@@ -26,7 +26,7 @@ from typing import Any
 
 from hiper_cli.errors import ConfigError, HiperError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S, readonly_form
+from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S, readonly_form, run_with_timeout
 
 MAX_BODY_BYTES = 1 << 20  # a query is text: a megabyte is far beyond any real one
 READ_TIMEOUT_S = 10.0  # a client that declares more body than it sends is dropped after this
@@ -134,10 +134,14 @@ class SparqlEndpoint:
         """Run one query; ``HiperError`` when refused, too slow or too many are running."""
         if not self._running.acquire(blocking=False):
             raise _Busy(f"{MAX_RUNNING} queries are running; try again shortly")
-        try:
-            return self.kb.run_readonly(sparql, media_type, timeout_s=self.timeout_s)
-        finally:
-            self._running.release()
+
+        def evaluate() -> tuple[bytes, str]:  # holds its slot until the evaluation really ends,
+            try:  # also after the client was answered 503 (pyoxigraph cannot be interrupted)
+                return self.kb.run_readonly(sparql, media_type, timeout_s=None)
+            finally:
+                self._running.release()
+
+        return run_with_timeout(evaluate, self.timeout_s)
 
     def start(self) -> SparqlEndpoint:
         """Serve in a background thread (tests, notebooks)."""
