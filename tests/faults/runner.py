@@ -140,7 +140,8 @@ def kb_problems(repo: Path, kb: Path, cwd: Path, expected: dict[str, Any] | None
     --no-repair`` fails, or (``expected``) it holds other documents than the template."""
     state = kb_state(repo, kb, cwd)
     if state is None:
-        return ["the knowledge base does not open any more"]
+        why = _last_line(run_hiper(repo, ["kb", "info", "--kb", str(kb)], cwd, 60.0))
+        return [f"the knowledge base does not open any more ({why})"]
     check = run_hiper(repo, ["kb", "check", "--no-repair", "--kb", str(kb)], cwd, 60.0)
     problems = [] if check.returncode == 0 else [f"kb check --no-repair: {_last_line(check)}"]
     if expected is not None and state != expected:
