@@ -110,6 +110,9 @@ class PerceiveOptions:
         ``overrides[stage][key]`` beats the same ``-o`` key (a dedicated flag such as
         ``--detector``); an override whose value is ``None`` was not given and is ignored.
         """
+        if env_name is not None and not env_name.strip():
+            raise ConfigError(f"--env {env_name!r}: expected a name for the environment (default: the log "
+                              "folder's name)")
         merged = parse_stage_options(options)
         for stage, values in (overrides or {}).items():
             for key, value in values.items():

@@ -100,19 +100,40 @@ class CameraIntrinsics:
         missing = [k for k in ("width", "height", "fx", "fy", "cx", "cy") if k not in data]
         if missing:
             raise DataError(f"{source}: missing keys {missing}; expected width, height, fx, fy, cx, cy")
-        try:
-            return cls(
-                width=int(data["width"]),
-                height=int(data["height"]),
-                fx=float(data["fx"]),
-                fy=float(data["fy"]),
-                cx=float(data["cx"]),
-                cy=float(data["cy"]),
-                depth_scale=float(data.get("depth_scale", 5000.0)),
-                distortion=tuple(float(v) for v in data.get("distortion", ()) or ()),
-            )
-        except (TypeError, ValueError) as err:
-            raise DataError(f"{source}: {err}") from err
+        width = int(_camera_number(data, "width", source, 1, 16384, integer=True))
+        height = int(_camera_number(data, "height", source, 1, 16384, integer=True))
+        distortion = data.get("distortion") or []
+        if not isinstance(distortion, list) or len(distortion) > 14:
+            raise DataError(f"{source}: 'distortion' is {str(distortion)[:40]!r}; expected a list of at most "
+                            "14 OpenCV coefficients")
+        return cls(
+            width=width,
+            height=height,
+            fx=_camera_number(data, "fx", source, 1e-3, 1e6),
+            fy=_camera_number(data, "fy", source, 1e-3, 1e6),
+            cx=_camera_number(data, "cx", source, 0.0, float(width)),
+            cy=_camera_number(data, "cy", source, 0.0, float(height)),
+            depth_scale=_camera_number({"depth_scale": 5000.0, **data}, "depth_scale", source, 1e-3, 1e7),
+            distortion=tuple(_camera_number({"k": v}, "k", f"{source}: distortion", -1e6, 1e6)
+                             for v in distortion),
+        )
+
+
+def _camera_number(data: dict[str, Any], key: str, source: str, lo: float, hi: float, *,
+                   integer: bool = False) -> float:
+    """``data[key]`` as a JSON number in [lo, hi] (a whole one when ``integer``): a boolean,
+    a text or a number out of range is a ``DataError`` naming the key and the range."""
+    value = data[key]
+    kind = "an integer" if integer else "a number"
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        shown = str(value).lower() if isinstance(value, bool) else repr(str(value)[:40])
+        raise DataError(f"{source}: '{key}' is {shown}; expected {kind} in [{lo:g}, {hi:g}]")
+    if isinstance(value, int) and not -1e15 < value < 1e15:
+        raise DataError(f"{source}: '{key}' is {str(value)[:20]}...; expected {kind} in [{lo:g}, {hi:g}]")
+    number = float(value)
+    if not (np.isfinite(number) and lo <= number <= hi) or (integer and number != int(number)):
+        raise DataError(f"{source}: '{key}' is {value!r}; expected {kind} in [{lo:g}, {hi:g}]")
+    return number
 
 
 @dataclass(frozen=True)

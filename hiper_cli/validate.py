@@ -83,6 +83,7 @@ OPTION_RANGES: dict[str, Range] = {
     "limit": Range(1, 1 << 31, integer=True), "resolution": Range(0.001, 10.0),
     "instances": Range(1, 10_000_000, integer=True), "observations": Range(1, 100_000_000, integer=True),
     "port": Range(0, 65535, integer=True),
+    "timeout_s": Range(0.0, 24 * 3600.0, lo_open=True),
     "short_s": Range(0.0, 1e9, lo_open=True), "glimpse_s": Range(0.0, 1e9),
     "image_hz": Range(0.0, 1000.0, lo_open=True),
     # hiper bench

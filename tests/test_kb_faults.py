@@ -88,16 +88,16 @@ def test_damaged_documents_get_recovery_advice(tmp_path):
 
 
 @pytest.mark.parametrize(("name", "match"), [
-    ("uuid-with-angle-bracket", r"instances\[0\] \(uuid 'abc>def'\): 'uuid' is 'abc>def', not a uuid"),
-    ("unknown-layer", r"instances\[0\] .*'layer' is 'basement', expected one of background, foreground"),
-    ("box-of-text", r"instances\[0\] .*'box' is 'big'"),
-    ("box-extent-nan", r"'box.extent_m\[0\]' is 'nan', expected a number"),
-    ("stamp-infinite", r"'last_seen_s' is inf"),
-    ("missing-uuid", r"instances\[0\]: 'uuid' is missing"),
+    ("uuid-with-angle-bracket", r"instances\[0\]\.uuid: 'abc>def': it is not a uuid \(8-4-4-4-12"),
+    ("unknown-layer", r"instances\[0\]\.layer: 'basement': it is not one of \['background', 'foreground'\]"),
+    ("box-of-text", r"instances\[0\]\.box: 'big': it is not of type 'object'"),
+    ("box-extent-nan", r"instances\[0\]\.box\.extent_m\[0\]: 'nan': it is not of type 'number'"),
+    ("stamp-infinite", r"not valid JSON \(Infinity is not a JSON number\)"),
+    ("missing-uuid", r"instances\[0\]: .*'uuid' is a required property"),
     ("instances-not-a-list", "'instances' is a str, expected a list"),
     ("instance-not-an-object", r"instances\[0\] is a int, expected an object"),
     ("top-level-array", "the top level is a JSON list"),
-    ("environment-without-name", r"environments\[0\] .*'name' is None"),
+    ("environment-without-name", r"environments\[0\]: .*'name' is a required property"),
 ])
 def test_import_names_the_bad_document_and_field(tmp_path, name, match):
     source = inputs.write_json(tmp_path / "in.json", inputs.HOSTILE_IMPORTS[name])

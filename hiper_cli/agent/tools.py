@@ -29,6 +29,7 @@ class ToolContext:
 
     kb: KnowledgeBase
     out_dir: Path | None = None
+    timeout_s: float | None = 30.0  # per SPARQL query
 
     def output_dir(self) -> Path:
         if self.out_dir is None:
@@ -232,7 +233,7 @@ def _heatmap(ctx: ToolContext, args: dict[str, Any]) -> ToolResult:
 
 
 def _sparql(ctx: ToolContext, args: dict[str, Any]) -> ToolResult:
-    body, media = ctx.kb.run_readonly(args["query"])
+    body, media = ctx.kb.run_readonly(args["query"], timeout_s=ctx.timeout_s)
     if media.endswith("json"):
         return ToolResult({"media_type": media, "results": json.loads(body)})
     return ToolResult({"media_type": media, "text": body.decode("utf-8")})

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -12,16 +13,40 @@ import typer
 
 from hiper_cli.commands._common import JSON_OPTION
 
-__all__ = ["JSON_OPTION", "HiperTyper", "console", "frame_progress", "group", "print_error", "print_json"]
+__all__ = ["JSON_OPTION", "HiperTyper", "console", "frame_progress", "group", "print_error", "print_json",
+           "safe_text"]
+
+
+# Terminal escape sequences (CSI ``ESC [ ... final``, OSC/DCS/APC/PM/SOS ``ESC ] ... BEL or ESC \``,
+# two-byte ``ESC x``) and the C0/C1 controls other than newline and tab.
+_ESCAPES = re.compile(
+    r"\x1b\[[0-?]*[ -/]*[@-~]?"
+    r"|[\x1b\x9b-\x9f][\]PX^_][^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?"
+    r"|\x1b[ -~]?"
+    r"|[\x00-\x08\x0b-\x1f\x7f-\x9f]"
+)
+
+
+def safe_text(value: object, *, markup: bool = True) -> str:
+    """``value`` as text that prints as itself: terminal escape sequences and control
+    characters (except newline and tab) removed, lone surrogates replaced, and, for rich output
+    (``markup``), ``[`` escaped so ``[bold]`` or ``[/]`` is shown rather than applied. Every
+    user-supplied or stored string goes through it before rich prints it; the consoles here
+    have emoji codes (``:x:``) off."""
+    from rich.markup import escape
+
+    text = _ESCAPES.sub("", str(value))
+    text = text.encode("utf-8", "replace").decode("utf-8")  # a lone surrogate becomes '?'
+    return escape(text) if markup else text
 
 
 def print_error(message: str) -> None:
     """One red line on stderr."""
     from rich.console import Console
-    from rich.markup import escape
 
     # Escaped: a message such as "pip install 'hiper[view]'" keeps its brackets.
-    Console(stderr=True, highlight=False, soft_wrap=True).print(f"[bold red]error:[/] {escape(message)}")
+    Console(stderr=True, highlight=False, soft_wrap=True, emoji=False).print(
+        f"[bold red]error:[/] {safe_text(message)}")
 
 
 def print_json(data: Any) -> None:
@@ -31,9 +56,11 @@ def print_json(data: Any) -> None:
 
 
 def console() -> Any:
+    """The stdout console of the commands: no highlighting, no emoji codes (print user or
+    stored strings through ``safe_text``)."""
     from rich.console import Console
 
-    return Console(highlight=False)
+    return Console(highlight=False, emoji=False)
 
 
 def _flag_names(func: Any) -> dict[str, str]:
@@ -48,6 +75,9 @@ def _flag_names(func: Any) -> dict[str, str]:
     for name, p in parameters.items():
         for info in (p.default, *getattr(p.annotation, "__metadata__", ())):
             decls = [d for d in getattr(info, "param_decls", None) or () if isinstance(d, str)]
+            first = getattr(info, "default", None)  # Annotated[..., typer.Option("--flag")]
+            if isinstance(first, str) and first.startswith("-") and hasattr(info, "param_decls"):
+                decls.insert(0, first)
             if decls:
                 out[name] = next((d for d in decls if d.startswith("--")), decls[0])
     return out

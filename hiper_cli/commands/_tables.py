@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from hiper_cli.commands._render import safe_text
+
 __all__ = [
     "show_background_eval",
     "show_bench_size",
@@ -20,13 +22,18 @@ __all__ = [
 ]
 
 
+def _skip(item: dict[str, Any]) -> str:
+    return f"{safe_text(item['source'])}: {safe_text(item['reason'])}"
+
+
 def show_perceive(out: Any, data: dict[str, Any]) -> None:
     """A ``perceive`` summary: frames, rate, stages not run, skipped frames, counts per class."""
     from rich.table import Table
 
     out.print(
         f"[bold]{data['frames_read']}[/] frames read, {data['frames_skipped']} skipped, "
-        f"{data['frames_per_s']:.2f} frames/s -> {data['kb']} (environment {data['environment']!r}, "
+        f"{data['frames_per_s']:.2f} frames/s -> {safe_text(data['kb'])} "
+        f"(environment {safe_text(repr(data['environment']))}, "
         f"session {data['session_id']})"
     )
     again = data.get("earlier_sessions", {})
@@ -34,15 +41,16 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
         out.print(f"earlier sessions' objects: {again['found_again']} found again "
                   f"({again['moved']} moved), {again['vacated']} vacated")
     for name, why in data["unavailable_stages"].items():
-        out.print(f"[yellow]stage {name} not run:[/] {why}")
+        out.print(f"[yellow]stage {safe_text(name)} not run:[/] {safe_text(why)}")
     for item in data["skipped"][:10]:
-        out.print(f"[yellow]skipped[/] {item['source']}: {item['reason']}")
+        out.print(f"[yellow]skipped[/] {_skip(item)}")
     table = Table("layer", "class", "observations", "instances")
     layers = sorted(set(data["observations"]) | set(data["instances"]))
     for layer in layers:
         classes = sorted(set(data["observations"].get(layer, {})) | set(data["instances"].get(layer, {})))
         for cls in classes:
-            table.add_row(layer, cls, str(data["observations"].get(layer, {}).get(cls, 0)),
+            table.add_row(safe_text(layer), safe_text(cls),
+                          str(data["observations"].get(layer, {}).get(cls, 0)),
                           str(data["instances"].get(layer, {}).get(cls, 0)))
     out.print(table)
 
@@ -53,7 +61,8 @@ def show_steps(out: Any, steps: dict[str, dict[str, float]]) -> None:
 
     table = Table("step", "frames", "mean ms", "per frame read ms", "total s")
     for name, row in steps.items():
-        table.add_row(name, str(row["frames"]), f"{row['mean_ms']:.2f}", f"{row['per_frame_ms']:.2f}",
+        table.add_row(safe_text(name), str(row["frames"]), f"{row['mean_ms']:.2f}",
+                      f"{row['per_frame_ms']:.2f}",
                       f"{row['total_s']:.2f}")
     out.print(table)
 
@@ -63,7 +72,8 @@ def show_log_info(out: Any, data: dict[str, Any]) -> None:
     from rich.table import Table
 
     cam = data["camera"]
-    table = Table(title=f"{data['path']} ({data['format']})", show_header=False)
+    title = f"{safe_text(data['path'])} ({safe_text(data['format'])})"
+    table = Table(title=title, show_header=False)
     table.add_column("what", style="bold")
     table.add_column("value")
     rows = [
@@ -75,13 +85,13 @@ def show_log_info(out: Any, data: dict[str, Any]) -> None:
         ("intrinsics", f"fx {cam['fx']:.2f} fy {cam['fy']:.2f} cx {cam['cx']:.2f} cy {cam['cy']:.2f} "
                        f"depth scale {cam['depth_scale']:g}"
                        + (f" distortion {cam['distortion']}" if cam.get("distortion") else "")),
-        ("pose source", data["pose_source"]),
+        ("pose source", safe_text(data["pose_source"])),
         ("detections", "yes" if data["has_detections"] else "no"),
         ("stamp gaps", ", ".join(f"{g['gap_s']:.3f} s after {g['after_stamp_s']:.3f}"
                                  for g in data["stamp_gaps"][:5])
          + (f" (+{len(data['stamp_gaps']) - 5} more)" if len(data["stamp_gaps"]) > 5 else "") or "none"),
     ]
-    rows += [(f"source: {role}", where) for role, where in data["sources"].items()]
+    rows += [(f"source: {safe_text(role)}", safe_text(where)) for role, where in data["sources"].items()]
     if "readable_frames" in data:
         rows.append(("readable", f"{data['readable_frames']} of {data['frames']}"))
     rows.append(("skipped", str(len(data["skipped"]))))
@@ -89,7 +99,7 @@ def show_log_info(out: Any, data: dict[str, Any]) -> None:
         table.add_row(name, value)
     out.print(table)
     for item in data["skipped"][:10]:
-        out.print(f"[yellow]skipped[/] {item['source']}: {item['reason']}")
+        out.print(f"[yellow]skipped[/] {_skip(item)}")
     if len(data["skipped"]) > 10:
         out.print(f"[yellow]... {len(data['skipped']) - 10} more skipped[/]")
     if data.get("frame_list"):
@@ -122,17 +132,19 @@ def show_foreground_eval(out: Any, report: dict[str, Any]) -> None:
         return [_fmt(paper[key][env], digits) for env in ("house", "hospital", "office")]
 
     title = (
-        f"Foreground, {report['world'] or report['log']} (seed {report['seed']}), "
-        f"detector {report['detector']}, background: {report['background_source']}"
+        f"Foreground, {safe_text(report['world'] or report['log'])} (seed {report['seed']}), "
+        f"detector {safe_text(report['detector'])}, "
+        f"background: {safe_text(report['background_source'])}"
     )
     if report.get("classes"):
-        title += f"; classes: {', '.join(report['classes'])}"
+        title += f"; classes: {safe_text(', '.join(report['classes']))}"
     if report.get("exclude_classes"):
         title += f"; {len(report['exclude_classes'])} classes excluded"
     table = Table(title=title)
     for name in ("metric", "ours", "paper house", "paper hospital", "paper office"):
         table.add_column(name)
-    classes = ", ".join(f"{c} {r['tp']}/{r['fp']}" for c, r in sorted(ours["classification"].items()))
+    classes = ", ".join(f"{safe_text(c)} {r['tp']}/{r['fp']}"
+                        for c, r in sorted(ours["classification"].items()))
     rows = [
         ("3D detect. time / s: mu; sigma", _fmt(ours["detect_time_s"]), *cols("detect_time_s")),
         ("classification i: TP; FP", f"{ours['tp']}; {ours['fp']}", *cols("classification_tp_fp")),
@@ -213,7 +225,8 @@ def show_background_eval(out: Any, data: dict[str, Any]) -> None:
     """``hiper eval background``: our Table II rows beside the paper's and the targets."""
     from rich.table import Table
 
-    table = Table(title=f"Table II, {data['world'] or 'log'} ({data['method']}, {data['keyframes']} "
+    world = safe_text(data['world'] or 'log')
+    table = Table(title=f"Table II, {world} ({data['method']}, {data['keyframes']} "
                         f"keyframes of {data['frames']} frames)")
     for col in ("Description", "hiper", "paper", "target"):
         table.add_column(col)
@@ -231,17 +244,20 @@ def show_kb_info(out: Any, data: dict[str, Any]) -> None:
 
     totals = data["totals"]
     out.print(
-        f"[bold]{data['kb']}[/]: {totals['observation']} observations, {totals['instance']} instances, "
+        f"[bold]{safe_text(data['kb'])}[/]: {totals['observation']} observations, "
+        f"{totals['instance']} instances, "
         f"{totals['analysis']} analyses, {totals['environment']} environments, "
         f"{data['size_bytes'] / 1e6:.1f} MB on disk"
     )
     table = Table("type", "layer", "class", "count")
     for c in data["counts"]:
-        table.add_row(c["type"], c["layer"] or "", c["class"] or "", str(c["count"]))
+        table.add_row(safe_text(c["type"]), safe_text(c["layer"] or ""), safe_text(c["class"] or ""),
+                      str(c["count"]))
     out.print(table)
     sessions = Table("session", "log", "frames", "finished")
     for s in data["sessions"]:
-        sessions.add_row(str(s["id"]), s["log_path"], str(s["frames"]), "yes" if s["ended_s"] else "no")
+        sessions.add_row(str(s["id"]), safe_text(s["log_path"]), str(s["frames"]),
+                         "yes" if s["ended_s"] else "no")
     if data["sessions"]:
         out.print(sessions)
 
@@ -253,7 +269,7 @@ def show_bench_size(out: Any, r: dict[str, Any]) -> None:
     out.print(
         f"[bold]{r['observations']:>8}[/] obs: documents {r['ingest_obs_per_s']:.0f}/s "
         f"({r['ingest_obs_per_cpu_s']:.0f}/CPU-s), graph {r['graph_sync_obs_per_s']:.0f}/s "
-        f"({r['graph']}), end to end {r['end_to_end_obs_per_s']:.0f}/s, peak RSS "
+        f"({safe_text(r['graph'])}), end to end {r['end_to_end_obs_per_s']:.0f}/s, peak RSS "
         f"{r['peak_rss_mb']:.0f} MB{follower}, load {r['load_average_1min']}\n    p50/p95: {lat}"
     )
 
@@ -261,7 +277,7 @@ def show_bench_size(out: Any, r: dict[str, Any]) -> None:
 def show_kb_check(out: Any, data: dict[str, Any]) -> None:
     """``hiper kb check``: each problem found, whether the graph was rebuilt, the verdict."""
     for problem in data["problems"]:
-        out.print(f"[yellow]problem:[/] {problem}")
+        out.print(f"[yellow]problem:[/] {safe_text(problem)}")
     if data["repaired"]:
         out.print("graph rebuilt from the documents")
     out.print("[green]consistent[/]" if data["ok"] else "[red]inconsistent[/]")

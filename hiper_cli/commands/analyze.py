@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import console, group, print_json
+from hiper_cli.commands._render import console, group, print_json, safe_text
 
 if TYPE_CHECKING:
     from hiper_cli.analyze import FeatureReport
@@ -65,11 +65,12 @@ def _print_features(report: FeatureReport) -> None:
     shape = narrow(escape("size and altitude (mean [95 % CI])"), "class", "size m³", "altitude m")
     for c in report.classes:
         o = c.ods
-        ods.add_row(c.class_name, str(o.instances), str(o.rows), f"{100 * o.ratio:.1f} %", _fmt(o.sigma_mps),
+        ods.add_row(safe_text(c.class_name), str(o.instances), str(o.rows), f"{100 * o.ratio:.1f} %",
+                    _fmt(o.sigma_mps),
                     _fmt(o.mean_mps), interval(o.mean_lo_mps, o.mean_hi_mps), interval(o.cl_mps, o.cu_mps))
         size = f"{_fmt(c.size.mean_m3)} {interval(c.size.lo_m3, c.size.hi_m3)}" if c.size else "-"
         alt = f"{_fmt(c.altitude.mean_m)} {interval(c.altitude.lo_m, c.altitude.hi_m)}" if c.altitude else "-"
-        shape.add_row(c.class_name, size, alt)
+        shape.add_row(safe_text(c.class_name), size, alt)
     out = console()
     out.print(ods)
     out.print(shape)
@@ -103,7 +104,7 @@ def features_command(
     from hiper_cli.analyze import learn_features
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         window = _window(knowledge, t_from, t_to, last, daily)
         report, stored = learn_features(knowledge, class_name or None, window, store=not no_store)
     plot_path = None
@@ -118,7 +119,8 @@ def features_command(
     _print_features(report)
     out = console()
     out.print(
-        f"{len(stored)} analyses stored in {kb}" + (f"; histograms in {plot_path}" if plot_path else "")
+        f"{len(stored)} analyses stored in {safe_text(kb)}"
+        + (f"; histograms in {safe_text(plot_path)}" if plot_path else "")
     )
 
 
@@ -153,7 +155,7 @@ def heatmap_command(
     from hiper_cli.analyze import generate_heatmap
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         window = _window(knowledge, t_from, t_to, last, daily)
         result = generate_heatmap(
             knowledge, class_name, window, out_dir, env_name=env, map_yaml=map_yaml, inverse=inverse
@@ -164,12 +166,13 @@ def heatmap_command(
         return
     out = console()
     out.print(
-        f"[bold]{class_name}[/] heatmap, {result.heatmap.window.describe()}: {data['rows']} rows of "
+        f"[bold]{safe_text(class_name)}[/] heatmap, {result.heatmap.window.describe()}: "
+        f"{data['rows']} rows of "
         f"{data['instances']} tracks, σ {data['kernel_sigma_m']:.2f} m (μ_v {data['speed_mps']:.2f} m/s "
         f"from {data['speed_source']}), {data['hot_cells']} hot cells, {data['seconds']:.2f} s"
     )
     for name, path in data["files"].items():
-        out.print(f"  {name:16} {path}")
+        out.print(f"  {name:16} {safe_text(path)}")
 
 
 @analyze_app.command("map")
@@ -196,14 +199,15 @@ def map_command(
     from hiper_cli.analyze import export_map
     from hiper_cli.graph import open_kb
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    with open_kb(kb, docs_dir=kb_docs, create=False) as knowledge:
         data = export_map(knowledge, out, env_name=env, map_yaml=map_yaml, resolution_m=resolution_m)
     if as_json:
         print_json(data)
         return
     console().print(
         f"map {data['shape'][1]}x{data['shape'][0]} cells of {data['resolution_m']} m "
-        f"({data['free_cells']} free, {data['occupied_cells']} occupied) -> {data['yaml']}"
+        f"({data['free_cells']} free, {data['occupied_cells']} occupied) "
+        f"-> {safe_text(data['yaml'])}"
     )
 
 
@@ -229,7 +233,7 @@ def bench_command(
     out = console()
     size = data["kb"]
     out.print(
-        f"{kb}: {size['observations']} observations, {size['instances']} instances, "
+        f"{safe_text(kb)}: {size['observations']} observations, {size['instances']} instances, "
         f"{size['trajectory_rows']} trajectory rows ({size['fill_s']:.0f} s to fill)"
     )
     out.print(f"  column cache brought up to date: {data['cache']['seconds']:.2f} s")

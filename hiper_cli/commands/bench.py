@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import HiperTyper, console, print_json
+from hiper_cli.commands._render import HiperTyper, console, print_json, safe_text
 
 HELP = (
     "The paper's benchmark (section VII): per world a simulated log (mapping, then people), perceived "
@@ -74,13 +74,14 @@ def bench(
     from rich.table import Table
 
     for world, cells in summary["tasks"].items():
-        table = Table("config", *[f"{t} median s (ok)" for t in ("T1", "T2", "T3", "T4")], title=world)
+        table = Table("config", *[f"{t} median s (ok)" for t in ("T1", "T2", "T3", "T4")],
+                      title=safe_text(world))
         for name, row in cells.items():
-            table.add_row(name, *[
+            table.add_row(safe_text(name), *[
                 f"{'-' if c['median_time_s'] is None else format(c['median_time_s'], '.1f')} "
                 f"({c['successes']}/{c['runs']})" for c in row.values()])
         screen.print(table)
-    screen.print(f"[green]wrote[/] {report}")
+    screen.print(f"[green]wrote[/] {safe_text(report)}")
 
 
 def register(app: HiperTyper) -> None:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION, LOG_ARGUMENT, with_log_flags
-from hiper_cli.commands._render import console, frame_progress, print_json
+from hiper_cli.commands._render import console, frame_progress, print_json, safe_text
 from hiper_cli.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -62,15 +62,16 @@ def convert(
     layout = bag_layout(to, rgb_format, depth_encoding, pose_as)
     reader = open_log(log, log_options)
     screen = console()
-    with frame_progress(f"writing {out}", screen, enabled=not json_out, total=len(reader)) as bar:
+    with frame_progress(f"writing {safe_text(out)}", screen, enabled=not json_out, total=len(reader)) as bar:
         result = convert_log(reader, out, to, layout=layout, overwrite=overwrite,
                              on_frame=bar.advance if bar else None)
     if json_out:
         print_json({**result.to_dict(), "input": str(log)})
         return
-    screen.print(f"wrote {result.frames_written} frames to {result.output} ({result.to})")
+    screen.print(f"wrote {result.frames_written} frames to {safe_text(result.output)} "
+                 f"({safe_text(result.to)})")
     for source, reason in result.skipped:
-        screen.print(f"[yellow]skipped[/] {source}: {reason}")
+        screen.print(f"[yellow]skipped[/] {safe_text(source)}: {safe_text(reason)}")
 
 
 def _convert_degraded(log: Path, out: Path, profile_name: str, to: str | None, seed: int,
@@ -87,18 +88,18 @@ def _convert_degraded(log: Path, out: Path, profile_name: str, to: str | None, s
         profile = profile.with_pose_drift(pose_drift)
     reader = open_log(log, log_options)
     screen = console()
-    with frame_progress(f"degrading to {out}", screen, enabled=not json_out, total=len(reader)) as bar:
+    with frame_progress(f"degrading to {safe_text(out)}", screen, enabled=not json_out, total=len(reader)) as bar:
         result = degrade_log(reader, out, profile, seed, overwrite=overwrite,
                              on_frame=bar.advance if bar else None)
     if json_out:
         print_json({**result.to_dict(), "input": str(log)})
         return
     err = result.pose_error
-    screen.print(f"wrote {result.convert.frames_written} frames to {out} as a {profile.name} sensor "
+    screen.print(f"wrote {result.convert.frames_written} frames to {safe_text(out)} as a {profile.name} sensor "
                  f"(seed {seed}); pose error RMS {err['rms_m']:.3f} m, final {err['final_m']:.3f} m; "
-                 f"truth in {out}/gt")
+                 f"truth in {safe_text(out)}/gt")
     for source, reason in result.convert.skipped:
-        screen.print(f"[yellow]skipped[/] {source}: {reason}")
+        screen.print(f"[yellow]skipped[/] {safe_text(source)}: {safe_text(reason)}")
 
 
 def register(app: typer.Typer) -> None:

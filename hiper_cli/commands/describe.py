@@ -7,7 +7,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
-from hiper_cli.commands._render import JSON_OPTION, console, print_json
+from hiper_cli.commands._render import JSON_OPTION, console, print_json, safe_text
 
 __all__ = ["register"]
 
@@ -32,7 +32,7 @@ def describe_command(
     if as_json:
         print_json(summary.to_dict())
         return
-    console().print(summary.text)
+    console().print(safe_text(summary.text))
 
 
 def register(app: typer.Typer) -> None:

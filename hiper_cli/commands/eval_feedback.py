@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 from hiper_cli.commands.eval import eval_app
 
 
@@ -51,13 +51,13 @@ def feedback(
         "unknown",
         "ID switches",
         "speed error / m/s",
-        title=f"feedback on {report['log']} (learned on {report['learned_on']})",
+        title=f"feedback on {safe_text(report['log'])} (learned on {safe_text(report['learned_on'])})",
     )
     for name, r in report["runs"].items():
         err = r["moving_people_speed_error_mps"]
         share = r["fp_share"]
         table.add_row(
-            name,
+            safe_text(name),
             str(r["person_tp"]),
             str(r["person_fp"]),
             str(r["fp"]),

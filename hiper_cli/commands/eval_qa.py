@@ -9,7 +9,7 @@ from typing import Annotated, Any
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, frame_progress, print_json
+from hiper_cli.commands._render import console, frame_progress, print_json, safe_text
 from hiper_cli.commands.eval import eval_app
 
 
@@ -101,7 +101,8 @@ def _print_logs(data: dict[str, Any]) -> None:
     table = Table("log", "detector", "questions", "binary", "count", "count, glimpses optional",
                   "position m", "time s", "duration s", title="hiper eval qa, per log")
     for row in [*data["logs"], {**data, "log": "all", "detector": ""}]:
-        table.add_row(Path(row["log"]).name if row["log"] != "all" else "[bold]all", str(row["detector"]),
+        name = safe_text(Path(row["log"]).name) if row["log"] != "all" else "[bold]all"
+        table.add_row(name, safe_text(row["detector"]),
                       str(row["questions"]), _fmt(row["binary_accuracy"]), _fmt(row["count_accuracy"]),
                       _fmt(row["count_accuracy_glimpses_optional"]), _err(row["position_error_median_m"]),
                       _err(row["time_error_median_s"]), _err(row["duration_error_median_s"]))
@@ -142,12 +143,12 @@ def _print_headline(data: dict[str, Any], glimpse_s: float, where: str) -> None:
         "optional), "
         f"position error {_err(data['position_error_median_m'])} m, time error "
         f"{_err(data['time_error_median_s'])} s, duration error {_err(data['duration_error_median_s'])} s "
-        f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); {where}"
+        f"(DAAAM on OC-NaVQA: 0.711, 41.75 m, 107.4 s); {safe_text(where)}"
     )
     other = data["unnamed"]
     if other["questions"]:
         out.print(
-            f"classes the perceiver cannot name ({', '.join(data['unnamed_classes'])}), apart: "
+            f"classes the perceiver cannot name ({safe_text(', '.join(data['unnamed_classes']))}), apart: "
             f"{other['questions']} questions, binary accuracy {_fmt(other['binary_accuracy'])}, count "
             f"accuracy {_fmt(other['count_accuracy'])}, position error "
             f"{_err(other['position_error_median_m'])} m"

@@ -8,7 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 from hiper_cli.commands.eval import eval_app
 
 
@@ -75,14 +75,14 @@ def show_scene_eval(data: dict[str, Any]) -> None:
     """The two tables as text."""
     out = console()
     b, f = data["background"], data["foreground"]
-    out.print(f"Table II, background ({data['world']}): {b['instances']} instances "
+    out.print(f"Table II, background ({safe_text(data['world'])}): {b['instances']} instances "
               f"({b['on_unlabelled']} on unlabelled geometry, {b['off_surface']} on no surface)")
     out.print(f"  semantic precision {_f(b['semantic_precision'])}   static/dynamic precision "
               f"{_f(b['static_precision'])}   centre distance mean/median {_f(b['distance_centre_mean_m'])}"
               f" / {_f(b['distance_centre_median_m'])} m")
     out.print(f"  coverage {_f(b['coverage'])} ({b['pieces_covered']} of {b['pieces']} observed pieces "
-              f">= 1 m^2); uncovered: {', '.join(b['uncovered']) or '-'}")
-    out.print(f"  class->truth {b['confusion']}")
+              f">= 1 m^2); uncovered: {safe_text(', '.join(b['uncovered']) or '-')}")
+    out.print(f"  class->truth {safe_text(b['confusion'])}")
     out.print(f"Table III, foreground: {f['instances']} instances, TP {f['tp']} FP {f['fp']} FN(observed) "
               f"{f['fn_observed']}, precision {_f(f['precision'])}")
     out.print(f"  classified ('unknown' left out): TP {f['classified_tp']} FP {f['classified_fp']} precision "
@@ -92,8 +92,8 @@ def show_scene_eval(data: dict[str, Any]) -> None:
     out.print(f"  static/dynamic: {f['dynamic_instances']} dynamic instances; state of the matched ones "
               f"right {_f(f['state_accuracy'])}")
     for name, c in f["per_class"].items():
-        out.print(f"  {name:<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
-    out.print(f"  unmatched, by what they lie on: {f['unmatched']}")
+        out.print(f"  {safe_text(name):<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
+    out.print(f"  unmatched, by what they lie on: {safe_text(f['unmatched'])}")
     c = data.get("detector_ceiling")
     if c is not None:
         out.print(f"  nameable objects seen clearly: hiper {c['hiper_found']} of {c['seen_clearly']}, the "

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 
 __all__ = ["register"]
 
@@ -41,7 +41,7 @@ def export_command(
     if as_json:
         print_json(summary)
     else:
-        console().print(f"wrote {summary['path']} ({summary['format']})")
+        console().print(f"wrote {safe_text(summary['path'])} ({safe_text(summary['format'])})")
 
 
 def import_command(
@@ -64,7 +64,7 @@ def import_command(
         print_json(summary)
     else:
         counts = ", ".join(f"{n} {_plural(k, n)}" for k, n in summary["counts"].items())
-        console().print(f"imported {counts} into {summary['kb']}")
+        console().print(f"imported {counts} into {safe_text(summary['kb'])}")
 
 
 def _plural(kind: str, n: int) -> str:

@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
+from hiper_cli.commands._render import safe_text
 from hiper_cli.errors import ConfigError
 
 __all__ = ["register"]
@@ -32,6 +33,9 @@ def mcp_command(
         Path | None,
         typer.Option("--out", "-o", help="Folder for the heatmap tool's files (default: a temp dir)."),
     ] = None,
+    timeout_s: Annotated[
+        float, typer.Option("--timeout", help="Give up on a sparql tool query after this many seconds.")
+    ] = 30.0,
 ) -> None:
     """Serve the query verbs as MCP tools (find, count, last_seen, when, trajectory, workspace,
     describe, features, heatmap, sparql, ask) and resources (vocabulary, summary); read-only.
@@ -46,14 +50,14 @@ def mcp_command(
     require_mcp()
     address = _host_port(http) if http is not None else None
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
-        ctx = ToolContext(knowledge, out_dir)
+        ctx = ToolContext(knowledge, out_dir, timeout_s)
         if address is None:
             run_stdio(ctx)
             return
         import sys
 
         def ready() -> None:
-            print(f"hiper mcp: serving {knowledge.location} at http://{address[0]}:{address[1]}/mcp",
+            print(f"hiper mcp: serving {safe_text(knowledge.location, markup=False)} at http://{address[0]}:{address[1]}/mcp",
                   file=sys.stderr, flush=True)
 
         with contextlib.suppress(KeyboardInterrupt):

@@ -11,7 +11,7 @@ import typer
 from typer.core import TyperGroup
 
 from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
-from hiper_cli.commands._render import JSON_OPTION, HiperTyper, console, print_json
+from hiper_cli.commands._render import JSON_OPTION, HiperTyper, console, print_json, safe_text
 from hiper_cli.errors import QueryError
 
 __all__ = ["query_app", "register"]
@@ -46,12 +46,15 @@ query_app = HiperTyper(
 def _floats(text: str | None, n: int, option: str, form: str) -> tuple[float, ...] | None:
     if text is None:
         return None
+    import math
+
     try:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
         values = ()
-    if len(values) != n:
-        raise QueryError(f"{option} {text!r}: expected {n} comma-separated numbers {form}")
+    if len(values) != n or not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE_M for v in values):
+        raise QueryError(f"{option} {text!r}: expected {n} comma-separated finite numbers {form}, "
+                         f"each at most {MAX_COORDINATE_M:g} in size")
     return values
 
 
@@ -59,16 +62,26 @@ def _stamp(text: str | None, option: str, now_s: float) -> float | None:
     """A time option: seconds (a stamp), HH:MM on the day of the KB's last stamp, or ISO."""
     if text is None:
         return None
+    import math
+
     try:
-        return float(text)
+        stamp_s = float(text)
     except ValueError:
         pass
+    else:
+        if not math.isfinite(stamp_s) or abs(stamp_s) > 1e11:
+            raise QueryError(f"{option} {text!r}: expected a finite stamp in seconds (at most 1e11), "
+                             "HH:MM or an ISO date-time")
+        return stamp_s
     from hiper_cli.query.grammar import parse_time
 
     stamp = parse_time(text, now_s)
     if stamp is None:
         raise QueryError(f"{option} {text!r}: expected a stamp in seconds, HH:MM or an ISO date-time")
     return stamp
+
+
+MAX_COORDINATE_M = 1e6  # a pose further out is a typo, not a place in a map
 
 
 @query_app.command("ask")
@@ -98,6 +111,9 @@ def ask_command(
             "'-' (stdin).",
         ),
     ] = None,
+    timeout_s: Annotated[
+        float, typer.Option("--timeout", help="Give up on a --sparql query after this many seconds.")
+    ] = 30.0,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Answer a plain-words query, or a read-only SPARQL query with --sparql.
@@ -107,9 +123,18 @@ def ask_command(
     from hiper_cli.graph import open_kb_for_reading
 
     text = None if sparql is None else sys.stdin.read() if sparql == "-" else _sparql_text(sparql)
+    if text is not None and words:
+        raise QueryError(f"--sparql with plain words too ({' '.join(words)!r}); ask one or the other")
+    if text is not None:
+        from hiper_cli.graph.sparql_safety import readonly_form
+
+        form = readonly_form(text)  # refused before the knowledge base is opened
     with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
         if text is not None:
-            _print_sparql(knowledge.run_readonly(text)[0], as_json)
+            graph_form = form in ("CONSTRUCT", "DESCRIBE")
+            media = "text/turtle" if graph_form else "application/sparql-results+json"
+            body = knowledge.run_readonly(text, media, timeout_s=timeout_s)[0]
+            (_print_triples if graph_form else _print_sparql)(body, as_json)
             return
         if not words:
             raise QueryError('no query; e.g. hiper query "cups in FOV" or --sparql "SELECT ..."')
@@ -161,6 +186,17 @@ def _is_file(value: str) -> bool:
         return False
 
 
+def _print_triples(body: bytes, as_json: bool) -> None:
+    """A CONSTRUCT or DESCRIBE answer: Turtle text (``--json``: its media type and text)."""
+    text = body.decode("utf-8", "replace")
+    if as_json:
+        print_json({"media_type": "text/turtle", "text": text})
+        return
+    sys.stdout.write(safe_text(text, markup=False))
+    if text and not text.endswith("\n"):
+        sys.stdout.write("\n")
+
+
 def _print_sparql(body: bytes, as_json: bool) -> None:
     import json
 
@@ -175,9 +211,9 @@ def _print_sparql(body: bytes, as_json: bool) -> None:
     from rich.table import Table
 
     names = data["head"]["vars"]
-    table = Table(*names)
+    table = Table(*(safe_text(n) for n in names))
     for row in data["results"]["bindings"]:
-        table.add_row(*(row[n]["value"] if n in row else "" for n in names))
+        table.add_row(*(safe_text(row[n]["value"]) if n in row else "" for n in names))
     out.print(table)
 
 
@@ -187,7 +223,7 @@ def _render_answer(answer: Any) -> None:
     from hiper_cli.query.results import ago_text, short_uuid
 
     out = console()
-    out.print(f"[bold]{answer.text}[/]")
+    out.print(f"[bold]{safe_text(answer.text)}[/]")
     if not answer.hits:
         return
     # one line per hit in an 80-column terminal: no rules, one space between columns, only the
@@ -198,14 +234,14 @@ def _render_answer(answer: Any) -> None:
     for h in answer.hits:
         x, y, z = h.center_map_m
         table.add_row(
-            h.class_name,
+            safe_text(h.class_name),
             short_uuid(h.uuid),
             f"{x:.2f} {y:.2f} {z:.2f}",
             f"{h.distance_m:.2f}",
             ago_text(h.last_seen_s, answer.now_s),
-            h.state,
+            safe_text(h.state),
             "" if h.speed_mps is None else f"{h.speed_mps:.2f}",
-            "" if h.support is None else h.support.class_name,
+            "" if h.support is None else safe_text(h.support.class_name),
             str(h.observation_count),
         )
     out.print(table)
@@ -248,9 +284,10 @@ def workspace_command(
     )
     table = Table("layer", "class", "shape / voxels", "dynamics")
     for p in ws.background:
-        table.add_row("background", p.class_name, p.shape, "")
+        table.add_row("background", safe_text(p.class_name), safe_text(p.shape), "")
     for k, name in enumerate(ws.classes):
-        table.add_row("foreground", name, str(int((ws.occupancy == k).sum())), str(ws.dynamics[name]))
+        table.add_row("foreground", safe_text(name), str(int((ws.occupancy == k).sum())),
+                      str(ws.dynamics[name]))
     out.print(table)
 
 

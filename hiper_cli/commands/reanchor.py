@@ -12,7 +12,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import HiperTyper, console, print_json
+from hiper_cli.commands._render import HiperTyper, console, print_json, safe_text
 
 HELP = (
     "Recompute every background instance (walls, floors, ceilings, tables) of a knowledge base from its "
@@ -35,7 +35,8 @@ def reanchor_command(poses: Poses, kb: KbOption = DEFAULT_KB, kb_docs: KbDocsOpt
         print_json(summary.to_dict())
         return
     console().print(
-        f"[bold]{kb}[/]: {summary.instances} background instances recomputed from {summary.observations} "
+        f"[bold]{safe_text(kb)}[/]: {summary.instances} background instances recomputed from "
+        f"{summary.observations} "
         f"observations; {summary.merged} merged away; mean shift {summary.shift_mean_m:.3f} m (max "
         f"{summary.shift_max_m:.3f} m)" + (" [dim](dry run: nothing written)[/]" if dry_run else ""))
 

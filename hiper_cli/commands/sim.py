@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import HiperTyper, console, frame_progress, print_json
+from hiper_cli.commands._render import HiperTyper, console, frame_progress, print_json, safe_text
 
 HELP = (
     "Simulate a robot driving through a house, hospital or office: a TUM RGB-D log (rgb, depth, poses) "
@@ -54,14 +54,15 @@ def sim(
         false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression,
         sensor=sensor)
     screen = console()
-    with frame_progress(f"sim {world}", screen, enabled=not as_json) as bar:
+    with frame_progress(f"sim {safe_text(world)}", screen, enabled=not as_json) as bar:
         result = simulate(world, seconds, seed, out, config, overwrite=overwrite,
                           progress=bar.update if bar else None)
     if as_json:
         print_json(result.to_dict())
         return
     screen.print(
-        f"[green]wrote[/] {result.out}: {result.frames} frames of {result.world} (seed {result.seed}), "
+        f"[green]wrote[/] {safe_text(result.out)}: {result.frames} frames of {safe_text(result.world)} "
+        f"(seed {result.seed}), "
         f"mapping {result.mapping_s:.1f} s then {result.people} people; {result.instances} instances; "
         f"{result.sensor} sensor; "
         f"{result.frames_per_s:.1f} frames/s"

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbOption
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 
 __all__ = ["register"]
 
@@ -39,7 +39,7 @@ def view_command(
     if as_json:
         print_json(summary.to_dict())
     else:
-        console().print(summary.line())
+        console().print(safe_text(summary.line()))
 
 
 def register(app: typer.Typer) -> None:

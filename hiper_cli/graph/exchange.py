@@ -30,10 +30,10 @@ import pyoxigraph as ox
 
 from hiper_cli.errors import DataError, KnowledgeBaseError
 from hiper_cli.files import atomic_output, os_error, refuse_inside
-from hiper_cli.graph.import_check import check_documents, check_json_shape
+from hiper_cli.graph.import_check import check_documents, check_json_shape, check_unique, read_json_export
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, doc_quads, h, layer_graph, link_quad, speed_mps
-from hiper_cli.model import LAYERS
+from hiper_cli.model import LAYERS, Instance
 
 __all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_export"]
 
@@ -366,6 +366,19 @@ def _props_from_graphml(path: Path) -> dict[str, dict[str, list[str]]]:
     return props
 
 
+def _check_graph_form(kb: KnowledgeBase, labelled: list[tuple[str, dict[str, Any]]], source: Path) -> None:
+    """Build every document's graph node in memory before the first write: what the graph
+    sync would fail on refuses the import instead of leaving the two stores apart."""
+    for where, doc in labelled:
+        try:
+            doc_quads(kb.kb_id, doc, kb.config.observation_detail)
+            if doc["type"] == "instance":
+                Instance.from_dict(doc).box.aabb()
+        except (ValueError, TypeError, KeyError, OverflowError, AttributeError) as err:
+            raise DataError(f"{source}: {where}: cannot be stored ({type(err).__name__}: "
+                            f"{' '.join(str(err).split())[:160]}); nothing was imported") from err
+
+
 def import_kb(kb: KnowledgeBase, path: Path, fmt: str | None = None) -> dict[str, Any]:
     """Read an export into ``kb`` (documents first, then the graph follows). Every document is
     validated before the first is written; the write is one transaction."""
@@ -373,13 +386,7 @@ def import_kb(kb: KnowledgeBase, path: Path, fmt: str | None = None) -> dict[str
     if not path.is_file():
         raise DataError(f"{path}: no such file; pass a file written by 'hiper export'")
     if fmt == "json":
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except (ValueError, RecursionError) as err:  # RecursionError: nesting deeper than any export
-            detail = "nested too deeply" if isinstance(err, RecursionError) else str(err)[:200]
-            raise DataError(f"{path}: not valid JSON ({detail}); pass a file written by "
-                            "'hiper export --format json'") from err
-        labelled = _docs_from_json(data, path)
+        labelled = _docs_from_json(read_json_export(path), path)
     elif fmt in ("graphml", "turtle", "nquads", "jsonld"):
         props = _props_from_graphml(path) if fmt == "graphml" else _props_from_rdf(path, fmt)
         try:
@@ -389,6 +396,8 @@ def import_kb(kb: KnowledgeBase, path: Path, fmt: str | None = None) -> dict[str
     else:
         raise DataError(f"import format {fmt!r}; expected one of {', '.join(EXPORT_FORMATS)}")
     check_documents(labelled, path)
+    check_unique(labelled, path, lambda uuid: (kb.docs.get(uuid) or {}).get("type"))
+    _check_graph_form(kb, labelled, path)
     docs = [d for _, d in labelled]
     if kb.read_only:
         raise KnowledgeBaseError(f"{kb.location}: opened read-only; cannot import")

@@ -4,7 +4,9 @@ An import must not save what later breaks the knowledge base (a uuid that is no 
 the graph has no named graph for, a box of text, a stamp of ``inf``). ``check_documents`` gets
 ``(where, document)`` pairs in their ``to_dict`` form, ``where`` saying where in the source the
 document came from (``instances[3]``, ``node <urn:uuid:...>``), and raises ``DataError`` at the
-first problem; ``check_json_shape`` checks the outline of a JSON export first.
+first problem. A JSON export is read strictly first (``read_json_export``: no NaN or Infinity,
+no lone surrogates, no nesting deeper than an export has) and checked in full against
+``export.schema.json``; ``check_unique`` refuses one uuid used for two documents.
 """
 
 from __future__ import annotations
@@ -17,7 +19,9 @@ from typing import Any
 
 from hiper_cli.errors import DataError
 
-__all__ = ["check_documents", "check_json_shape"]
+__all__ = ["check_documents", "check_json_shape", "check_unique", "read_json_export"]
+
+MAX_DEPTH = 64  # an export nests a few levels (instances[k].box.R[i][j]); more is no export
 
 UUID_RE = re.compile(r"^[0-9a-fA-F]{8}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{12}$")
 PERCEIVED_LAYERS = ("background", "foreground")
@@ -49,6 +53,95 @@ def check_json_shape(data: Any, source: Path) -> None:
                                 "object; nothing was imported")
 
 
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def _walk_strings(value: Any, where: str, depth: int = 0) -> None:
+    """Refuse nesting beyond ``MAX_DEPTH`` and strings that are not valid Unicode text."""
+    if depth > MAX_DEPTH:
+        raise DataError(f"{where}: nested deeper than {MAX_DEPTH} levels")
+    if isinstance(value, str):
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            raise DataError(f"{where}: {value[:40]!r} holds a lone surrogate (\\ud800-\\udfff), "
+                            "not text") from None
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            _walk_strings(k, where, depth + 1)
+            _walk_strings(v, f"{where}.{k}", depth + 1)
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            _walk_strings(v, f"{where}[{k}]", depth + 1)
+
+
+def read_json_export(path: Path) -> dict[str, Any]:
+    """A JSON export read strictly and checked in full against ``export.schema.json``;
+    ``DataError`` naming the place and the problem otherwise."""
+    import json
+
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_constant)
+    except (ValueError, RecursionError) as err:  # RecursionError: nesting deeper than any export
+        detail = "nested too deeply" if isinstance(err, RecursionError) else " ".join(str(err).split())[:200]
+        raise DataError(f"{path}: not valid JSON ({detail}); pass a file written by "
+                        "'hiper export --format json'") from err
+    except OSError as err:
+        raise DataError(f"{path}: cannot read it ({err.strerror})") from err
+    try:
+        _walk_strings(data, "$")
+    except DataError as err:
+        raise DataError(f"{path}: {err}; nothing was imported") from None
+    check_json_shape(data, path)
+    if data.get("format") != "hiper-kb-export":
+        raise DataError(f"{path}: not a hiper JSON export (format {data.get('format')!r}); expected "
+                        "'hiper-kb-export' written by 'hiper export --format json'")
+    _check_schema(data, path)
+    return data
+
+
+def _check_schema(data: Any, path: Path) -> None:
+    import json
+    from importlib import resources
+
+    import jsonschema
+    from jsonschema.exceptions import best_match
+
+    schema = json.loads(resources.files("hiper_cli.graph").joinpath("export.schema.json").read_text())
+    error = best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
+    if error is None:
+        return
+    where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")
+    value = repr(error.instance)
+    value = value if len(value) <= 60 else value[:57] + "..."
+    causes = error.context or [error]  # oneOf: what each alternative wanted
+    wanted = dict.fromkeys(" ".join(c.message.replace(repr(c.instance), "it").split()) for c in causes)
+    not_uuid = f"does not match {UUID_RE.pattern!r}"
+    problem = " or ".join(wanted).replace(not_uuid, "is not a uuid (8-4-4-4-12 hex digits)")
+    problem = problem if len(problem) <= 160 else problem[:157] + "..."
+    raise DataError(f"{path}: {where or 'the top level'}: {value}: {problem}; nothing was imported, fix "
+                    "or remove that document")
+
+
+def check_unique(docs: Sequence[tuple[str, dict[str, Any]]], source: Path,
+                 existing_type: Any = None) -> None:
+    """One uuid names one document: refuse two documents of an import with one uuid, and
+    (``existing_type(uuid)``: the type a stored document of that uuid has, or None) a
+    document whose uuid the knowledge base already uses for another type."""
+    seen: dict[str, str] = {}
+    for where, doc in docs:
+        uuid, kind = str(doc.get("uuid")), doc.get("type")
+        if uuid in seen:
+            raise DataError(f"{source}: {where}: uuid {uuid!r} is also {seen[uuid]}; nothing was "
+                            "imported, give each document its own uuid")
+        seen[uuid] = where
+        stored = existing_type(uuid) if existing_type is not None else None
+        if stored is not None and stored != kind:
+            raise DataError(f"{source}: {where}: uuid {uuid!r} is a stored {stored} of the knowledge "
+                            f"base, not a {kind}; nothing was imported, give it its own uuid")
+
+
 def check_documents(docs: Sequence[tuple[str, dict[str, Any]]], source: Path) -> None:
     """Raise ``DataError`` naming the first bad document (where, uuid) and field."""
     for where, doc in docs:
@@ -64,6 +157,11 @@ def check_documents(docs: Sequence[tuple[str, dict[str, Any]]], source: Path) ->
 def _check(doc: dict[str, Any]) -> None:
     _uuid(doc, "uuid")
     kind = doc.get("type")
+    if doc.get("frame_id") is not None:
+        _text(doc, "frame_id")
+    data = doc.get("data", {})
+    if isinstance(data, dict) and data.get("vacated_s") is not None:
+        _finite(data["vacated_s"], "data.vacated_s")
     if kind == "environment":
         _text(doc, "name")
     elif kind in ("instance", "observation"):
@@ -113,13 +211,19 @@ def _uuid(doc: dict[str, Any], key: str) -> None:
 
 def _text(doc: dict[str, Any], key: str) -> None:
     value = doc.get(key)
-    if not isinstance(value, str) or not value:
-        raise _Bad(key, f"is {value!r}, expected a non-empty text")
+    if not isinstance(value, str) or not value or len(value) > 1000:
+        raise _Bad(key, f"is {str(value)[:60]!r}, expected a non-empty text of at most 1000 characters")
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise _Bad(key, "holds a lone surrogate, not text") from None
 
 
 def _finite(value: Any, key: str, lo: float = -MAX_ABS, hi: float = MAX_ABS) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _Bad(key, f"is {value!r}, expected a number")
+        raise _Bad(key, f"is {str(value)[:60]!r}, expected a number")
+    if isinstance(value, int) and abs(value) > hi:
+        raise _Bad(key, f"is {str(value)[:20]}..., expected a finite number in [{lo:g}, {hi:g}]")
     number = float(value)
     if not math.isfinite(number) or not lo <= number <= hi:
         raise _Bad(key, f"is {value!r}, expected a finite number in [{lo:g}, {hi:g}]")

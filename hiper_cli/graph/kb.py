@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from hiper_cli import DEFAULT_KB
-from hiper_cli.errors import GraphDamagedError, KnowledgeBaseError
+from hiper_cli.errors import ConfigError, GraphDamagedError, KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
 from hiper_cli.graph.location import kb_location
 from hiper_cli.graph.ontology import (
@@ -529,6 +529,9 @@ def open_kb(
     then it is replaced by one rebuilt from the documents.
     """
     remote, text = kb_location(location)
+    if docs_dir is not None and not remote:
+        raise ConfigError(f"--kb-docs {docs_dir}: only for a --kb that is a SPARQL endpoint (http://...); "
+                          f"the documents of --kb {text} live inside that folder")
     root = Path(docs_dir) if docs_dir is not None else (Path(DEFAULT_KB) if remote else Path(text))
     if root.exists() and not root.is_dir():
         raise KnowledgeBaseError(

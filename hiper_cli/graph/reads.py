@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.graph.documents import DocumentStore, Session
+from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S
 from hiper_cli.model import Analysis, Observation
 
 __all__ = ["KbReads", "ObservationPoint", "RobotPose"]
@@ -104,8 +105,10 @@ class KbReads:
         return list(self.graph.query(sparql, bindings))
 
     def run_readonly(
-        self, sparql: str, media_type: str = "application/sparql-results+json"
+        self, sparql: str, media_type: str = "application/sparql-results+json",
+        timeout_s: float | None = DEFAULT_TIMEOUT_S,
     ) -> tuple[bytes, str]:
-        """Any read-only SPARQL query over all graphs, serialised; updates refused."""
-        body, media = self.graph.run_readonly(sparql, media_type)
+        """Any read-only SPARQL query over all graphs, serialised; updates, ``SERVICE`` and a
+        query past ``timeout_s`` refused."""
+        body, media = self.graph.run_readonly(sparql, media_type, timeout_s)
         return bytes(body), str(media)

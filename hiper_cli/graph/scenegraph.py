@@ -21,6 +21,7 @@ import pyoxigraph as ox
 
 from hiper_cli.errors import GraphDamagedError, KnowledgeBaseError, QueryError
 from hiper_cli.graph.ontology import HIPER, PROV, meta_graph
+from hiper_cli.graph.sparql_safety import DEFAULT_TIMEOUT_S, readonly_form, run_with_timeout
 
 __all__ = ["DetachedGraph", "GraphBackend", "LocalGraph", "SparqlGraph", "open_graph"]
 
@@ -84,10 +85,11 @@ class GraphBackend(Protocol):
         template's variables, never text pasted into it); bound variables must be projected."""
         ...
 
-    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
+    def run_readonly(self, sparql: str, media_type: str,
+                     timeout_s: float | None = DEFAULT_TIMEOUT_S) -> tuple[bytes, str]:
         """A SELECT, ASK, CONSTRUCT or DESCRIBE query over the union of all graphs, serialised
         as ``media_type`` (a SPARQL results or RDF media type); (body, media type). Updates
-        are refused with ``QueryError``."""
+        and ``SERVICE`` are refused, and a query running past ``timeout_s``, with ``QueryError``."""
         ...
 
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]: ...
@@ -255,13 +257,18 @@ class LocalGraph:
             raise KnowledgeBaseError(f"SPARQL query does not parse: {err}") from err
 
     @_guarded
-    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
-        readonly_check(sparql)
-        try:
-            result = self._store.query(_PREFIXES + sparql, use_default_graph_as_union=True)
-        except SyntaxError as err:
-            raise QueryError(f"SPARQL query does not parse: {err}") from err
-        return serialize_results(result, media_type)
+    def run_readonly(self, sparql: str, media_type: str,
+                     timeout_s: float | None = DEFAULT_TIMEOUT_S) -> tuple[bytes, str]:
+        readonly_form(sparql, _PREFIXES)
+
+        def evaluate() -> tuple[bytes, str]:  # lazy results: serialising runs the query
+            try:
+                result = self._store.query(_PREFIXES + sparql, use_default_graph_as_union=True)
+                return serialize_results(result, media_type)
+            except SyntaxError as err:
+                raise QueryError(f"SPARQL query does not parse: {err}") from err
+
+        return run_with_timeout(evaluate, timeout_s)
 
     @_guarded
     def quads(self, graphs: Sequence[ox.NamedNode]) -> list[ox.Quad]:
@@ -386,10 +393,14 @@ class SparqlGraph:
                          accept="application/sparql-results+json")
         return _solutions(ox.parse_query_results(raw, format=ox.QueryResultsFormat.JSON))
 
-    def run_readonly(self, sparql: str, media_type: str) -> tuple[bytes, str]:
-        readonly_check(sparql)
+    def run_readonly(self, sparql: str, media_type: str,
+                     timeout_s: float | None = DEFAULT_TIMEOUT_S) -> tuple[bytes, str]:
+        readonly_form(sparql, _PREFIXES)
         try:
-            body = self._post("query", _PREFIXES + sparql, "application/sparql-query", accept=media_type)
+            body = run_with_timeout(
+                lambda: self._post("query", _PREFIXES + sparql, "application/sparql-query",
+                                   accept=media_type),
+                timeout_s)
             return body, media_type
         except KnowledgeBaseError as err:
             raise QueryError(str(err)) from err
@@ -454,26 +465,6 @@ def values_bound(sparql: str, bindings: Mapping[str, Any]) -> str:
     names = " ".join(f"?{ox.Variable(k).value}" for k in bindings)
     row = " ".join(str(term(v)) for v in bindings.values())
     return f"{sparql[: match.end()]} VALUES ({names}) {{ ({row}) }} {sparql[match.end():]}"
-
-
-_UPDATE_WORDS = ("INSERT", "DELETE", "LOAD", "CLEAR", "CREATE", "DROP", "COPY", "MOVE", "ADD")
-
-
-def readonly_check(sparql: str) -> None:
-    """Refuse SPARQL updates (the text must parse as a query, checked on an empty store) and
-    federated ``SERVICE`` calls (a read-only endpoint must not fetch other URLs)."""
-    import re
-
-    if re.search(r"\bSERVICE\s+(SILENT\s+)?[<?$]", sparql, flags=re.IGNORECASE):
-        raise QueryError("SPARQL SERVICE (federated query) refused: only this knowledge base is queried")
-    try:
-        ox.Store().query(_PREFIXES + sparql)
-    except SyntaxError as err:
-        words = [w for w in _UPDATE_WORDS if w in sparql.upper().split()]
-        if words:
-            raise QueryError(f"SPARQL update ({', '.join(words)}) refused: the scene graph is read-only "
-                             "here; send a SELECT, ASK, CONSTRUCT or DESCRIBE query") from err
-        raise QueryError(f"SPARQL query does not parse: {err}") from err
 
 
 RESULT_FORMATS = {

@@ -17,6 +17,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -54,6 +55,7 @@ class Workspace:
     cache: Path
     repo: Path
     cleanups: list[Callable[[], None]] = field(default_factory=list)
+    extra: dict[str, str] = field(default_factory=dict)  # more {name} values a preparation sets
 
     @property
     def kb(self) -> Path:
@@ -62,7 +64,7 @@ class Workspace:
     def values(self) -> dict[str, str]:
         return {"root": str(self.root), "kb": str(self.kb), "log": str(self.cache / "log"),
                 "export": str(self.cache / "export.json"), "mcap": str(self.cache / "log.mcap"),
-                "bag": str(self.cache / "log.bag")}
+                "bag": str(self.cache / "log.bag"), **self.extra}
 
     def hiper(self, *args: str, timeout_s: float = 120.0, fsize: int | None = None) -> Result:
         return run_hiper(self.repo, [a.format(**self.values()) for a in args], self.root, timeout_s, fsize)
@@ -138,7 +140,8 @@ def kb_problems(repo: Path, kb: Path, cwd: Path, expected: dict[str, Any] | None
     --no-repair`` fails, or (``expected``) it holds other documents than the template."""
     state = kb_state(repo, kb, cwd)
     if state is None:
-        return ["the knowledge base does not open any more"]
+        why = _last_line(run_hiper(repo, ["kb", "info", "--kb", str(kb)], cwd, 60.0))
+        return [f"the knowledge base does not open any more ({why})"]
     check = run_hiper(repo, ["kb", "check", "--no-repair", "--kb", str(kb)], cwd, 60.0)
     problems = [] if check.returncode == 0 else [f"kb check --no-repair: {_last_line(check)}"]
     if expected is not None and state != expected:
@@ -219,7 +222,14 @@ def run_case(case: Any, repo: Path, cache: Path, totals: dict[str, Any]) -> Outc
                     return Outcome(case.name, case.group, case.behaviour, "failed", -1,
                                    f"set-up failed: {err!r}"[:300], 0.0, [f"set-up failed: {err!r}"])
             before = _kb_snapshot(ws.kb) if case.kb == "unchanged" else None
-            result = ws.hiper(*case.argv, timeout_s=case.timeout_s, fsize=case.fsize_limit)
+            if case.probe is not None:
+                try:
+                    result = case.probe(ws)
+                except Exception as err:  # a probe that breaks: report it, do not stop the suite
+                    return Outcome(case.name, case.group, case.behaviour, "failed", -1,
+                                   f"probe failed: {err!r}"[:300], 0.0, [f"probe failed: {err!r}"])
+            else:
+                result = ws.hiper(*case.argv, timeout_s=case.timeout_s, fsize=case.fsize_limit)
             problems = _verify(case, ws, result, totals, before)
         finally:
             for cleanup in reversed(ws.cleanups):
@@ -239,15 +249,15 @@ def _verify(case: Any, ws: Workspace, result: Result, totals: dict[str, Any],
     problems: list[str] = []
     if result.timed_out:
         return problems
+    mode = case.kb
+    if mode == "unchanged" and _kb_snapshot(ws.kb) != before:  # before the check opens it
+        problems.append("documents changed: files of the refused folder were modified")
     if case.check is not None:
         found = case.check(ws, result)
         if found:
             problems.append(found)
-    mode = case.kb
     if mode == "absent" and ws.kb.exists():
         problems.append(f"{ws.kb} was created")
-    elif mode == "unchanged" and _kb_snapshot(ws.kb) != before:
-        problems.append("documents changed: files of the refused folder were modified")
     elif mode == "intact":
         problems += kb_problems(ws.repo, ws.kb, ws.root, totals)
     elif mode == "consistent":
@@ -270,39 +280,62 @@ def _kill_command(kind: str, ws: Workspace) -> list[str]:
         shutil.copy(ws.cache / "export.json", ws.root / "out.json")
         return ["export", str(ws.root / "out.json"), "--kb", values["kb"], "--format", "json",
                 "--observations"]
+    if kind == "startup":  # what every command pays before it touches the knowledge base
+        return ["kb", "info", "--help"]
+    if kind == "check":  # a damaged scene graph, rebuilt from the documents by kb check
+        from tests.faults.inputs import damage_graph
+
+        shutil.copytree(ws.cache / "template.hiper", ws.kb)
+        damage_graph(ws.kb, "sst")
+        return ["kb", "check", "--kb", values["kb"]]
+    if kind == "analyze":
+        shutil.copytree(ws.cache / "template.hiper", ws.kb)
+        return ["analyze", "features", "--kb", values["kb"], "--json"]
+    if kind == "reanchor":
+        shutil.copytree(ws.cache / "template.hiper", ws.kb)
+        return ["reanchor", "--kb", values["kb"], "--poses", values["log"] + "/groundtruth.txt", "--json"]
     return ["import", values["export"], "--kb", values["kb"]]
 
 
 KILL_ATTEMPTS = 3
+_TIMING = threading.Lock()
+KILLS_SPREAD = 10  # the moments of one kind are spread over this many slices of its run
 
 
 def _duration(kind: str, repo: Path, cache: Path) -> float:
     """Seconds an uninterrupted run of the kill case's command takes here (measured once)."""
     timing = cache / f"duration-{kind}.txt"
-    if not timing.is_file():
-        with tempfile.TemporaryDirectory(prefix="hiper-time-") as tmp:
-            ws = Workspace(Path(tmp), cache, repo)
-            result = run_hiper(repo, _kill_command(kind, ws), ws.root, 300.0)
-        timing.write_text(str(result.seconds))
-    return float(timing.read_text())
+    with _TIMING:  # measured once, by one thread: the others wait for it
+        if not timing.is_file():
+            with tempfile.TemporaryDirectory(prefix="hiper-time-") as tmp:
+                ws = Workspace(Path(tmp), cache, repo)
+                result = run_hiper(repo, _kill_command(kind, ws), ws.root, 300.0)
+            timing.write_text(str(result.seconds))
+        return float(timing.read_text())
 
 
 def kill_case(kind: str, index: int, repo: Path, cache: Path, totals: dict[str, Any]) -> Outcome:
-    """Start a perceive, export or import, kill -9 it at a random instant, and check that the
-    knowledge base reopens consistent with nothing committed lost, and that an export target
-    holds either the earlier export or a complete new one.
+    """Start a perceive, export, import, analyze, reanchor or kb check (rebuilding a damaged
+    graph; a second kb check must finish the repair), kill -9 it at the ``index``-th of
+    ten moments of its run, and check that the knowledge base reopens consistent (``kb check``)
+    with nothing committed lost, and that an export target holds either the earlier export or a
+    complete new one.
 
     A run that finishes before its kill (the machine got faster than when the duration was
     measured) is checked too, then tried again with an instant drawn within its own duration."""
     rng = random.Random(f"{kind}-{index}")
     duration = _duration(kind, repo, cache)
+    # ten moments spread over the run after Python has started and imported hiper (a kill
+    # before that tests nothing), each jittered within its tenth
+    startup = min(_duration("startup", repo, cache), 0.8 * duration)
+    share = (index + rng.uniform(0.05, 0.95)) / max(1, KILLS_SPREAD)
     for _attempt in range(KILL_ATTEMPTS):
-        # a random instant of the run's second half or so (the first ~0.4 s is Python starting)
-        delay = rng.uniform(0.3, 0.95) * duration
+        delay = startup + min(share, 0.97) * (duration - startup)
         outcome = _kill_once(kind, index, delay, repo, cache, totals)
         if outcome.verdict != "pass" or outcome.exit_code == -signal.SIGKILL:
             return outcome
         duration = min(duration, outcome.seconds)
+        share = rng.uniform(0.3, 0.95)
     return outcome
 
 
@@ -333,7 +366,11 @@ def _kill_once(kind: str, index: int, delay: float, repo: Path, cache: Path,
             except (OSError, ValueError) as err_json:
                 problems.append(f"lost: the export file is damaged ({err_json})")
         elif ws.kb.exists() and (ws.kb / "documents.sqlite").exists():
-            problems += kb_problems(repo, ws.kb, ws.root, None)
+            if kind == "check":  # killed while rebuilding a damaged graph: the next check finishes it
+                repair = run_hiper(repo, ["kb", "check", "--kb", str(ws.kb)], ws.root, 120.0)
+                if repair.returncode != 0:
+                    problems.append(f"kb check after the kill failed: {_last_line(repair)}")
+            problems += kb_problems(repo, ws.kb, ws.root, totals if kind == "check" else None)
             if kind == "import":
                 state = kb_state(repo, ws.kb, ws.root)
                 if state and state["totals"]["instance"] not in (0, totals["totals"]["instance"]):

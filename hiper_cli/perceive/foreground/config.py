@@ -35,7 +35,11 @@ def _as_tuples(config: object, names: tuple[str, ...]) -> None:
     for name in names:
         value = getattr(config, name)
         if isinstance(value, str):
+            text = value
             value = tuple(v.strip() for v in value.split(",") if v.strip())
+            if text.strip() and not value:
+                raise ConfigError(f"--{name.replace('_', '-')} {text!r}: no class names; expected names "
+                                  "separated by commas, such as 'cup,chair'")
         object.__setattr__(config, name, tuple(str(v) for v in value))
 
 
@@ -641,6 +645,11 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
         super().__post_init__()
         _as_tuples(self, ("classes", "exclude_classes", "carried_classes"))
         _in_unit_interval(self, ("carried_containment", "same_box_iou"))
+        both = [c for c in self.classes if c in self.exclude_classes]
+        if both:
+            raise ConfigError(f"--classes and --exclude-classes both name {', '.join(both)}; a class is kept "
+                              "or dropped, not both (the default exclusions: outdoor COCO classes and "
+                              "'dining table')")
 
     @classmethod
     def from_options(cls, **options: Any) -> ForegroundConfig:

@@ -148,6 +148,7 @@ class ForegroundStage:
 
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
         _check_classes(cfg.classes, getattr(self.detector, "class_names", None), cfg.detector)
+        _check_excluded(cfg.exclude_classes, getattr(self.detector, "class_names", None) or ())
         # the ``log`` detector reads the log's own detections: perceive checks the log has them
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
@@ -769,6 +770,21 @@ def _corners(blob: Blob) -> tuple[FloatArray, FloatArray]:
     lo, hi = lo.copy(), hi.copy()
     lo[2], hi[2] = centre[2] - extent[2] / 2.0, centre[2] + extent[2] / 2.0
     return lo, hi
+
+
+def _check_excluded(excluded: tuple[str, ...], detector_classes: Any) -> None:
+    """Refuse ``--exclude-classes`` that name no class any detector reports (a typo)."""
+    from hiper_cli.perceive.detect._onnx import COCO_NAMES
+
+    known = {*COCO_NAMES, *detector_classes}
+    unknown = [c for c in excluded if c not in known]
+    if unknown:
+        import difflib
+
+        near = difflib.get_close_matches(unknown[0], sorted(known), n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise ConfigError(f"--exclude-classes {', '.join(unknown)}: no detector has such a class; {hint}"
+                          "expected COCO class names such as 'boat,traffic light'")
 
 
 def _check_classes(wanted: tuple[str, ...], known: Any, detector: str) -> None:

@@ -67,13 +67,18 @@ def convert_log(reader: LogReader, out: str | Path, to: str, *, layout: BagLayou
         raise ConfigError(f"--to {to}: unknown format; expected one of {', '.join(CONVERT_TARGETS)}")
     out = Path(out)
     refuse_inside(out, "converted log")
+    info = reader.info()
+    source, target = Path(info.path).resolve(), out.resolve()
+    if target == source or source in target.parents or target in source.parents:
+        raise ConfigError(f"{out}: the output is the input log {info.path} (or holds it, or lies in it); "
+                          "choose an output path outside the log")
     if out.exists() and (to != "tum" or not overwrite):
         if to != "tum":
             raise LogError(f"{out}: exists already; choose a new output path")
         if out.is_file() or any(out.iterdir()):
             raise LogError(f"{out}: folder exists and is not empty; choose another output or pass "
                            "--overwrite")
-    camera = reader.info().camera
+    camera = info.camera
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as err:

@@ -75,12 +75,23 @@ def check_pixels(head: bytes, source: str) -> None:
                        f"{MAX_IMAGE_PIXELS / 1e6:.0f} megapixels; not decoded (a damaged or wrong file?)")
 
 
+def check_complete(data: bytes, source: str) -> None:
+    """Refuse a JPEG that stops before its end-of-image marker (``FF D9``): OpenCV decodes a
+    truncated one without an error, the missing rows grey."""
+    if data[:2] == b"\xff\xd8" and not data.rstrip(b"\x00\r\n ")[-2:] == b"\xff\xd9":
+        raise LogError(f"{source}: the JPEG ends before its end-of-image marker (a truncated or damaged "
+                       "file); frame not decoded")
+
+
 def _check_file_pixels(path: Path) -> None:
     try:
         with path.open("rb") as f:
             head = f.read(32)
             if head[:2] == b"\xff\xd8":
                 head += f.read(1 << 16)
+                size = f.seek(0, 2)
+                f.seek(max(0, size - 64))
+                check_complete(head[:2] + f.read(), str(path))
     except OSError as err:
         raise LogError(f"{path}: cannot read ({err.strerror or err})") from err
     check_pixels(head, str(path))
@@ -182,9 +193,11 @@ def decode_depth(encoding: str, height: int, width: int, step: int, data: NDArra
 
 def decode_compressed_rgb(fmt: str, data: NDArray[np.uint8], source: str) -> NDArray[np.uint8]:
     """A ``sensor_msgs/CompressedImage`` (png/jpeg) colour payload to RGB."""
-    check_pixels(bytes(np.asarray(data, dtype=np.uint8).reshape(-1)[: 1 << 16]), source)
+    flat = np.asarray(data, dtype=np.uint8).reshape(-1)
+    check_pixels(bytes(flat[: 1 << 16]), source)
+    check_complete(bytes(flat[:2]) + bytes(flat[-64:]), source)
     cv2 = _cv2()
-    image = cv2.imdecode(np.asarray(data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+    image = cv2.imdecode(flat, cv2.IMREAD_UNCHANGED)
     if image is None:
         raise LogError(f"{source}: cannot decode the compressed image (format '{fmt}'); expected png or jpeg")
     return _to_rgb(image, source, order="bgr")  # OpenCV decodes to BGR

@@ -28,6 +28,8 @@ FloatArray = NDArray[np.float64]
 
 # A quaternion whose norm is further than this from 1 is a broken file, not rounding.
 QUAT_NORM_TOLERANCE = 1e-2
+MAX_POSITION_M = 1e6  # 1000 km from the map origin: a robot log never goes there; a pose that does is damage
+MAX_STAMP_S = 1e11  # Unix time and log time both fit
 
 
 def quat_xyzw_to_matrix(quat_xyzw: FloatArray) -> FloatArray:
@@ -99,6 +101,11 @@ class Trajectory:
             i = int(np.argmax(bad))
             raise LogError(f"{where}: pose {i} (stamp {stamps[i]}) contains NaN or infinite values; "
                            "fix or drop that pose")
+        far = (np.abs(stamps) > MAX_STAMP_S) | np.any(np.abs(pos) > MAX_POSITION_M, axis=1)
+        if np.any(far):
+            i = int(np.argmax(far))
+            raise LogError(f"{where}: pose {i} (stamp {stamps[i]:g}) lies at {pos[i].tolist()} m; expected "
+                           f"positions within {MAX_POSITION_M:g} m and stamps within {MAX_STAMP_S:g} s")
         norms = np.linalg.norm(quats, axis=1)
         off = np.abs(norms - 1.0) > QUAT_NORM_TOLERANCE
         if np.any(off):
@@ -208,6 +215,9 @@ def read_tum_trajectory(path: str | Path) -> Trajectory:
                            ) from err
         if not all(np.isfinite(values)):
             raise LogError(f"{path}:{number}: pose contains NaN or infinite values; fix or drop that line")
+        if abs(values[0]) > MAX_STAMP_S or max(abs(v) for v in values[1:4]) > MAX_POSITION_M:
+            raise LogError(f"{path}:{number}: pose at {values[1:4]} m, stamp {values[0]:g} s; expected "
+                           f"positions within {MAX_POSITION_M:g} m and stamps within {MAX_STAMP_S:g} s")
         norm = float(np.linalg.norm(values[4:]))
         if abs(norm - 1.0) > QUAT_NORM_TOLERANCE:
             raise LogError(f"{path}:{number}: quaternion norm is {norm:.4f}; expected a unit quaternion "

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,13 +48,18 @@ def is_tum_folder(path: Path) -> bool:
     )
 
 
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
 def load_camera_json(path: Path) -> CameraIntrinsics:
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(), parse_constant=_no_constant)
     except FileNotFoundError as err:
         raise LogError(f"{path}: camera file not found; pass an existing camera.json") from err
-    except (OSError, ValueError) as err:
-        raise LogError(f"{path}: not valid JSON ({err}); expected "
+    except (OSError, ValueError, RecursionError) as err:  # RecursionError: nested beyond any camera
+        detail = "nested too deeply" if isinstance(err, RecursionError) else " ".join(str(err).split())[:120]
+        raise LogError(f"{path}: not valid JSON ({detail}); expected "
                        '{"width", "height", "fx", "fy", "cx", "cy", "depth_scale"}') from err
     if not isinstance(data, dict):
         raise LogError(f"{path}: expected a JSON object with width, height, fx, fy, cx, cy")
@@ -82,9 +88,21 @@ def _read_list(path: Path) -> list[tuple[float, str]]:
                            "expected 'stamp path'") from err
         if len(parts) < 2 or not np.isfinite(stamp):
             raise LogError(f"{path}:{number}: expected 'stamp path', got '{line}'")
-        rows.append((stamp, parts[1]))
+        rows.append((stamp, _inside(path, number, parts[1])))
     rows.sort(key=lambda r: r[0])
     return rows
+
+
+def _inside(listing: Path, number: int, name: str) -> str:
+    """An image path of a list file, which must name a file inside the log folder: an absolute
+    path or one climbing out with ``..`` is refused (a log names its own images)."""
+    import os.path
+
+    normal = os.path.normpath(name)  # by text: a symlinked image folder stays allowed
+    if os.path.isabs(normal) or normal == ".." or normal.startswith(".." + os.sep):
+        raise LogError(f"{listing}:{number}: {name!r} lies outside the log folder; image paths must be "
+                       "relative to it (e.g. rgb/0.000000.png)")
+    return name
 
 
 def _text(path: Path, what: str) -> str:
@@ -108,7 +126,8 @@ def _read_associations(path: Path) -> list[tuple[float, str, float, str]]:
         if len(parts) < 4:
             raise LogError(f"{path}:{number}: expected 't_rgb rgb_path t_depth depth_path', got '{line}'")
         try:
-            rows.append((float(parts[0]), parts[1], float(parts[2]), parts[3]))
+            rows.append((float(parts[0]), _inside(path, number, parts[1]), float(parts[2]),
+                         _inside(path, number, parts[3])))
         except ValueError as err:
             raise LogError(f"{path}:{number}: not a timestamp ({err}); expected "
                            "'t_rgb rgb_path t_depth depth_path'") from err
