@@ -88,14 +88,16 @@ def _convert_degraded(log: Path, out: Path, profile_name: str, to: str | None, s
         profile = profile.with_pose_drift(pose_drift)
     reader = open_log(log, log_options)
     screen = console()
-    with frame_progress(f"degrading to {safe_text(out)}", screen, enabled=not json_out, total=len(reader)) as bar:
+    title = f"degrading to {safe_text(out)}"
+    with frame_progress(title, screen, enabled=not json_out, total=len(reader)) as bar:
         result = degrade_log(reader, out, profile, seed, overwrite=overwrite,
                              on_frame=bar.advance if bar else None)
     if json_out:
         print_json({**result.to_dict(), "input": str(log)})
         return
     err = result.pose_error
-    screen.print(f"wrote {result.convert.frames_written} frames to {safe_text(out)} as a {profile.name} sensor "
+    screen.print(f"wrote {result.convert.frames_written} frames to {safe_text(out)} "
+                 f"as a {profile.name} sensor "
                  f"(seed {seed}); pose error RMS {err['rms_m']:.3f} m, final {err['final_m']:.3f} m; "
                  f"truth in {safe_text(out)}/gt")
     for source, reason in result.convert.skipped:
