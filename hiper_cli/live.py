@@ -6,7 +6,8 @@ dropped and counted). Every frame is written in one transaction as for logs, and
 graph follows after each frame by default (``graph_sync_s=0``), so what a frame shows can be
 asked (``hiper query``/``serve``/``mcp`` on the same knowledge base) once it is written. The
 latency of a frame is from the moment its colour image was sent (rmw_zenoh's attachment
-source time; the receive time when absent) to the moment it is queryable.
+source time; the receive time when absent) to the moment it is queryable: written, and in
+the scene graph the queries read.
 Ctrl-C ends the run after the frame in hand, with the session finished and everything written.
 """
 
@@ -133,16 +134,26 @@ def perceive_live(
                         idle_timeout_s=settings.idle_timeout_s, silence_s=settings.silence_s,
                         domain_id=settings.domain_id, wait_s=settings.wait_s, on_status=on_status)
 
-    def written(frame: Frame | None, result: FrameResult) -> None:
-        if frame is not None:
-            report.latency_s.append(time.time() - float(frame.extras.get("sent_s", time.time())))
-            _copy_counts(source, report)
-            if progress is not None:
-                progress(source.counts.frames, report)
-        if on_frame is not None:
-            on_frame(frame, result)
+    unsynced: list[float] = []  # send times of frames written but not yet in the scene graph
+
+    def queryable() -> None:
+        now = time.time()
+        report.latency_s.extend(now - sent_s for sent_s in unsynced)
+        unsynced.clear()
 
     with open_kb(kb, docs_dir=kb_docs) as knowledge:
+
+        def written(frame: Frame | None, result: FrameResult) -> None:
+            if frame is not None:
+                unsynced.append(float(frame.extras.get("sent_s", time.time())))
+                if knowledge.graph.synced_seq(knowledge.kb_id) >= knowledge.docs.seq:
+                    queryable()
+                _copy_counts(source, report)
+                if progress is not None:
+                    progress(source.counts.frames, report)
+            if on_frame is not None:
+                on_frame(frame, result)
+
         source.start()
         report.session = source.how
         try:
@@ -150,6 +161,7 @@ def perceive_live(
                 summary = perceive(source, knowledge, stages, options, on_frame=written)
         finally:
             source.close()
+    queryable()
     _copy_counts(source, report)
     report.stopped_by = report.stopped_by or "idle timeout"
     return summary, report

@@ -3,7 +3,8 @@
 It subscribes to the colour, depth, camera-info and pose topics on a Zenoh endpoint
 (``rmw.open_session``), assembles frames (``sync.FrameSync``) and yields them to the
 pipeline as a log reader does, numbering them 0, 1, 2... as perceived. Iteration ends when
-``stop()`` is called (Ctrl-C) or after ``idle_timeout_s`` without a frame; a silence of
+``stop()`` is called (Ctrl-C) or after ``idle_timeout_s`` without a frame (``wait_s`` at
+least before the first); a silence of
 ``silence_s`` is reported once (``on_status``) and again when frames come back.
 """
 
@@ -179,8 +180,7 @@ class LiveSource:
                     silent = True
                     self.counts.silences.append({"after_frame": self.counts.frames, "seconds": 0.0})
                     self._status("silent", f"no frames for {now - last_frame:.1f} s from {self.url}")
-                if self.idle_timeout_s is not None and now - last_frame >= self.idle_timeout_s:
-                    self._status("idle", f"no frames for {self.idle_timeout_s:g} s: ending the run")
+                if self._idle(now - last_frame):
                     return
                 continue
             if silent:
@@ -192,6 +192,17 @@ class LiveSource:
             if frame is not None:
                 self.counts.frames += 1
                 yield frame
+
+    def _idle(self, quiet_s: float) -> bool:
+        """Whether to end the run: ``idle_timeout_s`` without frames once some came, ``wait_s``
+        (or the idle timeout if longer) before the first."""
+        limit = self.idle_timeout_s
+        if not self.counts.frames and limit is not None:
+            limit = max(limit, self.wait_s)
+        if limit is None or quiet_s < limit:
+            return False
+        self._status("idle", f"no frames for {limit:g} s: ending the run")
+        return True
 
     def _status(self, kind: str, text: str) -> None:
         if self.on_status is not None:

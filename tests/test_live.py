@@ -1,0 +1,255 @@
+"""Live mode: rmw_zenoh conventions, frame assembly, replay -> perceive, readers during a run,
+a publisher that dies and returns, and an independent rmw_zenoh publisher (zenoh-ros2-sdk).
+
+Everything runs on loopback endpoints with free ports; the tests that need the Zenoh binding
+skip with the reason when it is absent (pip install 'hiper[live]').
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import signal
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.live.rmw import TYPE_HASHES, Attachment, parse_endpoint, topic_key
+from tests.live_helpers import FIXTURE, ROOT, free_port, hiper, instances, wait_listening
+
+HAS_ZENOH = importlib.util.find_spec("zenoh") is not None
+needs_zenoh = pytest.mark.skipif(not HAS_ZENOH,
+                                 reason="the Zenoh binding is absent: pip install 'hiper[live]'")
+
+
+def _has_yolox() -> bool:
+    from hiper_cli.perceive.detect.yolox import find_yolox_model
+
+    try:
+        find_yolox_model()
+    except ConfigError:
+        return False
+    return True
+
+
+needs_yolox = pytest.mark.skipif(not _has_yolox(), reason="YOLOX-Nano model absent (set HIPER_MODELS)")
+
+
+# --- conventions (no network) ---------------------------------------------------------------
+def test_key_expressions_follow_rmw_zenoh():
+    assert topic_key("/camera/color/image_raw", "sensor_msgs/msg/Image") == (
+        "0/camera/color/image_raw/sensor_msgs::msg::dds_::Image_/" + TYPE_HASHES["sensor_msgs/msg/Image"])
+    assert topic_key("/tf", "tf2_msgs/msg/TFMessage", domain_id=7, type_hash="*") == (
+        "7/tf/tf2_msgs::msg::dds_::TFMessage_/*")
+
+
+def test_attachment_layout_is_sequence_time_gid():
+    data = Attachment(3, 1_700_000_000_123_456_789, bytes(range(16))).to_bytes()
+    assert data[:8] == (3).to_bytes(8, "little")
+    assert data[8:16] == (1_700_000_000_123_456_789).to_bytes(8, "little")
+    assert data[16] == 16 and data[17:] == bytes(range(16))
+    assert Attachment.from_bytes(data) == Attachment(3, 1_700_000_000_123_456_789, bytes(range(16)))
+    assert Attachment.from_bytes(data[:20]) is None
+
+
+@pytest.mark.parametrize(("url", "endpoint"), [
+    ("zenoh://tcp/127.0.0.1:7447", "tcp/127.0.0.1:7447"),
+    ("zenoh:/tcp/10.0.0.2:7448", "tcp/10.0.0.2:7448"),  # what a shell path argument becomes
+    ("zenoh://", "tcp/127.0.0.1:7447"),
+])
+def test_endpoints(url, endpoint):
+    assert parse_endpoint(url) == endpoint
+
+
+@pytest.mark.parametrize("url", ["zenoh://localhost", "zenoh://tcp/127.0.0.1", "http://x:1"])
+def test_bad_endpoints_say_what_is_expected(url):
+    with pytest.raises(ConfigError, match="zenoh://tcp/HOST:PORT"):
+        parse_endpoint(url)
+
+
+# --- zenoh-ros2-sdk as the reference --------------------------------------------------------
+@pytest.fixture(scope="module")
+def msg_dir(tmp_path_factory):
+    """The .msg files of the published types (rosbags' ROS 2 definitions), so no network is needed."""
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    out = tmp_path_factory.mktemp("msgs")
+    for msgtype in TYPE_HASHES:
+        text, _ = store.generate_msgdef(msgtype, ros_version=2)
+        for k, part in enumerate(text.split("=" * 80 + "\n")):
+            name = msgtype
+            if k:
+                first, _, part = part.partition("\n")
+                name = first.removeprefix("MSG: ")
+            package, leaf = name.split("/")[0], name.split("/")[-1]
+            path = out / package / "msg" / f"{leaf}.msg"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(part)
+    return out
+
+
+def test_type_hashes_match_zenoh_ros2_sdk(msg_dir):
+    pytest.importorskip("zenoh_ros2_sdk", reason="zenoh-ros2-sdk is absent: pip install 'hiper[dev]'")
+    from zenoh_ros2_sdk.message_registry import MessageRegistry
+    from zenoh_ros2_sdk.utils import get_type_hash, load_dependencies_recursive, ros2_to_dds_type
+
+    registry = MessageRegistry(str(msg_dir))
+    for msgtype, expected in TYPE_HASHES.items():
+        text = (msg_dir / msgtype.split("/")[0] / "msg" / f"{msgtype.split('/')[-1]}.msg").read_text()
+        deps = load_dependencies_recursive(msgtype, text, registry)
+        assert get_type_hash(msgtype, msg_definition=text, dependencies=deps) == expected, msgtype
+        assert topic_key("/x", msgtype).split("/")[2] == ros2_to_dds_type(msgtype)
+
+
+@needs_zenoh
+@needs_yolox
+def test_sdk_publisher_builds_the_same_kb_as_the_log(tmp_path, msg_dir):
+    """(a) an independent rmw_zenoh publisher, hiper perceive zenoh:// vs the log itself."""
+    pytest.importorskip("zenoh_ros2_sdk", reason="zenoh-ros2-sdk is absent: pip install 'hiper[dev]'")
+    port = free_port()
+    live = hiper("perceive", f"zenoh://tcp/127.0.0.1:{port}", "--kb", str(tmp_path / "live"),
+                 "--queue", "200", "--idle-timeout", "4", "--json")
+    direct = hiper("perceive", str(FIXTURE), "--kb", str(tmp_path / "direct"), "--json",
+                   stdout=subprocess.DEVNULL)
+    wait_listening(port)
+    script = str(ROOT / "tests" / "live_sdk_publisher.py")
+    pub = subprocess.run([sys.executable, script, str(FIXTURE), str(port), str(msg_dir), "10"], cwd=ROOT,
+                         env={"PYTHONPATH": str(ROOT), "PATH": ""},
+                         capture_output=True, text=True, timeout=120)
+    assert pub.returncode == 0, pub.stderr
+    assert "published 60" in pub.stdout
+    out, _ = live.communicate(timeout=180)
+    assert live.returncode == 0, out
+    assert direct.wait(timeout=180) == 0
+    summary = json.loads(out[out.index("{"):])
+    assert summary["frames_read"] == 60 and summary["live"]["frames_dropped"] == 0
+    got, want = instances(tmp_path / "live"), instances(tmp_path / "direct")
+    assert [(layer, cls) for layer, cls, _ in got] == [(layer, cls) for layer, cls, _ in want]
+    gaps = [float(np.linalg.norm(a[2] - b[2])) for a, b in zip(got, want, strict=True)]
+    assert max(gaps) <= 0.01, gaps
+
+
+# --- replay -> perceive ---------------------------------------------------------------------
+@needs_zenoh
+def test_replay_delivers_the_log_frames_unchanged():
+    """(b) every frame, pixel for pixel, with its stamp and pose, through rmw_zenoh messages."""
+    from hiper_cli.perceive.live.replay import replay_frames
+    from hiper_cli.perceive.live.source import LiveSource
+    from hiper_cli.perceive.logs import LogOptions, open_log
+
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    source = LiveSource(endpoint, LogOptions(), capacity=100, idle_timeout_s=2.0, silence_s=1.0)
+    source.start()
+    reader = open_log(FIXTURE)
+    thread = threading.Thread(target=replay_frames, args=(reader, reader.info().camera, endpoint),
+                              kwargs={"hz": 30.0}, daemon=True)
+    thread.start()
+    try:
+        frames = list(source)
+    finally:
+        source.close()
+    thread.join(timeout=30)
+    want = list(open_log(FIXTURE))
+    assert len(frames) == len(want) == 60
+    assert source.sync.dropped == 0 and source.counts.bad_messages == 0
+    for got, ref in zip(frames, want, strict=True):
+        assert got.stamp_s == pytest.approx(ref.stamp_s, abs=1e-6)
+        assert np.array_equal(got.rgb, ref.rgb) and np.array_equal(got.depth_m, ref.depth_m)
+        assert np.allclose(got.T_map_cam, ref.T_map_cam, atol=1e-9)
+        assert got.extras["sent_s"] == pytest.approx(time.time(), abs=60)
+
+
+def _snapshot(db: Path) -> tuple[int, int, list[tuple[int, int]]]:
+    """In one read transaction: frames the session row says, pose rows, and per frame stamp
+    (µs) the observations written with it."""
+    con = sqlite3.connect(f"file:{db}?mode=ro", uri=True, isolation_level=None)
+    try:
+        con.execute("BEGIN")
+        said = con.execute("SELECT COALESCE(SUM(frames), 0) FROM sessions").fetchone()[0]
+        poses = con.execute("SELECT COUNT(*) FROM poses").fetchone()[0]
+        per_stamp = con.execute("SELECT CAST(ROUND(stamp_s * 1e6) AS INTEGER), COUNT(*) FROM docs "
+                                "WHERE type = 'observation' GROUP BY 1").fetchall()
+        con.execute("COMMIT")
+    finally:
+        con.close()
+    return int(said), int(poses), [(int(a), int(b)) for a, b in per_stamp]
+
+
+@needs_zenoh
+@needs_yolox
+def test_queries_during_a_live_run_see_only_whole_frames(tmp_path):
+    """(c) a reader asking every 100 ms while hiper replay -> hiper perceive runs."""
+    from hiper_cli.graph import open_kb_for_reading
+    from hiper_cli.query import ask
+
+    port, kb = free_port(), tmp_path / "kb"
+    live = hiper("perceive", f"zenoh://tcp/127.0.0.1:{port}", "--kb", str(kb), "--idle-timeout", "3",
+                 "--json")
+    wait_listening(port)
+    replay = hiper("replay", str(FIXTURE), f"zenoh://tcp/127.0.0.1:{port}", "--hz", "10",
+                   stdout=subprocess.DEVNULL)
+    errors: list[str] = []
+    snapshots = []
+    answers = 0
+    while live.poll() is None:
+        time.sleep(0.1)
+        db = kb / "documents.sqlite"
+        if not db.exists():
+            continue
+        try:
+            snapshots.append(_snapshot(db))
+            with open_kb_for_reading(str(kb)) as knowledge:
+                ask(knowledge, "chairs")
+            answers += 1
+        except Exception as err:  # any reader error fails the test
+            errors.append(f"{type(err).__name__}: {err}")
+    out = live.stdout.read() if live.stdout else ""
+    assert replay.wait(timeout=30) == 0 and live.returncode == 0, out
+    assert not errors, errors[:3]
+    assert answers >= 10
+    final = dict(_snapshot(kb / "documents.sqlite")[2])
+    during = [s for s in snapshots if s[1] > 0]
+    assert len(during) >= 10
+    for said, poses, per_stamp in during:
+        assert said == poses  # the session's progress and its pose rows are written together
+        for stamp, count in per_stamp:  # each frame's observations are all there, or none
+            assert count == final.get(stamp), (stamp, count, final.get(stamp))
+
+
+@needs_zenoh
+@needs_yolox
+def test_publisher_killed_mid_run_then_back(tmp_path):
+    """(d) the silence is reported, the knowledge base stays consistent, the run resumes."""
+    from hiper_cli.graph import open_kb
+
+    port, kb = free_port(), tmp_path / "kb"
+    url = f"zenoh://tcp/127.0.0.1:{port}"
+    live = hiper("perceive", url, "--kb", str(kb), "--idle-timeout", "4")
+    wait_listening(port)
+    first = hiper("replay", str(FIXTURE), url, "--hz", "10", stdout=subprocess.DEVNULL)
+    time.sleep(4.0)
+    first.send_signal(signal.SIGKILL)
+    first.wait(timeout=10)
+    time.sleep(3.0)  # longer than the 2 s silence report, shorter than the idle timeout
+    second = hiper("replay", str(FIXTURE), url, "--hz", "10", stdout=subprocess.DEVNULL)
+    assert second.wait(timeout=60) == 0
+    out, _ = live.communicate(timeout=60)
+    assert live.returncode == 0, out
+    assert "silent: no frames for" in out and "resumed: frames again after" in out, out
+    flat = " ".join(out.split())
+    assert "ended by idle timeout" in flat, out
+    with open_kb(str(kb)) as knowledge:
+        report = knowledge.check(repair=False)
+        session = knowledge.docs.find(type="environment")
+    assert not report.problems, report.problems
+    assert session
+    said, poses, _ = _snapshot(kb / "documents.sqlite")
+    assert said == poses > 40  # frames of both publisher runs were perceived
