@@ -46,7 +46,14 @@ class ZenohPublisher(BagWriter):
     def _put(self, topic: str, msgtype: str, msg: Any, stamp_s: float) -> None:
         publisher = self._connections.get(topic)
         if publisher is None:
-            publisher = self.session.declare_publisher(topic_key(topic, msgtype, domain_id=self.domain_id))
+            import zenoh
+
+            # images as a camera driver's sensor-data QoS: best effort, a slow reader loses frames
+            # instead of queueing them; poses and camera info reliable
+            image = msgtype in ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
+            control = zenoh.CongestionControl.DROP if image else zenoh.CongestionControl.BLOCK
+            publisher = self.session.declare_publisher(topic_key(topic, msgtype, domain_id=self.domain_id),
+                                                       congestion_control=control)
             self._connections[topic] = publisher
         payload = bytes(self.store.serialize_cdr(msg, msgtype))
         sequence = self._sequence.get(topic, 0) + 1

@@ -136,7 +136,7 @@ class LiveSource:
                 sent_s = attachment.source_ns * 1e-9 if attachment is not None else now
                 self._last_message = time.monotonic()
                 self.counts.messages += 1
-                handle(str(sample.key_expr), bytes(sample.payload.to_bytes()), sent_s)
+                handle(str(sample.key_expr), sample.payload.to_bytes(), sent_s)
             except Exception as err:  # a bad message is counted, never fatal to the run
                 self.counts.bad_messages += 1
                 self.counts.last_error = f"{sample.key_expr}: {err}"

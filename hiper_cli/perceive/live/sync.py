@@ -27,7 +27,8 @@ from hiper_cli.types import CameraIntrinsics
 
 __all__ = ["FrameSync", "RawImage", "ReadyFrame"]
 
-WINDOW_S = 5.0  # poses and unpaired images older than this (behind the newest stamp) are forgotten
+WINDOW_S = 5.0  # unpaired images older than this (behind the newest stamp) are forgotten
+POSE_WINDOW_S = 2.0  # poses kept for interpolation, behind the newest pose
 FloatArray = NDArray[np.float64]
 
 
@@ -80,7 +81,9 @@ class FrameSync:
     dropped: int = 0
     unmatched: int = 0
     restarts: int = 0
-    _newest_s: float = float("-inf")
+    _newest_s: dict[str, float] = field(default_factory=dict)  # per stream: its newest stamp
+    _tree_cache: TfTree | None = None
+    _pose_newest_s: float = float("-inf")
     _rgb: list[RawImage] = field(default_factory=list)
     _depth: list[RawImage] = field(default_factory=list)
     _tf_static: dict[tuple[str, str], FloatArray] = field(default_factory=dict)
@@ -93,7 +96,7 @@ class FrameSync:
     def add_image(self, role: str, raw: bytes, sent_s: float) -> None:
         stamp, frame_id = header_of(raw)
         with self._cond:
-            self._check_clock(stamp)
+            self._check_clock(stamp, role)
             (self._rgb if role == "rgb" else self._depth).append(RawImage(stamp, frame_id, raw, sent_s))
             self._advance()
 
@@ -117,8 +120,9 @@ class FrameSync:
                 if static:
                     self._tf_static[(parent, child)] = T
                 else:
-                    self._check_clock(_stamp(tr.header))
+                    self._check_clock(_stamp(tr.header), "tf")
                     self._tf.append((_stamp(tr.header), parent, child, T))
+            self._tree_cache = None
             self._advance()
 
     def add_pose(self, raw: bytes, msgtype: str) -> None:
@@ -126,7 +130,7 @@ class FrameSync:
         pose = msg.pose.pose if hasattr(msg.pose, "covariance") else msg.pose
         child = str(getattr(msg, "child_frame_id", "")).lstrip("/")
         with self._cond:
-            self._check_clock(_stamp(msg.header))
+            self._check_clock(_stamp(msg.header), "pose")
             self._poses.append((_stamp(msg.header), pose_msg_to_matrix(pose, f"live {msgtype}"), child))
             self._advance()
 
@@ -144,20 +148,27 @@ class FrameSync:
             self._cond.notify_all()
 
     # --- assembly (under the lock) ------------------------------------------------------
-    def _check_clock(self, stamp_s: float) -> None:
-        """A stamp far behind the newest one: the publisher started over (a restarted replay,
+    def _check_clock(self, stamp_s: float, stream: str) -> None:
+        """A stamp far behind its stream's newest: the publisher started over (a restarted replay,
         a robot rebooted with sim time); what was buffered belongs to the old clock."""
-        if stamp_s < self._newest_s - WINDOW_S:
+        newest = self._newest_s.get(stream, float("-inf"))
+        if stamp_s < newest - WINDOW_S:
             self.unmatched += len(self._rgb)
             self._rgb, self._depth = [], []
             self._tf.clear()
             self._poses.clear()
+            self._tree_cache = None
+            self._pose_newest_s = float("-inf")
             self.restarts += 1
-            self._newest_s = stamp_s
-        self._newest_s = max(self._newest_s, stamp_s)
+            self._newest_s = {}
+        self._newest_s[stream] = max(self._newest_s.get(stream, float("-inf")), stamp_s)
+        if stream in ("tf", "pose"):
+            self._pose_newest_s = max(self._pose_newest_s, stamp_s)
 
     def _tree(self) -> TfTree:
-        tree = TfTree()
+        if self._tree_cache is not None:
+            return self._tree_cache
+        tree = self._tree_cache = TfTree()
         for (parent, child), T in self._tf_static.items():
             tree.add(parent, child, 0.0, T, True)
         for stamp, parent, child, T in self._tf:
@@ -185,6 +196,10 @@ class FrameSync:
             T = T @ T_child_cam
         return T[0] if ok[0] else None
 
+    def _tf_static_only(self) -> bool:
+        """Poses from /tf_static alone (a fixed camera): every stamp is covered."""
+        return self.pose_kind == "tf" and not self._tf and bool(self._tf_static)
+
     def _advance(self) -> None:
         """Turn every colour image that can become a frame into one; forget what is too old."""
         if self.camera is None or not self._rgb:
@@ -192,6 +207,8 @@ class FrameSync:
         self._rgb.sort(key=lambda m: m.stamp_s)
         emitted = False
         for rgb in list(self._rgb):
+            if rgb.stamp_s > self._pose_newest_s + self.max_dt_s and not self._tf_static_only():
+                break  # no pose covers this stamp yet (nor any later one)
             depth = min(self._depth, key=lambda m: abs(m.stamp_s - rgb.stamp_s), default=None)
             if depth is None or abs(depth.stamp_s - rgb.stamp_s) > self.max_dt_s:
                 continue
@@ -208,14 +225,16 @@ class FrameSync:
                 self.dropped += 1
             self._ready.append(ReadyFrame(rgb, depth, T, self.camera))
             emitted = True
-        horizon = self._newest_s - WINDOW_S
-        stale = [m for m in self._rgb if m.stamp_s < horizon]
+        horizon = max(self._newest_s.get("rgb", float("-inf")), self._newest_s.get("depth", float("-inf")))
+        stale = [m for m in self._rgb if m.stamp_s < horizon - WINDOW_S]
         self.unmatched += len(stale)
-        self._rgb = [m for m in self._rgb if m.stamp_s >= horizon]
-        self._depth = [m for m in self._depth if m.stamp_s >= horizon]
-        while self._tf and self._tf[0][0] < horizon:
+        self._rgb = [m for m in self._rgb if m.stamp_s >= horizon - WINDOW_S]
+        self._depth = [m for m in self._depth if m.stamp_s >= horizon - WINDOW_S]
+        pose_horizon = self._pose_newest_s - POSE_WINDOW_S
+        while self._tf and self._tf[0][0] < pose_horizon:
             self._tf.popleft()
-        while self._poses and self._poses[0][0] < horizon:
+            self._tree_cache = None
+        while self._poses and self._poses[0][0] < pose_horizon:
             self._poses.popleft()
         if emitted:
             self._cond.notify_all()
