@@ -486,7 +486,7 @@ def open_kb_for_reading(
     the writer's sync interval), else as ``open_kb`` does, which catches the graph up."""
     remote, _ = kb_location(location)
     root = Path(docs_dir) if docs_dir is not None else Path(str(location))
-    if not remote and not _writable(root):
+    if not remote and (not _writable(root) or _graph_locked(root)):
         return open_kb(location, docs_dir=docs_dir, read_only=True)
     try:
         return open_kb(location, docs_dir=docs_dir, create=False)
@@ -496,6 +496,24 @@ def open_kb_for_reading(
         if not any(why in str(err) for why in ("another hiper process", "disk is full", "read-only")):
             raise
         return open_kb(location, docs_dir=docs_dir, read_only=True)
+
+
+def _graph_locked(root: Path) -> bool:
+    """Whether another process holds the graph store (a perceive run writing it now): then a
+    reader opens it read-only at once instead of waiting for the lock."""
+    import fcntl
+
+    lock = root / GRAPH_DIR / "LOCK"
+    try:
+        with open(lock, "r+b") as handle:
+            try:
+                fcntl.lockf(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                return True
+            fcntl.lockf(handle, fcntl.LOCK_UN)
+    except OSError:  # no store yet, or not ours to open: the usual path decides
+        return False
+    return False
 
 
 def _writable(root: Path) -> bool:

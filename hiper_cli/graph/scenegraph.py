@@ -123,6 +123,19 @@ def _open_store(path: Path, wait_s: float = 3.0) -> ox.Store:
             time.sleep(0.05)
 
 
+def _open_read_only(path: Path, tries: int = 20) -> ox.Store:
+    """The store read-only; while a writer compacts it, a file listed at open may vanish before
+    it is read (RocksDB: "No such file"), so the open is tried again."""
+    for attempt in range(tries):
+        try:
+            return ox.Store.read_only(str(path))
+        except (OSError, RuntimeError) as err:
+            if "no such file" not in str(err).lower() or attempt == tries - 1:
+                raise
+            time.sleep(0.05)
+    raise AssertionError("unreachable")
+
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 
@@ -165,7 +178,7 @@ class LocalGraph:
         self.location = str(path)
         self.read_only = read_only
         try:
-            self._store = ox.Store.read_only(str(path)) if read_only else _open_store(path)
+            self._store = _open_read_only(path) if read_only else _open_store(path)
         except (OSError, RuntimeError) as err:
             if _is_lock_error(err):
                 raise KnowledgeBaseError(
