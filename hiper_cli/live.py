@@ -40,7 +40,11 @@ DEFAULT_ENV = "live"
 class LiveSettings:
     """How a live run reads: ``capacity`` frames may wait (then the oldest is dropped);
     ``idle_timeout_s`` ends the run without frames (``None``: only Ctrl-C ends it); a
-    silence of ``silence_s`` is reported; ``wait_s`` is how long to wait for the endpoint."""
+    silence of ``silence_s`` is reported; ``wait_s`` is how long to wait for the endpoint.
+    ``look_ahead``: take the next frame before perceiving this one, as for a log (the detector
+    runs on it meanwhile, and the run's last frame is known, which the background maps): the
+    same knowledge base as the log, more frames per second, but a frame waits for the next one
+    (about twice the latency). Off: each frame is perceived as it comes."""
 
     capacity: int = 1
     idle_timeout_s: float | None = None
@@ -48,6 +52,7 @@ class LiveSettings:
     wait_s: float = 30.0
     domain_id: int = 0
     graph_sync_s: float = 0.0
+    look_ahead: bool = False
 
 
 @dataclass
@@ -133,6 +138,7 @@ def perceive_live(
     source = LiveSource(endpoint, log_options or LogOptions(), capacity=settings.capacity,
                         idle_timeout_s=settings.idle_timeout_s, silence_s=settings.silence_s,
                         domain_id=settings.domain_id, wait_s=settings.wait_s, on_status=on_status)
+    source.look_ahead = settings.look_ahead
 
     unsynced: list[float] = []  # send times of frames written but not yet in the scene graph
 

@@ -395,7 +395,7 @@ def perceive(
     # Frames are read and decoded one thread ahead (decoding releases the interpreter lock):
     # with the `truth` or `log` detector the second core decodes while this one perceives.
     world, stats = run_stages(frames() if live else prefetch(frames()), stage_list, world, write,
-                              look_ahead=not live)
+                              look_ahead=bool(getattr(reader, "look_ahead", True)))
     kb.end_session(current)
     t0 = time.perf_counter()
     kb.sync_graph()

@@ -21,12 +21,12 @@ def is_live(log: Path | str) -> bool:
 
 def perceive_live_command(url: str, kb: str, kb_docs: Path | None, log_options: LogOptions,
                           options: PerceiveOptions, *, queue: int, idle_timeout_s: float | None,
-                          stats: bool, as_json: bool) -> None:
+                          look_ahead: bool, stats: bool, as_json: bool) -> None:
     """Run ``perceive_live`` with a one-line progress display and print its summary."""
     from hiper_cli.live import LiveReport, LiveSettings, perceive_live
 
     out = console()
-    settings = LiveSettings(capacity=queue, idle_timeout_s=idle_timeout_s)
+    settings = LiveSettings(capacity=queue, idle_timeout_s=idle_timeout_s, look_ahead=look_ahead)
     status = None if as_json else out.status(f"live {url}: waiting for frames (Ctrl-C ends the run)")
 
     def progress(frames: int, report: LiveReport) -> None:

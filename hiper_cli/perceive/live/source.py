@@ -71,6 +71,10 @@ class LiveSource:
     """See the module docstring. ``capacity``: frames waiting to be perceived (then dropped)."""
 
     live = True
+    # whether the pipeline takes the next frame before it perceives this one (as for logs: the
+    # detector runs on it meanwhile, and the last frame of the run is known); False perceives
+    # each frame as it comes
+    look_ahead = False
 
     def __init__(self, endpoint: str, options: LogOptions, *, capacity: int = 1,
                  idle_timeout_s: float | None = None, silence_s: float = DEFAULT_SILENCE_S,
