@@ -208,6 +208,9 @@ def test_queries_during_a_live_run_see_only_whole_frames(tmp_path):
     errors: list[str] = []
     snapshots = []
     answers = 0
+    held = None  # a reader open for the whole run, as hiper serve and hiper mcp are
+    held_counts: list[int] = []
+    count = "SELECT (COUNT(*) AS ?n) WHERE { ?s ?p ?o }"
     while live.poll() is None:
         time.sleep(0.1)
         db = kb / "documents.sqlite"
@@ -218,12 +221,20 @@ def test_queries_during_a_live_run_see_only_whole_frames(tmp_path):
             with open_kb_for_reading(str(kb)) as knowledge:
                 ask(knowledge, "chairs")
             answers += 1
+            if held is None and snapshots[-1][1] > 0:
+                held = open_kb_for_reading(str(kb))
+            if held is not None:
+                body = json.loads(held.run_readonly(count)[0])
+                held_counts.append(int(body["results"]["bindings"][0]["n"]["value"]))
         except Exception as err:  # any reader error fails the test
             errors.append(f"{type(err).__name__}: {err}")
+    if held is not None:
+        held.close()
     out = live.stdout.read() if live.stdout else ""
     assert replay.wait(timeout=30) == 0 and live.returncode == 0, out
     assert not errors, "\n".join(errors[:3])
     assert answers >= 10
+    assert held_counts and held_counts[-1] > held_counts[0]  # the held reader follows the run
     final = dict(_snapshot(kb / "documents.sqlite")[2])
     during = [s for s in snapshots if s[1] > 0]
     assert len(during) >= 10
