@@ -279,3 +279,37 @@ def test_publisher_killed_mid_run_then_back(tmp_path):
     # the second replay starts the log over: its frames follow the first run's, stamps restart
     restart = [k for k in range(1, len(stamps)) if stamps[k] < stamps[k - 1]]
     assert len(restart) == 1 and 0 < restart[0] < len(stamps) - 1, stamps
+
+
+@needs_zenoh
+@needs_yolox
+def test_ctrl_c_ends_the_session_with_everything_written(tmp_path):
+    """SIGINT: the frame in hand is finished, the session closed, the summary printed."""
+    from hiper_cli.graph import open_kb
+
+    port, kb = free_port(), tmp_path / "kb"
+    url = f"zenoh://tcp/127.0.0.1:{port}"
+    live = hiper("perceive", url, "--kb", str(kb), "--json")
+    wait_listening(port)
+    replay = hiper("replay", str(FIXTURE), url, "--hz", "10", stdout=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and _snapshot_or_none(kb) < 3:
+        time.sleep(0.2)
+    live.send_signal(signal.SIGINT)
+    out, _ = live.communicate(timeout=60)
+    replay.kill()
+    replay.wait(timeout=10)
+    assert live.returncode == 0, out
+    summary = json.loads(out[out.index("{"):])
+    assert summary["live"]["stopped_by"] == "interrupt" and summary["frames_read"] >= 3
+    with open_kb(str(kb)) as knowledge:
+        assert not knowledge.check(repair=False).problems
+    con = sqlite3.connect(f"file:{kb / 'documents.sqlite'}?mode=ro", uri=True)
+    ended, frames = con.execute("SELECT ended_s, frames FROM sessions").fetchone()
+    con.close()
+    assert ended is not None and frames == summary["frames_read"]
+
+
+def _snapshot_or_none(kb: Path) -> int:
+    db = kb / "documents.sqlite"
+    return _snapshot(db)[1] if db.exists() else 0
