@@ -176,6 +176,34 @@ def test_replay_delivers_the_log_frames_unchanged():
         assert got.extras["sent_s"] == pytest.approx(time.time(), abs=60)
 
 
+@needs_zenoh
+def test_compressed_colour_is_read_live():
+    """PNG CompressedImage colour (on <topic>/compressed, as image_transport names it)."""
+    from dataclasses import replace
+
+    from hiper_cli.perceive.live.replay import REPLAY_LAYOUT, replay_frames
+    from hiper_cli.perceive.live.source import LiveSource
+    from hiper_cli.perceive.logs import LogOptions, open_log
+
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    options = LogOptions(rgb_topic="/camera/color/image_raw/compressed")
+    source = LiveSource(endpoint, options, capacity=100, idle_timeout_s=2.0, silence_s=1.0)
+    source.start()
+    reader = open_log(FIXTURE)
+    frames = [f for k, f in enumerate(reader) if k < 10]
+    layout = replace(REPLAY_LAYOUT, rgb_format="png")
+    thread = threading.Thread(target=replay_frames, args=(frames, reader.info().camera, endpoint),
+                              kwargs={"hz": 20.0, "layout": layout}, daemon=True)
+    thread.start()
+    try:
+        got = list(source)
+    finally:
+        source.close()
+    thread.join(timeout=30)
+    assert len(got) == 10 and not source.skipped
+    assert all(np.array_equal(a.rgb, b.rgb) for a, b in zip(got, frames, strict=True))
+
+
 def _snapshot(db: Path) -> tuple[int, int, list[tuple[int, int]]]:
     """In one read transaction: frames the session row says, pose rows, and per frame stamp
     (µs) the observations written with it."""

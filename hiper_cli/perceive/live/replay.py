@@ -48,12 +48,10 @@ class ZenohPublisher(BagWriter):
         if publisher is None:
             import zenoh
 
-            # images as a camera driver's sensor-data QoS: best effort, a slow reader loses frames
-            # instead of queueing them; poses and camera info reliable
-            image = msgtype in ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
-            control = zenoh.CongestionControl.DROP if image else zenoh.CongestionControl.BLOCK
+            # reliable, as rmw_zenoh maps ROS 2's default QoS: a full link holds the publisher
+            # back rather than losing messages (the subscriber drops frames itself, newest kept)
             publisher = self.session.declare_publisher(topic_key(topic, msgtype, domain_id=self.domain_id),
-                                                       congestion_control=control)
+                                                       congestion_control=zenoh.CongestionControl.BLOCK)
             self._connections[topic] = publisher
         payload = bytes(self.store.serialize_cdr(msg, msgtype))
         sequence = self._sequence.get(topic, 0) + 1

@@ -24,7 +24,12 @@ from hiper_cli.perceive.live.rmw import Attachment, open_session
 from hiper_cli.perceive.live.sync import FrameSync, RawImage, ReadyFrame
 from hiper_cli.perceive.logs.bag_writer import BagLayout
 from hiper_cli.perceive.logs.base import LogInfo
-from hiper_cli.perceive.logs.images import decode_depth, decode_rgb
+from hiper_cli.perceive.logs.images import (
+    decode_compressed_depth,
+    decode_compressed_rgb,
+    decode_depth,
+    decode_rgb,
+)
 from hiper_cli.perceive.logs.options import LogOptions
 from hiper_cli.perceive.logs.ros_types import typestore
 from hiper_cli.types import CameraIntrinsics, Frame
@@ -35,6 +40,18 @@ DEFAULT_TOPICS = BagLayout()  # what `hiper replay` publishes and `hiper perceiv
 DEFAULT_SILENCE_S = 2.0
 Status = Callable[[str, str], None]
 Handler = Callable[[str, bytes, float], None]
+
+
+COMPRESSED = "sensor_msgs/msg/CompressedImage"
+
+
+def _image_type(key: str) -> str:
+    """The message type of an image topic's key expression: raw or compressed."""
+    if key.split("/")[-2] == "sensor_msgs::msg::dds_::CompressedImage_":
+        return COMPRESSED
+    if key.split("/")[-2] == "sensor_msgs::msg::dds_::Image_":
+        return "sensor_msgs/msg/Image"
+    raise LogError(f"{key}: not a sensor_msgs/Image or CompressedImage topic")
 
 
 @dataclass(frozen=True)
@@ -109,8 +126,8 @@ class LiveSource:
         self._session, self.how = open_session(self.endpoint, wait_s=self.wait_s, stop=self._stop)
         t = self.topics
         routes: list[tuple[str, Handler]] = [
-            (t.rgb, lambda _k, raw, sent_s: self.sync.add_image("rgb", raw, sent_s)),
-            (t.depth, lambda _k, raw, sent_s: self.sync.add_image("depth", raw, sent_s)),
+            (t.rgb, lambda key, raw, sent_s: self.sync.add_image("rgb", raw, sent_s, _image_type(key))),
+            (t.depth, lambda key, raw, sent_s: self.sync.add_image("depth", raw, sent_s, _image_type(key))),
             (t.info, lambda _k, raw, _s: self.sync.add_camera_info(raw)),
             ("/tf", lambda _k, raw, _s: self.sync.add_tf(raw, static=False)),
             ("/tf_static", lambda _k, raw, _s: self.sync.add_tf(raw, static=True)),
@@ -227,7 +244,12 @@ class LiveSource:
                      extras={"sent_s": ready.rgb.sent_s})
 
     def _image(self, store: Any, role: str, image: RawImage, where: str) -> Any:
-        msg = store.deserialize_cdr(image.raw, "sensor_msgs/msg/Image")
+        msg = store.deserialize_cdr(image.raw, image.msgtype)
+        if image.msgtype == COMPRESSED:
+            data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
+            if role == "rgb":
+                return decode_compressed_rgb(msg.format, data, where)
+            return decode_compressed_depth(msg.format, data, where, self.depth_scale)
         args = (str(msg.encoding), int(msg.height), int(msg.width), int(msg.step),
                 np.asarray(msg.data, dtype=np.uint8), bool(msg.is_bigendian), where)
         if role == "rgb":

@@ -54,6 +54,7 @@ class RawImage:
     frame_id: str
     raw: bytes
     sent_s: float
+    msgtype: str = "sensor_msgs/msg/Image"  # or sensor_msgs/msg/CompressedImage
 
 
 @dataclass(frozen=True)
@@ -93,11 +94,12 @@ class FrameSync:
     _cond: threading.Condition = field(default_factory=threading.Condition)
 
     # --- input (any thread) -------------------------------------------------------------
-    def add_image(self, role: str, raw: bytes, sent_s: float) -> None:
+    def add_image(self, role: str, raw: bytes, sent_s: float, msgtype: str = "sensor_msgs/msg/Image") -> None:
         stamp, frame_id = header_of(raw)
         with self._cond:
             self._check_clock(stamp, role)
-            (self._rgb if role == "rgb" else self._depth).append(RawImage(stamp, frame_id, raw, sent_s))
+            image = RawImage(stamp, frame_id, raw, sent_s, msgtype)
+            (self._rgb if role == "rgb" else self._depth).append(image)
             self._advance()
 
     def add_camera_info(self, raw: bytes) -> None:
