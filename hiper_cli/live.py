@@ -147,7 +147,14 @@ def perceive_live(
         report.latency_s.extend(now - sent_s for sent_s in unsynced)
         unsynced.clear()
 
-    with open_kb(kb, docs_dir=kb_docs) as knowledge:
+    source.start()  # nobody on the endpoint: an error before any knowledge base is made
+    report.session = source.how
+    try:
+        knowledge_cm = open_kb(kb, docs_dir=kb_docs)
+    except BaseException:
+        source.close()
+        raise
+    with knowledge_cm as knowledge:
 
         def written(frame: Frame | None, result: FrameResult) -> None:
             if frame is not None:
@@ -160,8 +167,6 @@ def perceive_live(
             if on_frame is not None:
                 on_frame(frame, result)
 
-        source.start()
-        report.session = source.how
         try:
             with _sigint_stops(source, report):
                 summary = perceive(source, knowledge, stages, options, on_frame=written)

@@ -75,6 +75,21 @@ def test_bad_endpoints_say_what_is_expected(url):
         parse_endpoint(url)
 
 
+def test_without_zenoh_the_error_names_the_extra(monkeypatch):
+    from hiper_cli.perceive.live.rmw import zenoh_module
+
+    monkeypatch.setitem(sys.modules, "zenoh", None)
+    with pytest.raises(ConfigError, match=r"pip install 'hiper\[live\]'"):
+        zenoh_module()
+
+
+def test_a_bad_live_url_is_one_line_and_makes_no_kb(tmp_path):
+    proc = hiper("perceive", "zenoh://localhost", "--kb", str(tmp_path / "kb"))
+    out, _ = proc.communicate(timeout=60)
+    assert proc.returncode != 0 and "expected zenoh://tcp/HOST:PORT" in out and "Traceback" not in out
+    assert not (tmp_path / "kb").exists()
+
+
 # --- zenoh-ros2-sdk as the reference --------------------------------------------------------
 @pytest.fixture(scope="module")
 def msg_dir(tmp_path_factory):

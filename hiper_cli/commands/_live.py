@@ -25,6 +25,7 @@ def perceive_live_command(url: str, kb: str, kb_docs: Path | None, log_options: 
     """Run ``perceive_live`` with a one-line progress display and print its summary."""
     from hiper_cli.live import LiveReport, LiveSettings, perceive_live
 
+    url = "zenoh://" + url[len("zenoh:"):].lstrip("/")  # a Path argument keeps one slash
     out = console()
     settings = LiveSettings(capacity=queue, idle_timeout_s=idle_timeout_s, look_ahead=look_ahead)
     status = None if as_json else out.status(f"live {url}: waiting for frames (Ctrl-C ends the run)")
