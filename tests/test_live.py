@@ -192,8 +192,10 @@ def test_replay_delivers_the_log_frames_unchanged():
 
 
 @needs_zenoh
-def test_compressed_colour_is_read_live():
-    """PNG CompressedImage colour (on <topic>/compressed, as image_transport names it)."""
+@pytest.mark.parametrize("variant", ["compressed", "odometry", "base_frame"])
+def test_other_topic_layouts_are_read_live(variant):
+    """PNG CompressedImage colour (on <topic>/compressed, as image_transport names it); poses
+    from nav_msgs/Odometry; /tf to a base frame plus a static base -> camera on /tf_static."""
     from dataclasses import replace
 
     from hiper_cli.perceive.live.replay import REPLAY_LAYOUT, replay_frames
@@ -201,12 +203,19 @@ def test_compressed_colour_is_read_live():
     from hiper_cli.perceive.logs import LogOptions, open_log
 
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    options = LogOptions(rgb_topic="/camera/color/image_raw/compressed")
+    layout, options = REPLAY_LAYOUT, LogOptions()
+    if variant == "compressed":
+        layout = replace(layout, rgb_format="png")
+        options = LogOptions(rgb_topic="/camera/color/image_raw/compressed")
+    elif variant == "odometry":
+        layout = replace(layout, pose_as="odometry", pose_topic="/odom")
+        options = LogOptions(pose_topic="/odom")
+    else:
+        layout = replace(layout, base_frame="base_link")
     source = LiveSource(endpoint, options, capacity=100, idle_timeout_s=2.0, silence_s=1.0)
     source.start()
     reader = open_log(FIXTURE)
     frames = [f for k, f in enumerate(reader) if k < 10]
-    layout = replace(REPLAY_LAYOUT, rgb_format="png")
     thread = threading.Thread(target=replay_frames, args=(frames, reader.info().camera, endpoint),
                               kwargs={"hz": 20.0, "layout": layout}, daemon=True)
     thread.start()
@@ -217,6 +226,7 @@ def test_compressed_colour_is_read_live():
     thread.join(timeout=30)
     assert len(got) == 10 and not source.skipped
     assert all(np.array_equal(a.rgb, b.rgb) for a, b in zip(got, frames, strict=True))
+    assert all(np.allclose(a.T_map_cam, b.T_map_cam, atol=1e-9) for a, b in zip(got, frames, strict=True))
 
 
 def _snapshot(db: Path) -> tuple[int, int, list[tuple[int, int]]]:
