@@ -192,7 +192,7 @@ def test_replay_delivers_the_log_frames_unchanged():
 
 
 @needs_zenoh
-@pytest.mark.parametrize("variant", ["compressed", "odometry", "base_frame"])
+@pytest.mark.parametrize("variant", ["compressed", "odometry", "base_frame", "late_subscriber"])
 def test_other_topic_layouts_are_read_live(variant):
     """PNG CompressedImage colour (on <topic>/compressed, as image_transport names it); poses
     from nav_msgs/Odometry; /tf to a base frame plus a static base -> camera on /tf_static."""
@@ -213,18 +213,26 @@ def test_other_topic_layouts_are_read_live(variant):
     else:
         layout = replace(layout, base_frame="base_link")
     source = LiveSource(endpoint, options, capacity=100, idle_timeout_s=2.0, silence_s=1.0)
-    source.start()
     reader = open_log(FIXTURE)
     frames = [f for k, f in enumerate(reader) if k < 10]
+    late = variant == "late_subscriber"  # /tf_static went out before the subscriber started
+    if not late:
+        source.start()
     thread = threading.Thread(target=replay_frames, args=(frames, reader.info().camera, endpoint),
-                              kwargs={"hz": 20.0, "layout": layout}, daemon=True)
+                              kwargs={"hz": 4.0 if late else 20.0, "layout": layout}, daemon=True)
     thread.start()
+    if late:
+        time.sleep(2.0)
+        source.start()
     try:
         got = list(source)
     finally:
         source.close()
     thread.join(timeout=30)
-    assert len(got) == 10 and not source.skipped
+    if late:  # the frames from the subscriber's start on, with poses through the cached static tf
+        assert 2 <= len(got) < 10
+        frames = frames[len(frames) - len(got):]
+    assert len(got) == len(frames) and not source.skipped
     assert all(np.array_equal(a.rgb, b.rgb) for a, b in zip(got, frames, strict=True))
     assert all(np.allclose(a.T_map_cam, b.T_map_cam, atol=1e-9) for a, b in zip(got, frames, strict=True))
 

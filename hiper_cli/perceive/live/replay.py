@@ -50,8 +50,16 @@ class ZenohPublisher(BagWriter):
 
             # reliable, as rmw_zenoh maps ROS 2's default QoS: a full link holds the publisher
             # back rather than losing messages (the subscriber drops frames itself, newest kept)
-            publisher = self.session.declare_publisher(topic_key(topic, msgtype, domain_id=self.domain_id),
-                                                       congestion_control=zenoh.CongestionControl.BLOCK)
+            key = topic_key(topic, msgtype, domain_id=self.domain_id)
+            if topic == "/tf_static":  # transient local: late subscribers get the cached sample
+                import zenoh.ext
+
+                publisher = zenoh.ext.declare_advanced_publisher(
+                    self.session, key, congestion_control=zenoh.CongestionControl.BLOCK,
+                    cache=zenoh.ext.CacheConfig(1), publisher_detection=True)
+            else:
+                publisher = self.session.declare_publisher(
+                    key, congestion_control=zenoh.CongestionControl.BLOCK)
             self._connections[topic] = publisher
         payload = bytes(self.store.serialize_cdr(msg, msgtype))
         sequence = self._sequence.get(topic, 0) + 1

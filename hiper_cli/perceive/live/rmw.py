@@ -106,6 +106,7 @@ def _config(zenoh: Any, endpoint: str, listen: bool) -> Any:
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps("peer"))
     config.insert_json5("scouting/multicast/enabled", "false")  # loopback and routed networks only
+    config.insert_json5("timestamping/enabled", "true")  # as rmw_zenoh: transient-local caches need it
     if listen:
         config.insert_json5("listen/endpoints", json.dumps([endpoint]))
     else:

@@ -54,6 +54,15 @@ def _image_type(key: str) -> str:
     raise LogError(f"{key}: not a sensor_msgs/Image or CompressedImage topic")
 
 
+def _latched_subscriber(session: Any, key: str, callback: Callable[[Any], None]) -> Any:
+    """A subscriber that also gets the cached history of publishers that keep one (rmw_zenoh's
+    transient-local durability, as for /tf_static, uses Zenoh's advanced publisher cache)."""
+    import zenoh.ext
+
+    history = zenoh.ext.HistoryConfig(detect_late_publishers=True)
+    return zenoh.ext.declare_advanced_subscriber(session, key, callback, history=history)
+
+
 @dataclass(frozen=True)
 class LiveTopics:
     """The topics a live run reads; ``pose`` is ``/tf`` or an Odometry/PoseStamped topic."""
@@ -136,7 +145,10 @@ class LiveSource:
             routes.append((t.pose, self._pose_message))
         for topic, handle in routes:
             key = f"{self.domain_id}/{topic.strip('/')}/*/*"
-            self._subscribers.append(self._session.declare_subscriber(key, self._callback(handle)))
+            if topic == "/tf_static":  # transient local: ask publishers for what they sent before
+                self._subscribers.append(_latched_subscriber(self._session, key, self._callback(handle)))
+            else:
+                self._subscribers.append(self._session.declare_subscriber(key, self._callback(handle)))
 
     def _pose_message(self, key: str, raw: bytes, _sent_s: float) -> None:
         dds = key.split("/")[-2]
