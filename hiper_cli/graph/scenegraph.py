@@ -129,12 +129,15 @@ READ_ONLY_REFRESH_S = 1.0
 
 def _open_read_only(path: Path, tries: int = 20) -> ox.Store:
     """The store read-only; while a writer compacts it, a file listed at open may vanish before
-    it is read (RocksDB: "No such file"), so the open is tried again."""
+    it is read (RocksDB: "No such file"), and while a writer creates it its column families
+    may not all be there yet, so the open is tried again."""
     for attempt in range(tries):
         try:
             return ox.Store.read_only(str(path))
         except (OSError, RuntimeError) as err:
-            if "no such file" not in str(err).lower() or attempt == tries - 1:
+            text = str(err).lower()
+            transient = "no such file" in text or "column family not found" in text
+            if not transient or attempt == tries - 1:
                 raise
             time.sleep(0.05)
     raise AssertionError("unreachable")
