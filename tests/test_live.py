@@ -161,6 +161,35 @@ def test_sdk_publisher_builds_the_same_kb_as_the_log(tmp_path, msg_dir):
     assert max(gaps) <= 0.01, gaps
 
 
+@needs_zenoh
+def test_sdk_subscriber_decodes_what_replay_publishes(msg_dir):
+    """Our key expressions, type hashes, CDR and attachments, read by zenoh-ros2-sdk's subscriber."""
+    pytest.importorskip("zenoh_ros2_sdk", reason="zenoh-ros2-sdk is absent: pip install 'hiper[dev]'")
+    from hiper_cli.perceive.live.replay import replay_frames
+    from hiper_cli.perceive.logs import open_log
+
+    port = free_port()
+    script = str(ROOT / "tests" / "live_sdk_subscriber.py")
+    sub = subprocess.Popen([sys.executable, script, str(port), str(msg_dir), "9"], cwd=ROOT, text=True,
+                           env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE)
+    reader = open_log(FIXTURE)
+    frames = [f for k, f in enumerate(reader) if k < 10]
+    summary = replay_frames(frames, reader.info().camera, f"tcp/127.0.0.1:{port}", hz=5.0, start_delay_s=4.0)
+    out, _ = sub.communicate(timeout=60)
+    assert summary.how == "listening" and sub.returncode == 0, out
+    seen = json.loads(out.strip().splitlines()[-1])
+    assert {name: seen[name]["count"] for name in ("rgb", "depth", "info", "tf")} == dict.fromkeys(
+        ("rgb", "depth", "info", "tf"), 10)
+    first = frames[0]
+    assert seen["rgb"]["first"] == {"stamp": [0, 0], "frame_id": "camera_color_optical_frame",
+                                    "encoding": "rgb8", "size": [256, 192], "bytes": 256 * 192 * 3}
+    assert seen["depth"]["first"]["encoding"] == "32FC1" and seen["depth"]["first"]["bytes"] == 256 * 192 * 4
+    assert seen["info"]["first"]["k"] == pytest.approx(first.camera.K.reshape(-1).tolist())
+    tf = seen["tf"]["first"]
+    assert tf["parent"] == "map" and tf["child"] == "camera_color_optical_frame"
+    assert tf["x"] == pytest.approx(float(first.T_map_cam[0, 3]))
+
+
 # --- replay -> perceive ---------------------------------------------------------------------
 @needs_zenoh
 def test_replay_delivers_the_log_frames_unchanged():
