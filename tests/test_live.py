@@ -90,6 +90,15 @@ def test_a_bad_live_url_is_one_line_and_makes_no_kb(tmp_path):
     assert not (tmp_path / "kb").exists()
 
 
+@pytest.mark.parametrize(("source", "flag"), [("zenoh://", "--view"), ("zenoh://", "--resume"),
+                                            (str(FIXTURE), "--stats"), (str(FIXTURE), "--look-ahead")])
+def test_flags_of_the_other_kind_of_source_are_refused(tmp_path, source, flag):
+    proc = hiper("perceive", source, "--kb", str(tmp_path / "kb"), flag)
+    out, _ = proc.communicate(timeout=60)
+    assert proc.returncode != 0 and f"{flag} is for" in out and "Traceback" not in out
+    assert not (tmp_path / "kb").exists()
+
+
 # --- zenoh-ros2-sdk as the reference --------------------------------------------------------
 @pytest.fixture(scope="module")
 def msg_dir(tmp_path_factory):

@@ -90,7 +90,15 @@ def perceive_command(
         on_existing="replace" if replace else "again" if again else "refuse",
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     from hiper_cli.commands._live import is_live, perceive_live_command
+    from hiper_cli.errors import ConfigError
 
+    live_only = {"--idle-timeout": idle_timeout is not None, "--queue": queue != 1,
+                 "--look-ahead": look_ahead, "--stats": stats}
+    log_only = {"--resume": resume, "--replace": replace, "--again": again, "--view": view}
+    wrong = [flag for flag, given in (log_only if is_live(log) else live_only).items() if given]
+    if wrong:
+        kind, source = ("a recorded log", "a zenoh:// source") if is_live(log) else ("a zenoh:// source", log)
+        raise ConfigError(f"{wrong[0]} is for {kind}; drop it for {source}")
     if is_live(log):
         perceive_live_command(str(log), kb, kb_docs, log_options, options, queue=queue,
                               idle_timeout_s=idle_timeout, look_ahead=look_ahead, stats=stats,
