@@ -343,16 +343,19 @@ def perceive(
     else:
         stage_list, unavailable_stages = list(stages), {}
     env_name, resume, graph_sync_s = options.env_name, options.resume, options.graph_sync_s
-    path = Path(options.log_path if options.log_path is not None else reader.info().path).resolve()
+    live = bool(getattr(reader, "live", False))  # a running robot: no read-ahead, its URL names it
+    source = options.log_path if options.log_path is not None else reader.info().path
+    path = Path(source) if live else Path(source).resolve()
+    log_name = str(source) if live else str(path)
     env = kb.environment(env_name or path.stem or path.name)
     names = [s.name for s in stage_list]
     _check_log_fits(reader, stage_list, path)
-    session = _session_for(kb, env, str(path), names,
+    session = _session_for(kb, env, log_name, names,
                            on_existing="resume" if resume else options.on_existing)
     world = kb.load_world(env)
     total = len(reader)
     summary = PerceiveSummary(
-        log=str(path), kb=kb.location, environment=env.name, session_id=session.id, stages=names,
+        log=log_name, kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=None, frames_total=total,
         unavailable_stages=unavailable_stages,
     )
@@ -394,7 +397,8 @@ def perceive(
     start = time.perf_counter()
     # Frames are read and decoded one thread ahead (decoding releases the interpreter lock):
     # with the `truth` or `log` detector the second core decodes while this one perceives.
-    world, stats = run_stages(prefetch(frames()), stage_list, world, write)
+    world, stats = run_stages(frames() if live else prefetch(frames()), stage_list, world, write,
+                              look_ahead=bool(getattr(reader, "look_ahead", True)))
     kb.end_session(current)
     t0 = time.perf_counter()
     kb.sync_graph()

@@ -67,6 +67,8 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
                  "hiper_cli.reanchor", *_UI),
     # runs of perception into a knowledge base
     "pipeline": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # live runs of perception into a knowledge base (a robot on rmw_zenoh)
+    "live": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     "reanchor": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     # hiper bench: simulates, perceives, scores and runs tasks on top of all the library
     "bench": ("hiper_cli.serve", "hiper_cli.view", "hiper_cli.reanchor", *_UI),

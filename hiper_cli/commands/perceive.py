@@ -42,7 +42,18 @@ View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(
     "--timings", help="Print the cost of each step per frame (always in --json, under 'steps').")]
-Log = Annotated[Path, typer.Argument(help="Sensor log: TUM folder, .bag, rosbag2 folder or .mcap.")]
+Log = Annotated[Path, typer.Argument(help=(
+    "Sensor log: TUM folder, .bag, rosbag2 folder or .mcap; or a running ROS 2 robot on rmw_zenoh: "
+    "zenoh://tcp/HOST:PORT (pip install 'hiper\\[live]')."))]
+IdleTimeout = Annotated[float | None, typer.Option(
+    "--idle-timeout", help="Live: end the run after this many seconds without frames (default: Ctrl-C).")]
+Queue = Annotated[int, typer.Option(
+    "--queue", help="Live: frames that may wait to be perceived; beyond, the oldest is dropped.")]
+LookAhead = Annotated[bool, typer.Option("--look-ahead", help=(
+    "Live: take the next frame before perceiving this one, as for a log (the same knowledge base as "
+    "the log, more frames/s, about twice the latency)."))]
+Stats = Annotated[bool, typer.Option(
+    "--stats", help="Live: print the latency from a frame being sent to being queryable (p50/p95).")]
 
 
 def perceive_command(
@@ -50,16 +61,22 @@ def perceive_command(
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
     resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
-    view: View = False, timings: Timings = False, as_json: bool = JSON_OPTION, *,
+    view: View = False, timings: Timings = False, idle_timeout: IdleTimeout = None, queue: Queue = 1,
+    look_ahead: LookAhead = False, stats: Stats = False, as_json: bool = JSON_OPTION, *,
     log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
     Each frame's results are written atomically; an interrupted run continues with --resume.
 
-    The log flags (camera, topics, frames, --poses) are those of hiper info.
+    The log flags (camera, topics, frames, --poses) are those of hiper info. A zenoh:// source
+    is a live robot (or hiper replay): frames are perceived as they come, the newest first when
+    perception falls behind; --rgb-topic, --depth-topic, --info-topic, --pose-topic (/tf or an
+    Odometry topic) choose what is read; Ctrl-C or --idle-timeout ends the session.
 
     Example: hiper perceive out/house --kb house.hiper --detector truth --timings
+
+    Example: hiper perceive zenoh://tcp/127.0.0.1:7447 --kb live.hiper --idle-timeout 5 --stats
     """
     from hiper_cli.pipeline import PerceiveOptions, perceive_log
 
@@ -73,6 +90,21 @@ def perceive_command(
         stages=stages, options=option or [], env_name=env, resume=resume,
         on_existing="replace" if replace else "again" if again else "refuse",
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
+    from hiper_cli.commands._live import is_live, perceive_live_command
+    from hiper_cli.errors import ConfigError
+
+    live_only = {"--idle-timeout": idle_timeout is not None, "--queue": queue != 1,
+                 "--look-ahead": look_ahead, "--stats": stats}
+    log_only = {"--resume": resume, "--replace": replace, "--again": again, "--view": view}
+    wrong = [flag for flag, given in (log_only if is_live(log) else live_only).items() if given]
+    if wrong:
+        kind, source = ("a recorded log", "a zenoh:// source") if is_live(log) else ("a zenoh:// source", log)
+        raise ConfigError(f"{wrong[0]} is for {kind}; drop it for {source}")
+    if is_live(log):
+        perceive_live_command(str(log), kb, kb_docs, log_options, options, queue=queue,
+                              idle_timeout_s=idle_timeout, look_ahead=look_ahead, stats=stats,
+                              as_json=as_json)
+        return
     out = console()
     live = None
     if view:  # without --view nothing of hiper_cli.view is imported or run

@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import time
 import uuid as _uuid
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -486,6 +487,8 @@ def open_kb_for_reading(
     the writer's sync interval), else as ``open_kb`` does, which catches the graph up."""
     remote, _ = kb_location(location)
     root = Path(docs_dir) if docs_dir is not None else Path(str(location))
+    if not remote and _graph_locked(root):
+        return _open_beside_writer(location, docs_dir)
     if not remote and not _writable(root):
         return open_kb(location, docs_dir=docs_dir, read_only=True)
     try:
@@ -495,7 +498,39 @@ def open_kb_for_reading(
     except KnowledgeBaseError as err:
         if not any(why in str(err) for why in ("another hiper process", "disk is full", "read-only")):
             raise
-        return open_kb(location, docs_dir=docs_dir, read_only=True)
+        return _open_beside_writer(location, docs_dir)
+
+
+def _open_beside_writer(location: str | Path, docs_dir: str | Path | None, wait_s: float = 5.0
+                        ) -> KnowledgeBase:
+    """Read-only, while another process writes; one that is creating the knowledge base right
+    now has not written its id yet, so that is waited for (up to ``wait_s``)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return open_kb(location, docs_dir=docs_dir, read_only=True)
+        except KnowledgeBaseError as err:
+            if "never written" not in str(err) or time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
+
+
+def _graph_locked(root: Path) -> bool:
+    """Whether another process holds the graph store (a perceive run writing it now): then a
+    reader opens it read-only at once instead of waiting for the lock."""
+    import fcntl
+
+    lock = root / GRAPH_DIR / "LOCK"
+    try:
+        with open(lock, "r+b") as handle:
+            try:
+                fcntl.lockf(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                return True
+            fcntl.lockf(handle, fcntl.LOCK_UN)
+    except OSError:  # no store yet, or not ours to open: the usual path decides
+        return False
+    return False
 
 
 def _writable(root: Path) -> bool:

@@ -8,6 +8,7 @@ bring the graph up to date from its documents with a high-water mark.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import time
 import urllib.error
@@ -125,6 +126,25 @@ def _open_store(path: Path, wait_s: float = 3.0) -> ox.Store:
             time.sleep(0.05)
 
 
+READ_ONLY_REFRESH_S = 1.0
+
+
+def _open_read_only(path: Path, tries: int = 20) -> ox.Store:
+    """The store read-only; while a writer compacts it, a file listed at open may vanish before
+    it is read (RocksDB: "No such file"), and while a writer creates it its column families
+    may not all be there yet, so the open is tried again."""
+    for attempt in range(tries):
+        try:
+            return ox.Store.read_only(str(path))
+        except (OSError, RuntimeError) as err:
+            text = str(err).lower()
+            transient = "no such file" in text or "column family not found" in text
+            if not transient or attempt == tries - 1:
+                raise
+            time.sleep(0.05)
+    raise AssertionError("unreachable")
+
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 
@@ -166,8 +186,10 @@ class LocalGraph:
     def __init__(self, path: Path, *, read_only: bool = False) -> None:
         self.location = str(path)
         self.read_only = read_only
+        self._opened_s: float = 0.0
+        self._opened: ox.Store
         try:
-            self._store = ox.Store.read_only(str(path)) if read_only else _open_store(path)
+            self._store = _open_read_only(path) if read_only else _open_store(path)
         except (OSError, RuntimeError) as err:
             if _is_lock_error(err):
                 raise KnowledgeBaseError(
@@ -178,6 +200,26 @@ class LocalGraph:
         if not read_only:
             _drop_old_logs(path)
         self._link = ox.NamedNode(PROV + "wasDerivedFrom")
+
+    @property
+    def _store(self) -> ox.Store:
+        """The store; read-only, a snapshot at its opening, so it is opened again when older
+        than ``READ_ONLY_REFRESH_S`` (a long-lived reader, ``hiper serve`` or ``hiper mcp``,
+        follows a ``perceive`` run writing the knowledge base)."""
+        if self.read_only and time.monotonic() - self._opened_s > READ_ONLY_REFRESH_S:
+            # on failure the snapshot in hand is kept; the next read tries again
+            with contextlib.suppress(OSError, RuntimeError):
+                self._opened = _open_read_only(Path(self.location))
+            self._opened_s = time.monotonic()
+        return self._opened
+
+    @_store.setter
+    def _store(self, store: ox.Store) -> None:
+        self._opened, self._opened_s = store, time.monotonic()
+
+    @_store.deleter
+    def _store(self) -> None:
+        del self._opened
 
     @_guarded
     def write(

@@ -39,6 +39,8 @@ def run_stages(
     stages: Sequence[Stage],
     world: World | None = None,
     on_frame: OnFrame | None = None,
+    *,
+    look_ahead: bool = True,
 ) -> tuple[World, RunStats]:
     """Feed every frame through ``stages`` in order, applying each result to ``world``.
 
@@ -47,9 +49,10 @@ def run_stages(
     updated by the stages before it in the same frame. A stage with a ``prepare(frame)``
     method is handed the next frame before the current one is processed, to start work that
     needs no world (the foreground stage runs its detector on it in a worker thread, so the
-    detector is busy while this frame's point cloud is processed). A frame that cannot be read
-    raises its error after the frames before it are processed and handed to ``on_frame``;
-    ``finish`` does not run then.
+    detector is busy while this frame's point cloud is processed); ``look_ahead=False`` processes
+    each frame as soon as it is read, without waiting for the next (a live stream). A frame
+    that cannot be read raises its error after the frames before it are processed and handed
+    to ``on_frame``; ``finish`` does not run then.
     """
     world = world if world is not None else World()
     stats = RunStats()
@@ -57,12 +60,19 @@ def run_stages(
     stream = iter(frames)
     upcoming = next(stream, None)
     unreadable: Exception | None = None
-    while upcoming is not None:
-        frame = upcoming
+    def read_next() -> None:
+        nonlocal upcoming, unreadable
         try:
             upcoming = next(stream, None)
         except Exception as err:  # the next frame cannot be read: finish this one first
             upcoming, unreadable = None, err
+
+    while upcoming is not None:
+        frame = upcoming
+        if look_ahead:
+            read_next()
+        else:
+            upcoming = None
         start = time.perf_counter()
         if upcoming is not None:
             for prepare in ahead:
@@ -79,6 +89,8 @@ def run_stages(
         stats.frame_times_s.append(time.perf_counter() - start)
         if on_frame is not None:
             on_frame(frame, merged)
+        if not look_ahead:
+            read_next()
     if unreadable is not None:
         raise unreadable
     final = FrameResult()
