@@ -239,15 +239,20 @@ def _mean_std(values: list[float] | NDArray[np.float64]) -> list[float | None]:
     return [float(arr.mean()), float(arr.std())]
 
 
-def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[str, Any]:
-    instances = list(run.world.foreground.values())
+def _instance_truth(run: ForegroundRun, instances: list[Instance]) -> dict[str, int | None]:
+    """Each instance's true object: the majority truth id of its observations."""
     inst_truth: dict[str, int | None] = {}
     for inst in instances:
         votes = Counter(run.obs_truth_id.get(u) for u in inst.observation_uuids)
         votes.pop(None, None)
         inst_truth[inst.uuid] = votes.most_common(1)[0][0] if votes else None
+    return inst_truth
 
-    # classification
+
+def _classification(
+    instances: list[Instance], inst_truth: dict[str, int | None], truth: Truth
+) -> tuple[dict[str, dict[str, int]], int]:
+    """TP/FP per predicted class (``unknown`` left out) and the number of unknown instances."""
     per_class: dict[str, dict[str, int]] = {}
     unknown = 0
     for inst in instances:
@@ -258,15 +263,11 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         ok = gid is not None and truth.instances[gid].class_name == inst.class_name
         counts = per_class.setdefault(inst.class_name, {"tp": 0, "fp": 0})
         counts["tp" if ok else "fp"] += 1
-    tp = sum(r["tp"] for r in per_class.values())
-    fp = sum(r["fp"] for r in per_class.values())
+    return per_class, unknown
 
-    # localisation
-    visible_err = list(run.obs_visible_error_m.values())
-    visible_err_xy = list(run.obs_visible_error_xy_m.values())
-    classified_err = [
-        e for u, e in run.obs_visible_error_m.items() if run.observations[u].class_name != "unknown"
-    ]
+
+def _centre_errors(instances: list[Instance], inst_truth: dict[str, int | None], truth: Truth) -> list[float]:
+    """Box-centre errors in metres: along the true path for walkers, at the box for the rest."""
     centre_err: list[float] = []
     for inst in instances:
         gid = inst_truth[inst.uuid]
@@ -281,8 +282,13 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
                     centre_err.append(float(np.linalg.norm(position - p)))
         else:
             centre_err.append(float(np.linalg.norm(inst.box.center_m - t.box.center_m)))
+    return centre_err
 
-    # people
+
+def _people_speeds(
+    instances: list[Instance], inst_truth: dict[str, int | None], truth: Truth, dynamic_speed_mps: float
+) -> tuple[NDArray[np.float64], list[float], list[float]]:
+    """All person speeds, and ours beside the truth's while a matched walker truly moves."""
     speeds: list[float] = []
     moving_ours: list[float] = []
     moving_truth: list[float] = []
@@ -302,9 +308,12 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
         inside = (stamps >= trk[0, 0]) & (stamps <= trk[-1, 0]) & (true_sp > dynamic_speed_mps)
         moving_ours.extend(sp[inside].tolist())
         moving_truth.extend(true_sp[inside].tolist())
-    sp_arr = np.asarray(speeds)
+    return np.asarray(speeds, dtype=np.float64), moving_ours, moving_truth
 
-    # identity switches: per frame and truth instance, the instance of its largest observation
+
+def _identity_switches(run: ForegroundRun, instances: list[Instance]) -> tuple[int, int]:
+    """Identity switches and the truth objects seen: per frame and truth object, the instance
+    of its largest observation; a switch is a change of that instance between frames."""
     best: dict[tuple[int, int], tuple[int, str]] = {}
     for inst in instances:
         for u in inst.observation_uuids:
@@ -322,6 +331,23 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
     for seq in by_truth.values():
         seq.sort()
         switches += sum(1 for a, b in itertools.pairwise(seq) if a[1] != b[1])
+    return switches, len(by_truth)
+
+
+def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[str, Any]:
+    instances = list(run.world.foreground.values())
+    inst_truth = _instance_truth(run, instances)
+    per_class, unknown = _classification(instances, inst_truth, truth)
+    tp = sum(r["tp"] for r in per_class.values())
+    fp = sum(r["fp"] for r in per_class.values())
+    visible_err = list(run.obs_visible_error_m.values())
+    visible_err_xy = list(run.obs_visible_error_xy_m.values())
+    classified_err = [
+        e for u, e in run.obs_visible_error_m.items() if run.observations[u].class_name != "unknown"
+    ]
+    centre_err = _centre_errors(instances, inst_truth, truth)
+    sp_arr, moving_ours, moving_truth = _people_speeds(instances, inst_truth, truth, dynamic_speed_mps)
+    switches, truth_seen = _identity_switches(run, instances)
     times = run.foreground_times_s
 
     return {
@@ -355,7 +381,7 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
             float(np.mean(moving_ours) - np.mean(moving_truth)) if moving_ours else None
         ),
         "identity_switches": switches,
-        "truth_instances_seen": len(by_truth),
+        "truth_instances_seen": truth_seen,
     }
 
 

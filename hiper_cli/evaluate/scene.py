@@ -185,12 +185,10 @@ def _walking_speeds(truth: Truth, t: TruthInstance, rows: list[list[float]]) -> 
     return float(np.median(np.linalg.norm(arr[walking, 4:7], axis=1))), float(np.median(true[walking]))
 
 
-def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, Any]:
-    """Table III style figures of the foreground ``instances``."""
-    preds = list(instances)
-    # Tables are background surfaces to hiper, found as planes; a table the foreground found
-    # (``unmapped_tables``) on a true table is right, and one it did not find is no miss.
-    gt = [t for t in truth.instances.values() if t.layer == "foreground" or t.class_name in FOUND_BOTH_WAYS]
+def _match(
+    truth: Truth, preds: list[Instance], gt: list[TruthInstance]
+) -> tuple[dict[int, tuple[int, float]], set[int]]:
+    """Greedy one-to-one matching, nearest first: prediction index -> (truth id, distance m)."""
     cand = []
     for pi, p in enumerate(preds):
         for t in gt:
@@ -205,6 +203,34 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
         if pi not in matched and tid not in used:
             matched[pi] = (tid, dist)
             used.add(tid)
+    return matched, used
+
+
+def _walker_speeds(
+    truth: Truth, preds: list[Instance], matched: dict[int, tuple[int, float]]
+) -> list[tuple[float, float]]:
+    """(our speed, true speed) in m/s of each matched walker, while it truly walks."""
+    speeds = []
+    for pi, (tid, _) in matched.items():
+        t = truth.instances[tid]
+        if t.state == "dynamic" and t.speed_mps is not None:
+            rows = preds[pi].data.get("trajectory") or []
+            walked = _walking_speeds(truth, t, rows)
+            speed = typical_speed_mps(rows)
+            if walked is not None:
+                speeds.append(walked)
+            elif speed is not None:
+                speeds.append((speed, t.speed_mps))
+    return speeds
+
+
+def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, Any]:
+    """Table III style figures of the foreground ``instances``."""
+    preds = list(instances)
+    # Tables are background surfaces to hiper, found as planes; a table the foreground found
+    # (``unmapped_tables``) on a true table is right, and one it did not find is no miss.
+    gt = [t for t in truth.instances.values() if t.layer == "foreground" or t.class_name in FOUND_BOTH_WAYS]
+    matched, used = _match(truth, preds, gt)
     per_class: dict[str, dict[str, int]] = {}
     for pi, p in enumerate(preds):
         per_class.setdefault(p.class_name, {"tp": 0, "fp": 0, "fn": 0})["tp" if pi in matched else "fp"] += 1
@@ -220,17 +246,7 @@ def score_foreground(truth: Truth, instances: Iterable[Instance]) -> dict[str, A
     known_tp = sum(pi in matched for pi in known)
     errors = [d for pi, (tid, d) in matched.items() if truth.instances[tid].state != "dynamic"]
     same_state = [preds[pi].state == truth.instances[tid].state for pi, (tid, _) in matched.items()]
-    speeds = []
-    for pi, (tid, _) in matched.items():
-        t = truth.instances[tid]
-        if t.state == "dynamic" and t.speed_mps is not None:
-            rows = preds[pi].data.get("trajectory") or []
-            walked = _walking_speeds(truth, t, rows)
-            speed = typical_speed_mps(rows)
-            if walked is not None:
-                speeds.append(walked)
-            elif speed is not None:
-                speeds.append((speed, t.speed_mps))
+    speeds = _walker_speeds(truth, preds, matched)
     return {
         "instances": len(preds),
         "tp": tp,

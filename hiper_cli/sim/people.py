@@ -110,48 +110,12 @@ class Crowd:
         for i, spec in enumerate(self.specs):
             if self.t_s < self.pause_until[i]:
                 continue
-            path = self.paths[i]
-            while path and math.dist(tuple(self.pos[i]), path[0]) < cfg.goal_tolerance_m:
-                path.pop(0)
-            if path and self.t_s >= self.next_check[i]:
-                self.next_check[i] = self.t_s + cfg.replan_s
-                if not self.grid.line_free(tuple(self.pos[i]), path[0]):
-                    self.paths[i] = path = self.grid.astar(tuple(self.pos[i]), path[-1])[1:]
+            path = self._waypoints(i, spec)
             if not path:
-                if spec.goals:
-                    self.goal_index[i] += 1
-                else:
-                    self.pause_until[i] = self.t_s + float(self.rng.uniform(*spec.pause_s))
-                self._new_path(i)
-                if not spec.goals:
-                    continue
-                if not self.paths[i]:
-                    continue
-                path = self.paths[i]
+                continue
             to_goal = np.asarray(path[0]) - self.pos[i]
             e = to_goal / max(np.linalg.norm(to_goal), 1e-9)
-            force = np.zeros(2)  # the social (repulsive) forces
-            others = [self.pos[j] for j in range(n) if j != i]
-            params = [(cfg.agent_radius_m * 2, cfg.agent_A_mps2, cfg.agent_B_m)] * len(others)
-            if robot_xy is not None:
-                others.append(np.asarray(robot_xy))
-                params.append((cfg.agent_radius_m + cfg.robot_radius_m, cfg.robot_A_mps2, cfg.robot_B_m))
-            for q, (r_ab, A, B) in zip(others, params, strict=True):
-                d_vec = self.pos[i] - q
-                d = float(np.linalg.norm(d_vec))
-                if d > 3.0 or d < 1e-9:
-                    continue
-                n_ab = d_vec / d
-                cos_phi = float(-n_ab @ e)
-                w = cfg.lambda_ + (1 - cfg.lambda_) * (1 + cos_phi) / 2
-                force += w * A * math.exp((r_ab - d) / B) * n_ab
-            for r in obstacles:
-                near = _nearest_on_rect(self.pos[i], r)
-                d_vec = self.pos[i] - near
-                d = float(np.linalg.norm(d_vec))
-                if d > 1.5 or d < 1e-9:
-                    continue
-                force += cfg.wall_A_mps2 * math.exp((cfg.body_radius_m - d) / cfg.wall_B_m) * d_vec / d
+            force = self._social_force(i, e, robot_xy, obstacles)
             # The velocity the model relaxes to: preferred velocity plus tau times the social forces.
             v = spec.speed_mps * e + cfg.tau_s * force
             want = math.atan2(v[1], v[0]) if np.linalg.norm(v) > 1e-9 else math.atan2(e[1], e[0])
@@ -166,6 +130,56 @@ class Crowd:
             self.vel[i] = new_vel[i]
             if np.linalg.norm(new_vel[i]) > 1e-6:
                 self.heading[i] = math.atan2(new_vel[i][1], new_vel[i][0])
+
+    def _waypoints(self, i: int, spec: WalkerSpec) -> list[XY]:
+        """Person ``i``'s remaining path: reached waypoints dropped, replanned when blocked, a new
+        path (or a pause, for a wanderer) when done; empty while the person stands."""
+        cfg = self.cfg
+        path = self.paths[i]
+        while path and math.dist(tuple(self.pos[i]), path[0]) < cfg.goal_tolerance_m:
+            path.pop(0)
+        if path and self.t_s >= self.next_check[i]:
+            self.next_check[i] = self.t_s + cfg.replan_s
+            if not self.grid.line_free(tuple(self.pos[i]), path[0]):
+                self.paths[i] = path = self.grid.astar(tuple(self.pos[i]), path[-1])[1:]
+        if path:
+            return path
+        if spec.goals:
+            self.goal_index[i] += 1
+        else:
+            self.pause_until[i] = self.t_s + float(self.rng.uniform(*spec.pause_s))
+        self._new_path(i)
+        return self.paths[i] if spec.goals else []
+
+    def _social_force(
+        self, i: int, e: NDArray[np.float64], robot_xy: XY | None, obstacles: list[Rect]
+    ) -> NDArray[np.float64]:
+        """The repulsive forces on person ``i`` (walking along ``e``): other people, the robot,
+        walls and obstacles (Helbing's social force model, anisotropic by ``lambda_``)."""
+        cfg = self.cfg
+        force = np.zeros(2)
+        others = [self.pos[j] for j in range(len(self.specs)) if j != i]
+        params = [(cfg.agent_radius_m * 2, cfg.agent_A_mps2, cfg.agent_B_m)] * len(others)
+        if robot_xy is not None:
+            others.append(np.asarray(robot_xy))
+            params.append((cfg.agent_radius_m + cfg.robot_radius_m, cfg.robot_A_mps2, cfg.robot_B_m))
+        for q, (r_ab, A, B) in zip(others, params, strict=True):
+            d_vec = self.pos[i] - q
+            d = float(np.linalg.norm(d_vec))
+            if d > 3.0 or d < 1e-9:
+                continue
+            n_ab = d_vec / d
+            cos_phi = float(-n_ab @ e)
+            w = cfg.lambda_ + (1 - cfg.lambda_) * (1 + cos_phi) / 2
+            force += w * A * math.exp((r_ab - d) / B) * n_ab
+        for r in obstacles:
+            near = _nearest_on_rect(self.pos[i], r)
+            d_vec = self.pos[i] - near
+            d = float(np.linalg.norm(d_vec))
+            if d > 1.5 or d < 1e-9:
+                continue
+            force += cfg.wall_A_mps2 * math.exp((cfg.body_radius_m - d) / cfg.wall_B_m) * d_vec / d
+        return force
 
     def _move(self, p: NDArray[np.float64], step: NDArray[np.float64]) -> NDArray[np.float64]:
         """Move by ``step`` but keep ``body_radius_m`` clear of every wall.
