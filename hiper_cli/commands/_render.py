@@ -5,13 +5,15 @@ from __future__ import annotations
 import json
 import re
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, TypeVar
 
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
+
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 __all__ = ["JSON_OPTION", "HiperTyper", "console", "frame_progress", "group", "print_error", "print_json",
            "safe_text"]
@@ -91,8 +93,8 @@ class HiperTyper(typer.Typer):
     installed script and typer's ``CliRunner`` in tests behave the same.
     """
 
-    def command(self, *args: Any, **kwargs: Any) -> Any:
-        def wrap(func: Any) -> Any:
+    def command(self, *args: Any, **kwargs: Any) -> Callable[[_F], _F]:
+        def wrap(func: _F) -> _F:
             import functools
             import inspect
 

@@ -53,7 +53,8 @@ def guess_format(path: Path) -> str:
 
 def _layer_quads(kb: KnowledgeBase) -> list[ox.Quad]:
     kb.sync_graph() if not kb.read_only else None
-    return kb.graph.quads([layer_graph(kb.kb_id, layer) for layer in LAYERS])
+    quads: list[ox.Quad] = kb.graph.quads([layer_graph(kb.kb_id, layer) for layer in LAYERS])
+    return quads
 
 
 def _with_observations(kb: KnowledgeBase, quads: list[ox.Quad]) -> list[ox.Quad]:

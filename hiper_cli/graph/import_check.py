@@ -98,7 +98,8 @@ def read_json_export(path: Path) -> dict[str, Any]:
         raise DataError(f"{path}: not a hiper JSON export (format {data.get('format')!r}); expected "
                         "'hiper-kb-export' written by 'hiper export --format json'")
     _check_schema(data, path)
-    return data
+    export: dict[str, Any] = data
+    return export
 
 
 def _check_schema(data: Any, path: Path) -> None:

@@ -453,7 +453,8 @@ class KnowledgeBase(KbReads):
 
     def query(self, sparql: str) -> list[dict[str, Any]]:
         """SPARQL SELECT over the scene graph (prefixes hiper:, prov:, sosa: predeclared)."""
-        return self.graph.query(sparql)
+        rows: list[dict[str, Any]] = self.graph.query(sparql)
+        return rows
 
     def info(self) -> dict[str, Any]:
         """Counts per type, layer and class, sessions, environments and size on disk."""

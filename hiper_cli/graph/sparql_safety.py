@@ -89,4 +89,5 @@ def run_with_timeout(work: Callable[[], T], timeout_s: float | None) -> T:
                          "specific patterns, or raise --timeout")
     if "error" in box:
         raise box["error"]
-    return box["value"]
+    value: T = box["value"]
+    return value

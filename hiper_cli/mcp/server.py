@@ -49,9 +49,9 @@ def build_server(ctx: ToolContext) -> Any:
     from mcp.server.lowlevel import Server
     from mcp.server.lowlevel.helper_types import ReadResourceContents
 
+    # The SDK's decorators are untyped, so the handlers are registered by call, not as decorators.
     server: Any = Server("hiper", version=__version__, instructions=INSTRUCTIONS)
 
-    @server.list_tools()
     async def list_tools() -> list[Any]:
         return [
             types.Tool(name=t.name, description=t.description, inputSchema=t.input_schema,
@@ -59,8 +59,6 @@ def build_server(ctx: ToolContext) -> Any:
             for t in TOOLS
         ]
 
-    # The registry validates the arguments itself, so a bad call is a structured error too.
-    @server.call_tool(validate_input=False)
     async def call(name: str, arguments: dict[str, Any] | None) -> Any:
         result = call_tool(ctx, name, arguments)
         content: list[Any] = [types.TextContent(type="text", text=json.dumps(result.data))]
@@ -68,13 +66,11 @@ def build_server(ctx: ToolContext) -> Any:
                     for png in result.images]
         return types.CallToolResult(content=content, structuredContent=result.data, isError=result.is_error)
 
-    @server.list_resources()
     async def list_resources() -> list[Any]:
         return [types.Resource.model_validate({"uri": uri, "name": name, "description": text,
                                                 "mimeType": "application/json"})
                 for uri, (name, text) in RESOURCES.items()]
 
-    @server.read_resource()
     async def read_resource(uri: Any) -> list[Any]:
         if str(uri) == "hiper://vocabulary":
             data = _vocabulary()
@@ -86,6 +82,11 @@ def build_server(ctx: ToolContext) -> Any:
             raise ValueError(f"no resource {uri}; expected one of {', '.join(RESOURCES)}")
         return [ReadResourceContents(json.dumps(data), "application/json")]
 
+    server.list_tools()(list_tools)
+    # The registry validates the arguments itself, so a bad call is a structured error too.
+    server.call_tool(validate_input=False)(call)
+    server.list_resources()(list_resources)
+    server.read_resource()(read_resource)
     return server
 
 

@@ -98,15 +98,18 @@ class Candidates:
 
     @property
     def centers(self) -> np.ndarray:
-        return self.index.centers[self.rows]
+        values: np.ndarray = self.index.centers[self.rows]
+        return values
 
     @property
     def extents(self) -> np.ndarray:
-        return self.index.extents[self.rows]
+        values: np.ndarray = self.index.extents[self.rows]
+        return values
 
     @property
     def last_s(self) -> np.ndarray:
-        return self.index.last_s[self.rows]
+        values: np.ndarray = self.index.last_s[self.rows]
+        return values
 
     @property
     def uuids(self) -> list[str]:
@@ -147,7 +150,8 @@ def _window_mask(ctx: Context, spec: QuerySpec) -> np.ndarray:
     mask = (idx.first_s <= until) & (idx.last_s >= since)
     mask &= idx.vacated_s > (spec.since_s if spec.since_s is not None else until)
     added, moved = mask & (idx.first_s >= since), mask & (idx.states == "dynamic")
-    return {"added": added, "moved": moved, "any": added | moved | removed}.get(spec.change or "", mask)
+    masks: dict[str, np.ndarray] = {"added": added, "moved": moved, "any": added | moved | removed}
+    return masks.get(spec.change or "", mask)
 
 
 def details(ctx: Context, uuid: str) -> dict[str, Any] | None:

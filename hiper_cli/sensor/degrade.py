@@ -38,7 +38,8 @@ _POSE_STREAM = 0x5E50  # the pose source's own random stream, apart from the fra
 def luma(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """Grey level (ITU-R 601) of an RGB image: a stand-in for the IR reflectance."""
     grey = rgb[..., 0] * 0.299 + rgb[..., 1] * 0.587 + rgb[..., 2] * 0.114
-    return grey.astype(np.uint8)
+    out: NDArray[np.uint8] = grey.astype(np.uint8)
+    return out
 
 
 def degrade_frame(frame: Frame, flow_px_per_s: NDArray[np.float64], profile: SensorProfile,

@@ -126,7 +126,8 @@ def incidence_deg(depth_m: FloatImage, camera: CameraIntrinsics) -> NDArray[np.f
     norm = np.linalg.norm(normal, axis=-1) * np.linalg.norm(points, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
         cos = np.abs(np.einsum("hwk,hwk->hw", normal, points)) / norm
-    return np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), 0.0, 1.0)))
+    angle_deg: NDArray[np.float64] = np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), 0.0, 1.0)))
+    return angle_deg
 
 
 def grazing_dropout(profile: SensorProfile, incidence: NDArray[np.float64]) -> NDArray[np.float64]:

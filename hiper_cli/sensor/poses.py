@@ -28,7 +28,8 @@ def rotation_about(rotvec: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.eye(3)
     k = rotvec / angle
     K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    R: NDArray[np.float64] = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    return R
 
 
 def _angle(R: NDArray[np.float64]) -> float:

@@ -193,4 +193,6 @@ def _tensor(array: NDArray[Any]) -> Any:
 
 def _matmul3(a: NDArray[np.float32], M: NDArray[np.float32]) -> NDArray[np.float32]:
     """``a @ M`` for (N, 3) × (3, 3); numpy's matmul is slow for such thin matrices."""
-    return (a[:, 0:1] * M[0] + a[:, 1:2] * M[1] + a[:, 2:3] * M[2]).astype(np.float32, copy=False)
+    out: NDArray[np.float32] = a[:, 0:1] * M[0] + a[:, 1:2] * M[1] + a[:, 2:3] * M[2]
+    out = out.astype(np.float32, copy=False)
+    return out

@@ -122,7 +122,8 @@ def _seen_spans(stamps_s: NDArray[np.float64], hold_s: float) -> NDArray[np.floa
     """The stamps at which a track is cleared: ``hold_s`` after each sighting that is not
     followed by another within ``hold_s``, and after the last one."""
     ends = np.append(np.diff(stamps_s) > hold_s, True)
-    return stamps_s[ends] + hold_s
+    cleared_s: NDArray[np.float64] = stamps_s[ends] + hold_s
+    return cleared_s
 
 
 def _log_static(rr: Any, rec: Any, tl: Timeline, track: TrackItem) -> None:
