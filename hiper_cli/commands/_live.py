@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.logs import LogOptions
@@ -33,12 +33,13 @@ def perceive_live_command(url: str, kb: str, kb_docs: Path | None, log_options: 
     def progress(frames: int, report: LiveReport) -> None:
         if status is not None:
             p95 = report.latency_ms()["p95"]
-            status.update(f"live {url}: {frames} frames perceived, {report.frames_dropped} dropped, "
-                          f"latency p95 {p95} ms (Ctrl-C ends the run)")
+            status.update(f"live {safe_text(url)}: {frames} frames perceived, "
+                          f"{report.frames_dropped} dropped, latency p95 {p95} ms (Ctrl-C ends the run)")
 
     def on_status(kind: str, text: str) -> None:
         if not as_json:
-            out.print(f"[yellow]{kind}:[/] {text}" if kind == "silent" else f"{kind}: {text}")
+            shown = safe_text(text)
+            out.print(f"[yellow]{kind}:[/] {shown}" if kind == "silent" else f"{kind}: {shown}")
 
     if status is not None:
         status.start()

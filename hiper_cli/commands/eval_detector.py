@@ -8,7 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, frame_progress, print_json
+from hiper_cli.commands._render import console, frame_progress, print_json, safe_text
 from hiper_cli.commands.eval import eval_app
 
 
@@ -36,7 +36,7 @@ def eval_detector(
     reader = open_log(log)
     model = make_detector(detector, log_path=log)
     screen = console()
-    with frame_progress(f"{detector} on {log}", screen, enabled=not json_out) as bar:
+    with frame_progress(f"{safe_text(detector)} on {safe_text(log)}", screen, enabled=not json_out) as bar:
         result = detector_ceiling(log, reader, model, max_frames=max_frames,
                                   progress=bar.update if bar else None)
     data = {**result.to_dict(), "detector": detector}
@@ -52,10 +52,10 @@ def show_detector_ceiling(data: dict[str, Any]) -> None:
 
     out = console()
     table = Table("class", "seen clearly", "found", "share of frames", title=(
-        f"{data['detector']} on {data['log']}: {data['frames']} labelled frames"))
+        f"{safe_text(data['detector'])} on {safe_text(data['log'])}: {data['frames']} labelled frames"))
     for name, row in data["per_class"].items():
         share = "-" if row["frame_share"] is None else f"{row['frame_share']:.2f}"
-        table.add_row(name, str(row["seen_clearly"]), str(row["found"]), share)
+        table.add_row(safe_text(name), str(row["seen_clearly"]), str(row["found"]), share)
     total = data["total"]
     share = "-" if total["frame_share"] is None else f"{total['frame_share']:.2f}"
     table.add_row("[bold]total", str(total["seen_clearly"]), f"[bold]{total['found']}", share)

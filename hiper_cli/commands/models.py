@@ -8,7 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, group, print_json
+from hiper_cli.commands._render import console, group, print_json, safe_text
 
 __all__ = ["models_app", "register"]
 
@@ -36,7 +36,6 @@ def list_command(directory: DirOption = None, as_json: bool = JSON_OPTION) -> No
     if as_json:
         print_json({"models_dir": str(models_dir(directory)), "models": rows})
         return
-    from rich.markup import escape
     from rich.table import Table
 
     table = Table("name", "layout", "px", "MB", "licence", "mAP", "sha256", "where")
@@ -53,15 +52,15 @@ def list_command(directory: DirOption = None, as_json: bool = JSON_OPTION) -> No
             str(r["layout"]),
             f"{r['input_px'] or '?'}",
             size,
-            escape(str(r["licence"])),
+            safe_text(str(r["licence"])),
             coco,
             sha,
-            escape(where),
+            safe_text(where),
         )
     out = console()
     out.print(table)
     out.print(
-        f"models folder: {escape(str(models_dir(directory)))}; sha256 'unknown': not verified by "
+        f"models folder: {safe_text(str(models_dir(directory)))}; sha256 'unknown': not verified by "
         "hiper, fetched only with --trust-unverified"
     )
 
@@ -136,14 +135,13 @@ def fetch_command(
     if as_json:
         print_json(data)
         return
-    from rich.markup import escape
 
     check = "verified" if result.verified else "NOT verified: no known sha256, check it yourself"
     resumed = f", resumed at {result.resumed_from} bytes" if result.resumed_from else ""
     got = (
         f"{result.downloaded_bytes} bytes downloaded{resumed}" if result.downloaded_bytes else "already here"
     )
-    console().print(f"{model.name} -> {escape(str(result.path))} ({got}; sha256 {result.sha256} {check})")
+    console().print(f"{model.name} -> {safe_text(str(result.path))} ({got}; sha256 {result.sha256} {check})")
 
 
 @models_app.command("add")
@@ -195,10 +193,9 @@ def add_command(
     if as_json:
         print_json(data)
         return
-    from rich.markup import escape
 
     console().print(
-        f"{model.name} -> {escape(str(result.path))} ({detector.layout} layout, "
+        f"{model.name} -> {safe_text(str(result.path))} ({detector.layout} layout, "
         f"{len(detector.class_names)} classes; use --detector {model.name})"
     )
 

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from hiper_cli.commands._common import JSON_OPTION, with_log_flags
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.commands._render import console, print_json, safe_text
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.logs import LogOptions
@@ -51,7 +51,7 @@ def replay_command(log: Log, url: Url, rate: Rate = 1.0, hz: Hz = None, wait: Wa
     layout = replace(REPLAY_LAYOUT, depth_encoding="16UC1" if depth_encoding == "16UC1" else "32FC1")
     out = console()
     if not as_json:
-        out.print(f"replaying {log} ({len(reader)} frames) on zenoh://{endpoint}")
+        out.print(f"replaying {safe_text(log)} ({len(reader)} frames) on zenoh://{safe_text(endpoint)}")
     summary = replay_frames(reader, reader.info().camera, endpoint, rate=rate, hz=hz, layout=layout,
                             wait_s=wait)
     if as_json:
