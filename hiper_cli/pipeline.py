@@ -7,9 +7,9 @@ unfinished session of the same log in its place. Perceiving a log the environmen
 holds with the same stages is refused unless asked for (``on_existing``). The scene
 graph follows the documents every ``graph_sync_s`` seconds and at the end (see ``graph.kb``).
 
-Each run is a session of an environment (default: the log folder's name); the environment's
-live instances and analyses are loaded into the ``World`` first, so several logs of the same
-place accumulate into one environment.
+Each run is a session of an environment (default: the one place the knowledge base holds, or
+for an empty one the log folder's name); the environment's live instances and analyses are
+loaded into the ``World`` first, so several logs of the same place accumulate into one.
 
 Two entries: ``perceive(reader, kb, stages, options)`` runs built stages over an open log;
 ``perceive_log(path, kb_location, LogOptions(...), PerceiveOptions(...))`` is the whole of
@@ -341,7 +341,7 @@ def perceive(
         stage_list, unavailable_stages = list(stages), {}
     env_name, resume, graph_sync_s = options.env_name, options.resume, options.graph_sync_s
     path = Path(options.log_path if options.log_path is not None else reader.info().path).resolve()
-    env = kb.environment(env_name or path.stem or path.name)
+    env = _environment_for(kb, env_name, path)
     names = [s.name for s in stage_list]
     _check_log_fits(reader, stage_list, path)
     session = _session_for(kb, env, str(path), names,
@@ -409,6 +409,22 @@ def perceive(
 
 
 ON_EXISTING = ("refuse", "replace", "again", "resume")
+
+
+def _environment_for(kb: KnowledgeBase, env_name: str | None, path: Path) -> Any:
+    """The place a log joins: ``env_name`` when given (created on first use); else the one
+    place the knowledge base holds (a lasting memory of one place needs no flag), or, in an
+    empty knowledge base, one named after the log folder."""
+    if env_name:
+        return kb.environment(env_name)
+    places = kb.environments()
+    if len(places) == 1:
+        return places[0]
+    if not places:
+        return kb.environment(path.stem or path.name)
+    names = ", ".join(sorted(e.name for e in places))
+    raise ConfigError(f"{kb.location} holds {len(places)} places ({names}); pass --env NAME to say which "
+                      "one this log shows (a new name starts another place)")
 
 
 def _check_log_fits(log: Any, stages: Sequence[Stage], path: Path) -> None:

@@ -1,4 +1,4 @@
-"""``hiper kb info|check|bench``: look after a knowledge base."""
+"""``hiper kb info|check|sessions|bench``: look after a knowledge base."""
 
 from __future__ import annotations
 
@@ -67,6 +67,26 @@ def check_command(
         show_kb_check(console(), report.to_dict())
     if not report.ok:
         raise typer.Exit(1)
+
+
+@kb_app.command("sessions")
+def sessions_command(
+    kb: KbOption = DEFAULT_KB, kb_docs: KbDocsOption = None, as_json: bool = JSON_OPTION
+) -> None:
+    """The sessions of the knowledge base: id, place, log, log stamps, when it ran, alignment.
+
+    Example: hiper kb sessions --kb scene.hiper --json
+    """
+    from hiper_cli.graph import open_kb_for_reading
+
+    with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
+        rows = knowledge.session_records()
+    if as_json:
+        print_json({"kb": kb, "sessions": rows})
+        return
+    from hiper_cli.commands._tables import show_sessions
+
+    show_sessions(console(), rows)
 
 
 def register(app: typer.Typer) -> None:

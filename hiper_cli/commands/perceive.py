@@ -36,7 +36,9 @@ Replace = Annotated[bool, typer.Option(
     "--replace", help="Drop this log's earlier session (one transaction), then perceive it again.")]
 Again = Annotated[bool, typer.Option(
     "--again", help="Perceive a log the knowledge base holds already, as a new session.")]
-Env = Annotated[Text, typer.Option("--env", help="Environment name (default: the log folder's name).")]
+Env = Annotated[Text, typer.Option("--env", help=(
+    "Place (environment) name; default: the one place the knowledge base holds, or the log folder's "
+    "name in a new one. A new name starts another place."))]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(

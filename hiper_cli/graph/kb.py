@@ -438,6 +438,13 @@ class KnowledgeBase(KbReads):
         world.analyses = [Analysis.from_dict(d) for d in self.docs.find(type="analysis")]
         return world
 
+    def session_records(self) -> list[dict[str, Any]]:
+        """Every session with its place, log stamps and alignment (``sessions.session_record``)."""
+        from hiper_cli.graph.sessions import session_record
+
+        names = {e.uuid: e.name for e in self.environments()}
+        return [session_record(self.docs, s, names) for s in self.docs.sessions()]
+
     def observation(self, uuid: str) -> Observation | None:
         doc = self.docs.get(uuid)
         return Observation.from_dict(doc) if doc and doc["type"] == "observation" else None

@@ -216,4 +216,9 @@ def session_quads(kb_id: str, session: dict[str, Any]) -> list[ox.Quad]:
     ]
     if session.get("ended_s") is not None:
         t.append((h("endedS"), _dbl(session["ended_s"])))
+    if session.get("alignment") is not None:  # the transform into the place's map frame
+        align = session["alignment"]
+        t += [(h("alignmentJson"), ox.Literal(json.dumps(align["T_map_log"]))),
+              (h("alignmentMethod"), ox.Literal(align["method"])),
+              (h("alignmentFitness"), _dbl(align["fitness"]))]
     return [ox.Quad(s, p, o, g) for p, o in t]
