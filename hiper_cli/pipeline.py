@@ -29,9 +29,11 @@ from typing import Any
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.documents import Session
+from hiper_cli.graph.history import session_changes, snapshot
 from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
+from hiper_cli.session_align import MapCloudGrower, aligned, choose_alignment
 from hiper_cli.types import Frame
 
 __all__ = [
@@ -93,6 +95,7 @@ class PerceiveOptions:
     on_existing: str = "refuse"
     log_path: Path | None = None
     graph_sync_s: float = DEFAULT_GRAPH_SYNC_S
+    align: str = "auto"
 
     @classmethod
     def from_text(
@@ -104,6 +107,7 @@ class PerceiveOptions:
         env_name: str | None = None,
         resume: bool = False,
         on_existing: str = "refuse",
+        align: str = "auto",
     ) -> PerceiveOptions:
         """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
 
@@ -117,7 +121,7 @@ class PerceiveOptions:
                     merged.setdefault(stage, {})[key] = value
         names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
         return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume,
-                   on_existing=on_existing)
+                   on_existing=on_existing, align=align)
 
 
 @dataclass(frozen=True)
@@ -205,6 +209,9 @@ class PerceiveSummary:
     # what the stages counted (``FrameResult.counts``): earlier sessions' objects found again,
     # moved or vacated
     counts: dict[str, int] = field(default_factory=dict)
+    # the transform that carried the log into the place's map frame (``session_align.py``)
+    alignment: dict[str, Any] | None = None
+    changes: dict[str, int] = field(default_factory=dict)  # change events of the session, per kind
 
     def add_steps(self, timings_s: dict[str, float]) -> None:
         """Add one frame's step timings (names ending in ``_s``; others are counts)."""
@@ -252,6 +259,8 @@ class PerceiveSummary:
             "earlier_sessions": {k: self.counts.get(k, 0) for k in ("found_again", "moved", "vacated")},
             "stage_mean_s": {k: round(v, 4) for k, v in self.stage_mean_s.items()},
             "graph_sync_s": round(self.graph_sync_s, 3),
+            "alignment": self.alignment,
+            "changes": {k: self.changes.get(k, 0) for k in ("added", "removed", "moved")},
             "steps": self.steps(),
         }
 
@@ -344,21 +353,25 @@ def perceive(
     env = _environment_for(kb, env_name, path)
     names = [s.name for s in stage_list]
     _check_log_fits(reader, stage_list, path)
+    alignment = choose_alignment(reader, kb, env, options.align, str(path))
     session = _session_for(kb, env, str(path), names,
                            on_existing="resume" if resume else options.on_existing)
+    kb.record_alignment(session, alignment)
+    grower = MapCloudGrower(kb, env)
     world = kb.load_world(env)
+    before = snapshot(world.foreground.values())
     total = len(reader)
     summary = PerceiveSummary(
         log=str(path), kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=None, frames_total=total,
-        unavailable_stages=unavailable_stages,
+        unavailable_stages=unavailable_stages, alignment=alignment.to_dict(),
     )
     obs_counts: Counter[tuple[str, str]] = Counter()
     last_sync = time.perf_counter()
     current = session
 
     def frames() -> Iterator[Frame]:
-        yield from reader
+        yield from aligned(iter(reader), alignment)
 
     hook = on_frame
 
@@ -371,6 +384,7 @@ def perceive(
             kb.write_frame(current, result, pose_id=frame.pose_id, stamp_s=frame.stamp_s,
                            T_map_cam=frame.T_map_cam)
             summary.frames_read += 1
+            grower.add(frame)
         summary.add_steps({**result.timings_s, "kb_write_s": time.perf_counter() - t_write})
         for obs in result.observations:
             obs_counts[(obs.layer, obs.class_name)] += 1
@@ -392,6 +406,11 @@ def perceive(
     # Frames are read and decoded one thread ahead (decoding releases the interpreter lock):
     # with the `truth` or `log` detector the second core decodes while this one perceives.
     world, stats = run_stages(prefetch(frames()), stage_list, world, write)
+    grower.store()
+    changes = session_changes(before, world.foreground.values(), current.id,
+                              seen_before=kb.earlier_views(env, current))
+    kb.write_changes(current, changes)
+    summary.changes = dict(Counter(c.kind for c in changes))
     kb.end_session(current)
     t0 = time.perf_counter()
     kb.sync_graph()

@@ -29,6 +29,9 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
         f"{data['frames_per_s']:.2f} frames/s -> {data['kb']} (environment {data['environment']!r}, "
         f"session {data['session_id']})"
     )
+    align = data.get("alignment")
+    if align and align["method"] == "registration":
+        out.print(f"aligned to the place's map: fitness {align['fitness']:.2f}, rmse {align['rmse_m']:.3f} m")
     again = data.get("earlier_sessions", {})
     if any(again.values()):
         out.print(f"earlier sessions' objects: {again['found_again']} found again "

@@ -39,6 +39,9 @@ Again = Annotated[bool, typer.Option(
 Env = Annotated[Text, typer.Option("--env", help=(
     "Place (environment) name; default: the one place the knowledge base holds, or the log folder's "
     "name in a new one. A new name starts another place."))]
+Align = Annotated[str, typer.Option("--align", help=(
+    "How the log's poses join the place's map frame: auto (register its background to the map; the "
+    "first session defines the frame), none (its poses are map poses) or FILE (a 4x4 T_map_log)."))]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(
@@ -51,7 +54,7 @@ def perceive_command(
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
     resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
-    view: View = False, timings: Timings = False, as_json: bool = JSON_OPTION, *,
+    align: Align = "auto", view: View = False, timings: Timings = False, as_json: bool = JSON_OPTION, *,
     log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
@@ -72,7 +75,7 @@ def perceive_command(
         raise ConfigError("choose one of --resume, --replace and --again")
     options = PerceiveOptions.from_text(
         stages=stages, options=option or [], env_name=env, resume=resume,
-        on_existing="replace" if replace else "again" if again else "refuse",
+        on_existing="replace" if replace else "again" if again else "refuse", align=align,
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     out = console()
     live = None

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -14,7 +14,8 @@ HELP = (
     "Simulate a robot driving through a house, hospital or office: a TUM RGB-D log (rgb, depth, poses) "
     "plus ground truth in OUT/gt (instances, people tracks, per-pixel ids, noisy truth detections). A "
     "mapping phase without people comes first.\n\n"
-    "Example: hiper sim --world hospital --seconds 60 --seed 1 -o out/hospital"
+    "Example: hiper sim --world hospital --seconds 60 --seed 1 -o out/hospital\n\n"
+    "Several sessions of one place with changes between them: hiper sim --sessions 3 --changes 6 -o out/days"
 )
 Out = Annotated[Path, typer.Option("--out", "-o", help="Output folder (created; must be empty).")]
 
@@ -40,6 +41,10 @@ def sim(
     confusion: float = typer.Option(0.03, "--confusion", help="Truth detector: chance of a wrong class."),
     png_compression: int = typer.Option(3, "--png-compression", help="PNG compression level 0-9."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Write into a non-empty output folder."),
+    sessions: int = typer.Option(
+        1, "--sessions", help="Logs of one place, each in its own odometry frame (OUT/session_K)."),
+    changes: int = typer.Option(
+        0, "--changes", help="Objects moved, removed or added between sessions (truth: OUT/changes.json)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     from hiper_cli.sim import SimConfig, simulate
@@ -49,6 +54,9 @@ def sim(
         speed_mps=speed_mps, depth_noise=depth_noise, miss_rate=miss_rate, jitter_frac=jitter,
         false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression)
     screen = console()
+    if sessions > 1 or changes:
+        _sessions(world, sessions, changes, seconds, seed, out, config, overwrite, as_json)
+        return
     with frame_progress(f"sim {world}", screen, enabled=not as_json) as bar:
         result = simulate(world, seconds, seed, out, config, overwrite=overwrite,
                           progress=bar.update if bar else None)
@@ -60,6 +68,24 @@ def sim(
         f"mapping {result.mapping_s:.1f} s then {result.people} people; {result.instances} instances; "
         f"{result.frames_per_s:.1f} frames/s"
     )
+
+
+def _sessions(world: str, sessions: int, changes: int, seconds: float, seed: int, out: Path, config: Any,
+              overwrite: bool, as_json: bool) -> None:
+    """``--sessions N --changes K``: N logs of one place (``hiper_cli.sim.sessions``)."""
+    from hiper_cli.sim.sessions import simulate_sessions
+
+    screen = console()
+    with frame_progress(f"sim {world} x{sessions}", screen, enabled=not as_json) as bar:
+        result = simulate_sessions(world, sessions, changes, seconds, seed, out, config, overwrite=overwrite,
+                                   progress=bar.update if bar else None)
+    if as_json:
+        print_json(result.to_dict())
+        return
+    kinds = ", ".join(f"{sum(c['kind'] == k for c in result.changes)} {k}"
+                      for k in ("moved", "removed", "added"))
+    screen.print(f"[green]wrote[/] {result.out}: {sessions} sessions of {world} (seed {seed}) in their own "
+                 f"frames; changes: {kinds} (truth: {result.out / 'changes.json'})")
 
 
 def register(app: HiperTyper) -> None:
