@@ -122,7 +122,7 @@ def _refine(source: Any, target: Any, T0: FloatArray) -> Registration:
     return Registration(T.copy(), float(ev.fitness), float(ev.inlier_rmse))
 
 
-def register(log_points: FloatArray, map_points: FloatArray, *, tries: int = 4,
+def register(log_points: FloatArray, map_points: FloatArray, *, tries: int = 3,
              seed: int = 0) -> Registration:
     """The transform from the log's frame into the map's: ICP from where the log stands first
     (a log in the map frame already, or nearly), else FPFH + RANSAC global registration (best
@@ -142,7 +142,7 @@ def register(log_points: FloatArray, map_points: FloatArray, *, tries: int = 4,
         coarse = reg.registration_ransac_based_on_feature_matching(
             src, tgt, f_src, f_tgt, True, dist, reg.TransformationEstimationPointToPoint(False), 3,
             [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9), reg.CorrespondenceCheckerBasedOnDistance(dist)],
-            reg.RANSACConvergenceCriteria(200000, 0.999))
+            reg.RANSACConvergenceCriteria(100000, 0.999))
         found = _refine(fine_src, fine_tgt, np.asarray(coarse.transformation))
         if found.fitness > best.fitness:
             best = found
