@@ -8,7 +8,7 @@ import functools
 import numpy as np
 
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.query import engine
+from hiper_cli.query import engine, history
 from hiper_cli.query import geometry as geo
 from hiper_cli.query.engine import Context, make_context
 from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
@@ -116,4 +116,7 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
+    change = history.match(text)  # questions about change: query/history.py
+    if change is not None:
+        return history.answer_change(ctx, change, text)
     return answer(ctx, with_limit(parse(text, now_s=ctx.now_s, config=ctx.config), limit))
