@@ -29,7 +29,7 @@ from typing import Any
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.documents import Session
-from hiper_cli.graph.history import session_changes, snapshot
+from hiper_cli.graph.history import FreeBefore, session_changes, snapshot
 from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
@@ -408,7 +408,7 @@ def perceive(
     world, stats = run_stages(prefetch(frames()), stage_list, world, write)
     grower.store()
     changes = session_changes(before, world.foreground.values(), current.id,
-                              seen_before=kb.earlier_views(env, current))
+                              seen_before=FreeBefore(grower.before))
     kb.write_changes(current, changes)
     summary.changes = dict(Counter(c.kind for c in changes))
     kb.end_session(current)

@@ -99,6 +99,7 @@ class MapCloudGrower:
         self.kb, self.env = kb, env
         self.cloud = BackgroundCloud()
         stored = kb.map_cloud(env)
+        self.before = stored  # the place as the earlier sessions saw it (for ``FreeBefore``)
         if stored is not None:
             self.cloud.add_points(stored)
         self._last_s = -np.inf

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from hiper_cli.graph import open_kb
-from hiper_cli.graph.history import Change, Views, session_changes, snapshot, validity
+from hiper_cli.graph.history import Change, FreeBefore, session_changes, snapshot, validity
 from hiper_cli.model import Box3D, Instance
 from hiper_cli.pipeline import perceive
 from tests.kb_helpers import FrameList, ProbeStage, make_frame
@@ -42,17 +42,19 @@ def test_moved_when_found_again_elsewhere_and_not_for_jitter():
     assert (moved.kind, moved.from_m[:2], moved.to_m[:2]) == ("moved", [1.0, 1.0], [2.5, 1.0])
 
 
-def test_added_only_where_an_earlier_session_looked():
+def test_added_only_where_earlier_sessions_saw_free_space():
     old = _inst("chair", 0, 0, "old")
     before = snapshot([old])
-    seen, unseen = _inst("chair", 2, 0, "new1"), _inst("chair", -3, 0, "new2")
-    T = np.eye(4)
-    T[:3, :3] = [[0, 0, 1], [-1, 0, 0], [0, -1, 0]]  # optical axis along map +x
-    views = Views(T[None])
-    changes = session_changes(before, [old, seen, unseen], 2, seen_before=views)
+    free, unseen = _inst("chair", 2, 0, "new1"), _inst("chair", -3, 0, "new2")
+    occupied = _inst("chair", 4, 0, "new3")
+    floor = np.array([[x, y, 0.0] for x in np.arange(1.0, 5.01, 0.08) for y in np.arange(-0.5, 0.51, 0.08)])
+    something = np.array([[4.0, 0.0, 0.5], [4.05, 0.05, 0.3]])  # stood at 4 m, not recognised then
+    seen_free = FreeBefore(np.concatenate([floor, something]))
+    changes = session_changes(before, [old, free, unseen, occupied], 2, seen_before=seen_free)
     assert [(c.kind, c.instance_uuid) for c in changes] == [("added", "new1")]
     # the first session of a place adds nothing: the place had no objects before
-    assert session_changes({}, [old, seen], 1, seen_before=views) == []
+    assert session_changes({}, [old, free], 1, seen_before=seen_free) == []
+    assert not FreeBefore(None)(free)
 
 
 def test_walkers_and_debris_make_no_changes():

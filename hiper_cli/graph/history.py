@@ -8,8 +8,9 @@ with what they are after it (re-identification and the empty-place test have run
   now): negative evidence, from views that would have shown it. An object this session did not
   see keeps its state: unseen is not removed.
 - **moved**: an object found again whose centre is more than ``MOVED_M`` from where it was.
-- **added**: a new object where an earlier session's camera looked (``seen_before``), so the
-  space was seen free then; a new object in a corner no session saw before is not an addition.
+- **added**: a new object where the earlier sessions saw free space (``FreeBefore``: their
+  background cloud holds the floor or table under it and nothing in its box); a new object in
+  a corner no session saw, or where something unrecognised stood, is not an addition.
 
 Each change is a document of type ``change`` (``Change.to_dict``), written with the session;
 the graph holds it as a ``hiper:Change`` (a ``prov:Activity``) that ``prov:used`` the
@@ -28,7 +29,8 @@ import numpy as np
 
 from hiper_cli.model import Instance
 
-__all__ = ["CHANGE_KINDS", "MOVED_M", "Change", "Placed", "Views", "session_changes", "snapshot", "validity"]
+__all__ = ["CHANGE_KINDS", "MOVED_M", "Change", "FreeBefore", "Placed", "session_changes", "snapshot",
+           "validity"]
 
 CHANGE_KINDS = ("added", "removed", "moved")
 MOVED_M = 0.5  # a static object found again this far (footprint centres) from where it was moved
@@ -91,7 +93,7 @@ def session_changes(
     after: Iterable[Instance],
     session_id: int,
     *,
-    seen_before: Callable[[np.ndarray], bool],
+    seen_before: Callable[[Instance], bool],
 ) -> list[Change]:
     """The change events of one session (see the module docstring), in stamp order."""
     out: list[Change] = []
@@ -102,7 +104,7 @@ def session_changes(
         old = before.get(inst.uuid)
         vacated = inst.data.get("vacated_s")
         if old is None:
-            if before and vacated is None and seen_before(np.asarray(now)):
+            if before and vacated is None and seen_before(inst):
                 out.append(Change("added", inst.class_name, inst.uuid, session_id, float(inst.first_seen_s),
                                   None, list(now)))
         elif old.vacated_s is None and vacated is not None:
@@ -115,23 +117,27 @@ def session_changes(
     return sorted(out, key=lambda c: (c.stamp_s, c.kind, c.instance_uuid))
 
 
-class Views:
-    """Where earlier sessions' cameras looked: a point was in view of one of these poses
-    (within ``range_m``, within ``half_fov_deg`` of its optical axis). Occlusion is not
-    modelled: a spot behind a wall within range counts as seen."""
+class FreeBefore:
+    """Whether the place's earlier sessions saw an object's space free: their background cloud
+    (``mapcloud.py``) holds the support under its footprint (``SUPPORT_POINTS`` points within
+    ``SUPPORT_M`` below its box) and hardly anything inside its box (at most ``INSIDE_POINTS``
+    above ``SUPPORT_M`` over its bottom). A space never seen, or one where something stood that
+    was not recognised then, is not free: an object found there is not an addition."""
 
-    def __init__(self, T_map_cams: np.ndarray, range_m: float = 4.0, half_fov_deg: float = 25.0) -> None:
-        T = np.asarray(T_map_cams, dtype=np.float64).reshape(-1, 4, 4)
-        self.origins = T[:, :3, 3]
-        self.axes = T[:, :3, 2]
-        self.range_m = range_m
-        self.cos_fov = float(np.cos(np.radians(half_fov_deg)))
+    SUPPORT_M = 0.08
+    SUPPORT_POINTS = 2
+    INSIDE_POINTS = 1
 
-    def __call__(self, point_m: np.ndarray) -> bool:
-        if len(self.origins) == 0:
+    def __init__(self, points_m: np.ndarray | None) -> None:
+        self.points = np.zeros((0, 3)) if points_m is None else np.asarray(points_m, dtype=np.float64)
+
+    def __call__(self, inst: Instance) -> bool:
+        if len(self.points) == 0:
             return False
-        d = np.asarray(point_m, dtype=np.float64)[None, :3] - self.origins
-        dist = np.linalg.norm(d, axis=1)
-        ok = (dist > 0.3) & (dist < self.range_m)
-        cos = (d * self.axes).sum(axis=1) / np.maximum(dist, 1e-9)
-        return bool(np.any(ok & (cos > self.cos_fov)))
+        lo, hi = inst.box.aabb()
+        p = self.points
+        over = (p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0]) & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1])
+        z = p[over, 2]
+        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + self.SUPPORT_M)).sum())
+        inside = int(((z >= lo[2] + self.SUPPORT_M) & (z <= hi[2])).sum())
+        return support >= self.SUPPORT_POINTS and inside <= self.INSIDE_POINTS

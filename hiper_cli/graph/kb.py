@@ -265,17 +265,6 @@ class KnowledgeBase(KbReads):
         with self.docs.transaction():
             return store_map_cloud(self.docs, env.uuid, points_m)
 
-    def earlier_views(self, env: Environment, session: Session, every: int = 5) -> Any:
-        """Where the place's other sessions looked (``history.Views``), every ``every``-th pose."""
-        import json
-
-        from hiper_cli.graph.history import Views
-
-        rows = self.docs._db.execute(
-            "SELECT p.T_map_cam FROM poses p JOIN sessions s ON s.id = p.session_id "
-            "WHERE s.env_uuid = ? AND s.id != ? AND p.pose_id % ? = 0", (env.uuid, session.id, every))
-        return Views(np.array([json.loads(t) for (t,) in rows]).reshape(-1, 4, 4))
-
     def write_changes(self, session: Session, changes: Sequence[Any]) -> None:
         """Store a session's change events (``history.Change``) in one transaction."""
         if changes:

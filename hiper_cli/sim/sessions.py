@@ -38,6 +38,8 @@ CHANGE_KINDS = ("moved", "removed", "added")
 MOVABLE = ("chair", "potted plant")
 CLEAR_M = 0.45  # a changed object's centre stays this far from furniture and walls
 ROUTE_CLEAR_M = 0.9  # ... and from the robot's waypoints
+APART_M = 3.5  # an object added or moved to stays this far from where one of its class was taken away
+# (closer, a removal and an addition are a move to anyone who cannot tell two chairs apart)
 MOVE_M = (1.2, 3.0)  # how far a moved object goes
 
 
@@ -81,8 +83,9 @@ class _Place:
         self.w = world
         self.rng = rng
         self.taken: list[tuple[float, float]] = []  # spots changed already: keep changes apart
+        self.gone: list[tuple[str, tuple[float, float]]] = []  # (class, spot) of objects taken away
 
-    def free_spot(self, near: tuple[float, float] | None = None) -> tuple[float, float] | None:
+    def free_spot(self, cls: str, near: tuple[float, float] | None = None) -> tuple[float, float] | None:
         for _ in range(400):
             x0, y0, x1, y1 = self.w.walkable[int(self.rng.integers(len(self.w.walkable)))]
             p = (float(self.rng.uniform(x0, x1)), float(self.rng.uniform(y0, y1)))
@@ -90,7 +93,8 @@ class _Place:
                 continue
             if (_clearance(p, self.w.obstacles) >= CLEAR_M
                     and all(math.dist(p, q) >= ROUTE_CLEAR_M for q in self.w.waypoints)
-                    and all(math.dist(p, q) >= 1.0 for q in self.taken)):
+                    and all(math.dist(p, q) >= 1.0 for q in self.taken)
+                    and all(math.dist(p, q) >= APART_M for c, q in self.gone if c == cls)):
                 self.taken.append(p)
                 return p
         return None
@@ -116,10 +120,10 @@ def _change(place: _Place, kind: str, changed: set[int]) -> dict[str, Any] | Non
     """Apply one change of ``kind`` to the place; its truth record, or None if none fits."""
     rng = place.rng
     if kind == "added":
-        spot = place.free_spot()
+        cls = MOVABLE[int(rng.integers(len(MOVABLE)))]
+        spot = place.free_spot(cls)
         if spot is None:
             return None
-        cls = MOVABLE[int(rng.integers(len(MOVABLE)))]
         mesh = (fu.chair((0.2, 0.5, 0.3), (0.3, 0.2, 0.1)) if cls == "chair"
                 else fu.plant((0.6, 0.3, 0.2)))
         mesh = mesh.transformed(rot_z(float(rng.uniform(0, 2 * math.pi)), (spot[0], spot[1], 0.0)))
@@ -130,17 +134,20 @@ def _change(place: _Place, kind: str, changed: set[int]) -> dict[str, Any] | Non
     candidates = place.movable(changed)
     rng.shuffle(candidates)
     for obj in candidates:
+        c = obj.box.center_m
         if kind == "removed":
             place.remove(obj)
+            place.gone.append((obj.class_name, (float(c[0]), float(c[1]))))
+            place.taken.append((float(c[0]), float(c[1])))
             changed.add(obj.id)
             return {"kind": kind, "class": obj.class_name, "object_id": obj.id, "from_m": _centre(obj),
                     "to_m": None}
-        c = obj.box.center_m
         place.remove(obj)  # its own footprint does not block where it goes
-        spot = place.free_spot(near=(float(c[0]), float(c[1])))
+        spot = place.free_spot(obj.class_name, near=(float(c[0]), float(c[1])))
         if spot is None:
             place.put(obj)
             continue
+        place.gone.append((obj.class_name, (float(c[0]), float(c[1]))))
         moved = replace(obj, mesh=obj.mesh.translated((spot[0] - c[0], spot[1] - c[1], 0.0)))
         place.put(moved)
         changed.add(obj.id)
