@@ -28,6 +28,7 @@ from typing import Any
 
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
+from hiper_cli.graph.compact import compact
 from hiper_cli.graph.documents import Session
 from hiper_cli.graph.history import FreeBefore, session_changes, snapshot
 from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
@@ -96,6 +97,10 @@ class PerceiveOptions:
     log_path: Path | None = None
     graph_sync_s: float = DEFAULT_GRAPH_SYNC_S
     align: str = "auto"
+    # raw observations kept this long before the newest stamp; older ones that add nothing are
+    # summarised at the end of the session (``graph/compact.py``); None (the library's default;
+    # ``hiper perceive`` summarises unless told otherwise) keeps every observation
+    keep_observations_s: float | None = None
 
     @classmethod
     def from_text(
@@ -108,6 +113,7 @@ class PerceiveOptions:
         resume: bool = False,
         on_existing: str = "refuse",
         align: str = "auto",
+        keep_observations_s: float | None = None,
     ) -> PerceiveOptions:
         """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
 
@@ -121,7 +127,7 @@ class PerceiveOptions:
                     merged.setdefault(stage, {})[key] = value
         names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
         return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume,
-                   on_existing=on_existing, align=align)
+                   on_existing=on_existing, align=align, keep_observations_s=keep_observations_s)
 
 
 @dataclass(frozen=True)
@@ -212,6 +218,7 @@ class PerceiveSummary:
     # the transform that carried the log into the place's map frame (``session_align.py``)
     alignment: dict[str, Any] | None = None
     changes: dict[str, int] = field(default_factory=dict)  # change events of the session, per kind
+    storage: dict[str, Any] | None = None  # what the end-of-session compaction did
 
     def add_steps(self, timings_s: dict[str, float]) -> None:
         """Add one frame's step timings (names ending in ``_s``; others are counts)."""
@@ -261,6 +268,7 @@ class PerceiveSummary:
             "graph_sync_s": round(self.graph_sync_s, 3),
             "alignment": self.alignment,
             "changes": {k: self.changes.get(k, 0) for k in ("added", "removed", "moved")},
+            "storage": self.storage,
             "steps": self.steps(),
         }
 
@@ -412,6 +420,8 @@ def perceive(
     kb.write_changes(current, changes)
     summary.changes = dict(Counter(c.kind for c in changes))
     kb.end_session(current)
+    if options.keep_observations_s is not None:
+        summary.storage = compact(kb, keep_raw_s=options.keep_observations_s).to_dict()
     t0 = time.perf_counter()
     kb.sync_graph()
     summary.graph_sync_s += time.perf_counter() - t0

@@ -32,6 +32,7 @@ def test_logs_without_env_join_the_one_place(tmp_path):
         assert [s.frames for s in kb.docs.sessions()] == [4, 3, 2]
         (floor,) = kb.instances(layer="background")  # one floor, not three
         assert len(floor.observation_uuids) == 9
+        assert kb.session_records()[2]["environment"] == "monday"
 
 
 def test_a_new_env_name_starts_another_place_and_then_the_choice_is_asked(tmp_path):

@@ -42,6 +42,9 @@ Env = Annotated[Text, typer.Option("--env", help=(
 Align = Annotated[str, typer.Option("--align", help=(
     "How the log's poses join the place's map frame: auto (register its background to the map; the "
     "first session defines the frame), none (its poses are map poses) or FILE (a 4x4 T_map_log)."))]
+Keep = Annotated[str, typer.Option("--keep-observations", help=(
+    "Keep raw observations this long before the newest stamp ('10 minutes', '2 h'); older ones that add "
+    "nothing are summarised at the end of the session. 0 (default) summarises all; 'all' keeps all."))]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(
@@ -54,7 +57,8 @@ def perceive_command(
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
     resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
-    align: Align = "auto", view: View = False, timings: Timings = False, as_json: bool = JSON_OPTION, *,
+    align: Align = "auto", keep_observations: Keep = "0", view: View = False, timings: Timings = False,
+    as_json: bool = JSON_OPTION, *,
     log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
@@ -76,6 +80,7 @@ def perceive_command(
     options = PerceiveOptions.from_text(
         stages=stages, options=option or [], env_name=env, resume=resume,
         on_existing="replace" if replace else "again" if again else "refuse", align=align,
+        keep_observations_s=keep_duration_s(keep_observations),
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     out = console()
     live = None
@@ -96,6 +101,24 @@ def perceive_command(
         show_perceive(out, summary.to_dict())
         if timings:
             show_steps(out, summary.to_dict()["steps"])
+
+
+def keep_duration_s(text: str) -> float | None:
+    """``--keep-observations``: seconds, or None for 'all' (no summarising)."""
+    if text.strip().lower() in ("all", "forever", "none"):
+        return None
+    try:
+        return max(0.0, float(text))
+    except ValueError:
+        pass
+    from hiper_cli.agent.times import resolve_span_s
+    from hiper_cli.errors import ConfigError, QueryError
+
+    try:
+        return resolve_span_s(text)
+    except QueryError as err:
+        raise ConfigError(f"--keep-observations {text!r}: expected a duration such as '10 minutes', "
+                          "'2 h', 0 or 'all'") from err
 
 
 def register(app: typer.Typer) -> None:

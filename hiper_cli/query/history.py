@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from hiper_cli.errors import QueryError
+from hiper_cli.graph.compact import summarised_count
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.query.engine import Context
 from hiper_cli.query.results import Answer, Hit, TimeValue
@@ -123,7 +124,8 @@ def _hit(ctx: Context, uuid: str) -> Hit | None:
     return Hit(uuid=inst.uuid, class_name=inst.class_name, layer=inst.layer, center_map_m=(c[0], c[1], c[2]),
                extent_m=tuple(float(v) for v in inst.box.extent_m),  # type: ignore[arg-type]
                first_seen_s=inst.first_seen_s, last_seen_s=inst.last_seen_s,
-               observation_count=len(inst.observation_uuids), confidence=inst.confidence, state=inst.state,
+               observation_count=len(inst.observation_uuids) + summarised_count(inst.to_dict()),
+               confidence=inst.confidence, state=inst.state,
                speed_mps=None, distance_m=round(dist, 4))
 
 
