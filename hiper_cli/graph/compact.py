@@ -16,8 +16,8 @@ and drops the others, counting them in the instance (``data.observations_summari
 ``observation_count`` stays what was seen). Observations of a session whose stamps fall inside
 a stretch already covered by earlier sessions of a found-again object (the same log perceived
 again) add nothing either. Observations no instance holds (debris that never became an
-object, tracks merged away) are dropped. Movers keep every observation: their sightings are
-their trajectory. Only observations older than ``keep_raw_s`` before the newest stamp are
+object, tracks merged away) are dropped. Movers keep every observation, as a stub: their
+sightings are their trajectory. Only observations older than ``keep_raw_s`` before the newest stamp are
 touched (``--keep-observations``).
 
 The graph is rebuilt from the documents afterwards (observation batches change); queries over
@@ -182,7 +182,8 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
         summarised: dict[str, int] = {}
         stub_ids: list[int] = []
         for inst, rows in _observation_rows(db).items():
-            if inst not in static:
+            if inst not in static:  # a mover: every sighting stays, its low-level data goes
+                stub_ids += [r[0] for r in rows if r[2] < keep_after_s]
                 continue
             stretches = _stretches(rows)
             keep: set[int] = set()
@@ -212,6 +213,9 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
     if vacuum:
         db.execute("VACUUM")
         db.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+        optimize = getattr(kb.graph, "optimize", None)  # a local graph store: shrink it too
+        if optimize is not None:
+            optimize()
     report.observations_after = int(docs._scalar("SELECT COUNT(*) FROM docs WHERE type = 'observation'"))
     report.bytes_after = _bytes(kb)
     report.seconds = time.perf_counter() - started
