@@ -78,11 +78,11 @@ def _keep(rows: list[Row], covered: list[tuple[float, float]],
         ends = stamp - prev_stamp > STRETCH_GAP_S or nxt - stamp > STRETCH_GAP_S
         prev_stamp = stamp
         moved = last is not None and (x - last[5]) ** 2 + (y - last[6]) ** 2 > MOVE_M ** 2
-        if stamp >= keep_after_s or last is None or cls != last[3] or moved:
+        if stamp >= keep_after_s or last is None or cls != last[3]:
             whole.add(oid)
         elif any(a <= stamp <= b for a, b in covered):
             continue  # seen at that time already, by an earlier session: the same log again
-        elif ends:
+        elif moved or ends:
             whole.add(oid)
         elif stamp - last_s >= SUMMARY_S:
             stubs.add(oid)
@@ -92,6 +92,12 @@ def _keep(rows: list[Row], covered: list[tuple[float, float]],
             last = row
         last_s = stamp
     return whole, stubs
+
+
+def _covered(row: Row, stretches: dict[int | None, list[tuple[float, float]]]) -> bool:
+    """Whether an earlier session saw the instance at this observation's stamp."""
+    return any(a <= row[2] <= b for other, spans in stretches.items()
+               if other != row[4] and (other or 0) < (row[4] or 0) for a, b in spans)
 
 
 def _stretches(rows: Iterable[Row]) -> dict[int | None, list[tuple[float, float]]]:
@@ -112,9 +118,8 @@ def _stretches(rows: Iterable[Row]) -> dict[int | None, list[tuple[float, float]
     return out
 
 
-def _static_instances(db: Any) -> dict[str, dict[str, Any]]:
-    rows = db.execute("SELECT uuid, body FROM docs WHERE type = 'instance'")
-    return {u: doc for u, body in rows if (doc := loads(body)).get("state", "static") == "static"}
+def _instances(db: Any) -> dict[str, dict[str, Any]]:
+    return {u: loads(body) for u, body in db.execute("SELECT uuid, body FROM docs WHERE type = 'instance'")}
 
 
 def _observation_rows(db: Any) -> dict[str, list[Row]]:
@@ -177,15 +182,21 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
         debris = [int(i) for (i,) in db.execute(
             "SELECT d.id FROM docs d WHERE d.type = 'observation' AND d.stamp_s < ? AND NOT EXISTS "
             "(SELECT 1 FROM all_links l WHERE l.observation_uuid = d.uuid)", (keep_after_s,))]
-        static = _static_instances(db)
+        instances = _instances(db)
         drop: list[int] = []
         summarised: dict[str, int] = {}
         stub_ids: list[int] = []
         for inst, rows in _observation_rows(db).items():
-            if inst not in static:  # a mover: every sighting stays, its low-level data goes
-                stub_ids += [r[0] for r in rows if r[2] < keep_after_s]
-                continue
             stretches = _stretches(rows)
+            if inst not in instances:
+                continue
+            if instances[inst].get("state", "static") != "static":  # a mover: stubs, but not twice
+                again = {r[0] for r in rows if r[2] < keep_after_s and _covered(r, stretches)}
+                stub_ids += [r[0] for r in rows if r[2] < keep_after_s and r[0] not in again]
+                if again:
+                    drop += sorted(again)
+                    summarised[inst] = len(again)
+                continue
             keep: set[int] = set()
             for session in {r[4] for r in rows}:
                 mine = [r for r in rows if r[4] == session]
@@ -201,7 +212,7 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
         _stub(db, stub_ids)
         _drop(db, debris + drop)
         for inst, n in summarised.items():
-            doc = static[inst]
+            doc = instances[inst]
             data = doc.setdefault("data", {})
             data[SUMMARISED] = int(data.get(SUMMARISED, 0)) + n
             db.execute("UPDATE docs SET body = ?, seq = ? WHERE uuid = ?", (dumps(doc), seq, inst))
