@@ -4,13 +4,14 @@ A memory meant for months cannot append every sighting of a chair that stands wh
 stood: at 15-30 Hz that is gigabytes a day whatever changed. ``compact`` keeps, per static
 instance, the observations that say something:
 
-- the first and the last of each stretch in view (observations closer than ``STRETCH_GAP_S``),
-  and within a stretch one every ``SUMMARY_S`` as a stub (stamp, class, box; its low-level
-  data gone), below the query layer's ``view_gap_s``, so "time in view" and first/last
-  sightings answer the same;
+- the first of each session;
 - every observation whose class differs from the last one kept (class evidence);
 - every observation whose map box centre lies ``MOVE_M`` from the last one kept (a new place
   or a new side of the object);
+
+and summarises the others into the instance's stretches in view (``data.view_spans``: first
+and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
+them, ``span_stamps``);
 
 and drops the others, counting them in the instance (``data.observations_summarised``: its
 ``observation_count`` stays what was seen). Observations of a session whose stamps fall inside
@@ -28,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections import defaultdict
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -37,12 +38,12 @@ from hiper_cli.graph.codec import dumps, loads
 if TYPE_CHECKING:
     from hiper_cli.graph.kb import KnowledgeBase
 
-__all__ = ["SUMMARY_S", "CompactReport", "compact"]
+__all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps"]
 
-SUMMARY_S = 0.9  # within a stretch in view, one observation per this many seconds is kept (a stub)
 STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
 MOVE_M = 0.1
 SUMMARISED = "observations_summarised"
+VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
 
 
 @dataclass
@@ -63,35 +64,36 @@ Row = tuple[int, str, float, str | None, int | None, float, float]  # id, uuid, 
 
 
 def _keep(rows: list[Row], covered: list[tuple[float, float]],
-          keep_after_s: float) -> tuple[set[int], set[int]]:
-    """Ids of the observations of one static instance (one session) kept whole, and of those
-    kept as stubs (module docstring). ``covered``: stretches (first, last stamp) that earlier
+          keep_after_s: float) -> tuple[set[int], list[tuple[float, float]]]:
+    """Ids of the observations of one static instance (one session) kept, and the stretches in
+    view the others are summarised into (module docstring). ``covered``: stretches earlier
     sessions' observations of the instance span; one inside them adds nothing."""
-    whole: set[int] = set()
-    stubs: set[int] = set()
-    last: Row | None = None  # the last observation kept whole
-    last_s = -1e18  # the stamp of the last one kept, whole or stub
-    prev_stamp = -1e18
-    for k, row in enumerate(rows):
+    keep: set[int] = set()
+    spans: list[tuple[float, float]] = []
+    last: Row | None = None  # the last observation kept
+    for row in rows:
         oid, _, stamp, cls, _, x, y = row
-        nxt = rows[k + 1][2] if k + 1 < len(rows) else 1e18
-        ends = stamp - prev_stamp > STRETCH_GAP_S or nxt - stamp > STRETCH_GAP_S
-        prev_stamp = stamp
-        moved = last is not None and (x - last[5]) ** 2 + (y - last[6]) ** 2 > MOVE_M ** 2
-        if stamp >= keep_after_s or last is None or cls != last[3]:
-            whole.add(oid)
-        elif any(a <= stamp <= b for a, b in covered):
-            continue  # seen at that time already, by an earlier session: the same log again
-        elif moved or ends:
-            whole.add(oid)
-        elif stamp - last_s >= SUMMARY_S:
-            stubs.add(oid)
+        if spans and stamp - spans[-1][1] <= STRETCH_GAP_S:
+            spans[-1] = (spans[-1][0], stamp)
         else:
-            continue
-        if oid in whole:
+            spans.append((stamp, stamp))
+        moved = last is not None and (x - last[5]) ** 2 + (y - last[6]) ** 2 > MOVE_M ** 2
+        if (stamp >= keep_after_s or last is None or cls != last[3]
+                or (moved and not any(a <= stamp <= b for a, b in covered))):
+            keep.add(oid)
             last = row
-        last_s = stamp
-    return whole, stubs
+    return keep, spans
+
+
+def merge_spans(spans: Iterable[Sequence[float]]) -> list[list[float]]:
+    """Stretches in view, sorted and joined where they overlap or lie ``STRETCH_GAP_S`` apart."""
+    out: list[list[float]] = []
+    for a, b in sorted((float(a), float(b)) for a, b in spans):
+        if out and a - out[-1][1] <= STRETCH_GAP_S:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return out
 
 
 def _covered(row: Row, stretches: dict[int | None, list[tuple[float, float]]]) -> bool:
@@ -186,6 +188,7 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
         drop: list[int] = []
         summarised: dict[str, int] = {}
         stub_ids: list[int] = []
+        spans: dict[str, list[tuple[float, float]]] = {}
         for inst, rows in _observation_rows(db).items():
             stretches = _stretches(rows)
             if inst not in instances:
@@ -200,11 +203,11 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
             keep: set[int] = set()
             for session in {r[4] for r in rows}:
                 mine = [r for r in rows if r[4] == session]
-                covered = [s for other, spans in stretches.items() if other != session
-                           and (other or 0) < (session or 0) for s in spans]
-                whole, stubs = _keep(mine, covered, keep_after_s)
-                keep |= whole | stubs
-                stub_ids += stubs
+                covered = [s for other, spans_ in stretches.items() if other != session
+                           and (other or 0) < (session or 0) for s in spans_]
+                kept, session_spans = _keep(mine, covered, keep_after_s)
+                keep |= kept
+                spans.setdefault(inst, []).extend(session_spans)
             gone = [r[0] for r in rows if r[0] not in keep]
             if gone:
                 drop += gone
@@ -215,6 +218,8 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
             doc = instances[inst]
             data = doc.setdefault("data", {})
             data[SUMMARISED] = int(data.get(SUMMARISED, 0)) + n
+            if inst in spans:
+                data[VIEW_SPANS] = merge_spans([*data.get(VIEW_SPANS, []), *spans[inst]])
             db.execute("UPDATE docs SET body = ?, seq = ? WHERE uuid = ?", (dumps(doc), seq, inst))
         report.debris_dropped, report.summarised = len(debris), len(drop)
     docs._link_counts.clear()
@@ -238,6 +243,17 @@ def _bytes(kb: KnowledgeBase) -> int:
     path = kb.docs.path
     wal = path.with_name(path.name + "-wal")
     return path.stat().st_size + (wal.stat().st_size if wal.exists() else 0)
+
+
+def span_stamps(doc: dict[str, Any], step_s: float = 0.5) -> list[float]:
+    """Stamps standing for an instance's summarised stretches in view (``VIEW_SPANS``): each
+    stretch from its first to its last stamp in ``step_s`` steps, so "time in view" over them
+    is what it was over the observations they summarise."""
+    out: list[float] = []
+    for a, b in (doc.get("data") or {}).get(VIEW_SPANS, []):
+        n = max(1, int((b - a) / step_s))
+        out += [a + (b - a) * k / n for k in range(n + 1)]
+    return out
 
 
 def summarised_count(doc: dict[str, Any]) -> int:
