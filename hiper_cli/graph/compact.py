@@ -5,9 +5,10 @@ stood: at 15-30 Hz that is gigabytes a day whatever changed. ``compact`` keeps, 
 instance, the observations that say something:
 
 - the first of each session;
-- every observation whose class differs from the last one kept (class evidence);
-- every observation whose map box centre lies ``MOVE_M`` from the last one kept (a new place
-  or a new side of the object);
+- every observation that gives a class none kept gave (class evidence);
+- every observation of a foreground object whose map box centre lies ``MOVE_M`` from every
+  one kept (the object somewhere new; a plane's pieces lie all along it, and its instance has
+  fused their outline);
 
 and summarises the others into the instance's stretches in view (``data.view_spans``: first
 and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
@@ -22,7 +23,9 @@ sightings are their trajectory. Only observations older than ``keep_raw_s`` befo
 touched (``--keep-observations``).
 
 The graph is rebuilt from the documents afterwards (observation batches change); queries over
-instances, events and trajectories answer the same.
+instances, events and trajectories answer the same. What is dropped cannot be re-anchored to an
+optimised trajectory later (``hiper reanchor``): keep the raw observations of the window a loop
+closure may still change with ``--keep-observations``.
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ if TYPE_CHECKING:
 __all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps"]
 
 STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
-MOVE_M = 0.1
+MOVE_M = 0.25  # an observation this far from every one kept shows the object somewhere new
 SUMMARISED = "observations_summarised"
 VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
 
@@ -63,25 +66,28 @@ class CompactReport:
 Row = tuple[int, str, float, str | None, int | None, float, float]  # id, uuid, stamp, class, session, x, y
 
 
-def _keep(rows: list[Row], covered: list[tuple[float, float]],
-          keep_after_s: float) -> tuple[set[int], list[tuple[float, float]]]:
+def _keep(rows: list[Row], covered: list[tuple[float, float]], keep_after_s: float,
+          background: bool = False) -> tuple[set[int], list[tuple[float, float]]]:
     """Ids of the observations of one static instance (one session) kept, and the stretches in
     view the others are summarised into (module docstring). ``covered``: stretches earlier
     sessions' observations of the instance span; one inside them adds nothing."""
     keep: set[int] = set()
     spans: list[tuple[float, float]] = []
-    last: Row | None = None  # the last observation kept
+    classes: set[str | None] = set()  # the classes the kept observations give
+    places: list[tuple[float, float]] = []  # where the kept observations lie
     for row in rows:
         oid, _, stamp, cls, _, x, y = row
         if spans and stamp - spans[-1][1] <= STRETCH_GAP_S:
             spans[-1] = (spans[-1][0], stamp)
         else:
             spans.append((stamp, stamp))
-        moved = last is not None and (x - last[5]) ** 2 + (y - last[6]) ** 2 > MOVE_M ** 2
-        if (stamp >= keep_after_s or last is None or cls != last[3]
-                or (moved and not any(a <= stamp <= b for a, b in covered))):
+        # a plane's pieces lie all along it: its instance has fused their outline already
+        new_place = not background and all((x - px) ** 2 + (y - py) ** 2 > MOVE_M ** 2 for px, py in places)
+        if (stamp >= keep_after_s or cls not in classes
+                or (new_place and not any(a <= stamp <= b for a, b in covered))):
             keep.add(oid)
-            last = row
+            classes.add(cls)
+            places.append((x, y))
     return keep, spans
 
 
@@ -205,7 +211,8 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
                 mine = [r for r in rows if r[4] == session]
                 covered = [s for other, spans_ in stretches.items() if other != session
                            and (other or 0) < (session or 0) for s in spans_]
-                kept, session_spans = _keep(mine, covered, keep_after_s)
+                kept, session_spans = _keep(mine, covered, keep_after_s,
+                                            instances[inst].get("layer") == "background")
                 keep |= kept
                 spans.setdefault(inst, []).extend(session_spans)
             gone = [r[0] for r in rows if r[0] not in keep]
