@@ -120,9 +120,10 @@ def session_changes(
 class FreeBefore:
     """Whether the place's earlier sessions saw an object's space free: their background cloud
     (``mapcloud.py``) holds the support under its footprint (``SUPPORT_POINTS`` points within
-    ``SUPPORT_M`` below its box) and hardly anything inside its box (at most ``INSIDE_POINTS``
-    above ``SUPPORT_M`` over its bottom). A space never seen, or one where something stood that
-    was not recognised then, is not free: an object found there is not an addition."""
+    ``SUPPORT_M`` of its box's bottom) and hardly anything inside its box (at most
+    ``INSIDE_POINTS`` above the support band: ``SUPPORT_M``, or 30 % of a small object's
+    height). A space never seen, or one where something stood that was not recognised then,
+    is not free: an object found there is not an addition."""
 
     SUPPORT_M = 0.08
     SUPPORT_POINTS = 2
@@ -138,6 +139,7 @@ class FreeBefore:
         p = self.points
         over = (p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0]) & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1])
         z = p[over, 2]
-        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + self.SUPPORT_M)).sum())
-        inside = int(((z >= lo[2] + self.SUPPORT_M) & (z <= hi[2])).sum())
+        margin = min(self.SUPPORT_M, 0.3 * float(hi[2] - lo[2]))  # a cup is barely taller than this
+        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
+        inside = int(((z >= lo[2] + margin) & (z <= hi[2])).sum())
         return support >= self.SUPPORT_POINTS and inside <= self.INSIDE_POINTS
