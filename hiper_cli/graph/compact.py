@@ -239,6 +239,8 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
         optimize = getattr(kb.graph, "optimize", None)  # a local graph store: shrink it too
         if optimize is not None:
             optimize()
+            kb.detach_graph()  # reopening lets the store drop its obsolete write-ahead logs
+            kb.attach_graph()
     report.observations_after = int(docs._scalar("SELECT COUNT(*) FROM docs WHERE type = 'observation'"))
     report.bytes_after = _bytes(kb)
     report.seconds = time.perf_counter() - started
