@@ -7,9 +7,9 @@ unfinished session of the same log in its place. Perceiving a log the environmen
 holds with the same stages is refused unless asked for (``on_existing``). The scene
 graph follows the documents every ``graph_sync_s`` seconds and at the end (see ``graph.kb``).
 
-Each run is a session of an environment (default: the log folder's name); the environment's
-live instances and analyses are loaded into the ``World`` first, so several logs of the same
-place accumulate into one environment.
+Each run is a session of an environment (default: the one place the knowledge base holds, or
+for an empty one the log folder's name); the environment's live instances and analyses are
+loaded into the ``World`` first, so several logs of the same place accumulate into one.
 
 Two entries: ``perceive(reader, kb, stages, options)`` runs built stages over an open log;
 ``perceive_log(path, kb_location, LogOptions(...), PerceiveOptions(...))`` is the whole of
@@ -28,10 +28,13 @@ from typing import Any
 
 from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
+from hiper_cli.graph.compact import compact
 from hiper_cli.graph.documents import Session
+from hiper_cli.graph.history import FreeBefore, session_changes, snapshot
 from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
+from hiper_cli.session_align import MapCloudGrower, aligned, choose_alignment
 from hiper_cli.types import Frame
 
 __all__ = [
@@ -93,6 +96,11 @@ class PerceiveOptions:
     on_existing: str = "refuse"
     log_path: Path | None = None
     graph_sync_s: float = DEFAULT_GRAPH_SYNC_S
+    align: str = "auto"
+    # raw observations kept this long before the newest stamp; older ones that add nothing are
+    # summarised at the end of the session (``graph/compact.py``); None (the library's default;
+    # ``hiper perceive`` summarises unless told otherwise) keeps every observation
+    keep_observations_s: float | None = None
 
     @classmethod
     def from_text(
@@ -104,6 +112,8 @@ class PerceiveOptions:
         env_name: str | None = None,
         resume: bool = False,
         on_existing: str = "refuse",
+        align: str = "auto",
+        keep_observations_s: float | None = None,
     ) -> PerceiveOptions:
         """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
 
@@ -120,7 +130,7 @@ class PerceiveOptions:
                     merged.setdefault(stage, {})[key] = value
         names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
         return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume,
-                   on_existing=on_existing)
+                   on_existing=on_existing, align=align, keep_observations_s=keep_observations_s)
 
 
 @dataclass(frozen=True)
@@ -208,6 +218,10 @@ class PerceiveSummary:
     # what the stages counted (``FrameResult.counts``): earlier sessions' objects found again,
     # moved or vacated
     counts: dict[str, int] = field(default_factory=dict)
+    # the transform that carried the log into the place's map frame (``session_align.py``)
+    alignment: dict[str, Any] | None = None
+    changes: dict[str, int] = field(default_factory=dict)  # change events of the session, per kind
+    storage: dict[str, Any] | None = None  # what the end-of-session compaction did
 
     def add_steps(self, timings_s: dict[str, float]) -> None:
         """Add one frame's step timings (names ending in ``_s``; others are counts)."""
@@ -255,6 +269,9 @@ class PerceiveSummary:
             "earlier_sessions": {k: self.counts.get(k, 0) for k in ("found_again", "moved", "vacated")},
             "stage_mean_s": {k: round(v, 4) for k, v in self.stage_mean_s.items()},
             "graph_sync_s": round(self.graph_sync_s, 3),
+            "alignment": self.alignment,
+            "changes": {k: self.changes.get(k, 0) for k in ("added", "removed", "moved")},
+            "storage": self.storage,
             "steps": self.steps(),
         }
 
@@ -347,24 +364,28 @@ def perceive(
     source = options.log_path if options.log_path is not None else reader.info().path
     path = Path(source) if live else Path(source).resolve()
     log_name = str(source) if live else str(path)
-    env = kb.environment(env_name or path.stem or path.name)
+    env = _environment_for(kb, env_name, path)
     names = [s.name for s in stage_list]
     _check_log_fits(reader, stage_list, path)
+    alignment = choose_alignment(reader, kb, env, options.align, log_name)
     session = _session_for(kb, env, log_name, names,
                            on_existing="resume" if resume else options.on_existing)
+    kb.record_alignment(session, alignment)
+    grower = MapCloudGrower(kb, env)
     world = kb.load_world(env)
+    before = snapshot(world.foreground.values())
     total = len(reader)
     summary = PerceiveSummary(
         log=log_name, kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=None, frames_total=total,
-        unavailable_stages=unavailable_stages,
+        unavailable_stages=unavailable_stages, alignment=alignment.to_dict(),
     )
     obs_counts: Counter[tuple[str, str]] = Counter()
     last_sync = time.perf_counter()
     current = session
 
     def frames() -> Iterator[Frame]:
-        yield from reader
+        yield from aligned(iter(reader), alignment)
 
     hook = on_frame
 
@@ -377,6 +398,7 @@ def perceive(
             kb.write_frame(current, result, pose_id=frame.pose_id, stamp_s=frame.stamp_s,
                            T_map_cam=frame.T_map_cam)
             summary.frames_read += 1
+            grower.add(frame)
         summary.add_steps({**result.timings_s, "kb_write_s": time.perf_counter() - t_write})
         for obs in result.observations:
             obs_counts[(obs.layer, obs.class_name)] += 1
@@ -399,7 +421,14 @@ def perceive(
     # with the `truth` or `log` detector the second core decodes while this one perceives.
     world, stats = run_stages(frames() if live else prefetch(frames()), stage_list, world, write,
                               look_ahead=bool(getattr(reader, "look_ahead", True)))
+    grower.store()
+    changes = session_changes(before, world.foreground.values(), current.id,
+                              seen_before=FreeBefore(grower.before))
+    kb.write_changes(current, changes)
+    summary.changes = dict(Counter(c.kind for c in changes))
     kb.end_session(current)
+    if options.keep_observations_s is not None:
+        summary.storage = compact(kb, keep_raw_s=options.keep_observations_s).to_dict()
     t0 = time.perf_counter()
     kb.sync_graph()
     summary.graph_sync_s += time.perf_counter() - t0
@@ -416,6 +445,22 @@ def perceive(
 
 
 ON_EXISTING = ("refuse", "replace", "again", "resume")
+
+
+def _environment_for(kb: KnowledgeBase, env_name: str | None, path: Path) -> Any:
+    """The place a log joins: ``env_name`` when given (created on first use); else the one
+    place the knowledge base holds (a lasting memory of one place needs no flag), or, in an
+    empty knowledge base, one named after the log folder."""
+    if env_name:
+        return kb.environment(env_name)
+    places = kb.environments()
+    if len(places) == 1:
+        return places[0]
+    if not places:
+        return kb.environment(path.stem or path.name)
+    names = ", ".join(sorted(e.name for e in places))
+    raise ConfigError(f"{kb.location} holds {len(places)} places ({names}); pass --env NAME to say which "
+                      "one this log shows (a new name starts another place)")
 
 
 def _check_log_fits(log: Any, stages: Sequence[Stage], path: Path) -> None:

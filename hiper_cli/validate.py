@@ -59,6 +59,8 @@ PIXELS = Range(1, 16384, integer=True)
 COUNT = Range(0, 1 << 31, integer=True)
 
 OPTION_RANGES: dict[str, Range] = {
+    # hiper sim --sessions N --changes K (several logs of one place)
+    "sessions": Range(1, 100, integer=True), "changes": Range(0, 100, integer=True),
     # camera and log flags (hiper info / perceive / convert)
     "fx_px": Range(0.0, 1e6, lo_open=True), "fy_px": Range(0.0, 1e6, lo_open=True),
     "cx_px": Range(0.0, 1e5), "cy_px": Range(0.0, 1e5),

@@ -70,6 +70,8 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     # live runs of perception into a knowledge base (a robot on rmw_zenoh)
     "live": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     "reanchor": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
+    # a session's log aligned to its place's map before perception (a part of the pipeline)
+    "session_align": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     # hiper bench: simulates, perceives, scores and runs tasks on top of all the library
     "bench": ("hiper_cli.serve", "hiper_cli.view", "hiper_cli.reanchor", *_UI),
     # the command line sits on top of everything

@@ -68,7 +68,7 @@ def test_export_import_round_trips_the_counts(kb_location, tmp_path, fmt):
 def test_json_export_schema(tmp_path):
     with _filled(str(tmp_path / "kb"), None) as kb:
         data = json_export(kb)
-    assert data["format"] == "hiper-kb-export" and data["version"] == 1
+    assert data["format"] == "hiper-kb-export" and data["version"] == 2
     assert [e["name"] for e in data["environments"]] == ["lab"]
     assert data["sessions"][0]["frames"] == 10
     assert data["observations"] == []  # only with observations=True
@@ -76,9 +76,10 @@ def test_json_export_schema(tmp_path):
     cups = sorted((i for i in data["instances"] if i["class"] == "cup"), key=lambda i: i["first_seen_s"])
     assert [c["observation_count"] for c in cups] == [4, 2]
     cup = cups[0]
-    assert set(cup) >= {"uuid", "layer", "class", "box", "first_seen_s", "last_seen_s", "state",
-                        "observation_count", "speed_mps"}
-    assert cup["layer"] == "foreground" and cup["state"] == "dynamic"
+    assert set(cup) >= {"uuid", "layer", "class", "box", "first_seen_s", "last_seen_s", "motion", "state",
+                        "valid_from_s", "valid_to_s", "observation_count", "speed_mps"}
+    assert cup["layer"] == "foreground" and cup["motion"] == "dynamic" and cup["state"] == "present"
+    assert data["changes"] == []
     # the camera moves 0.3 m and the cup 0.1 m in the camera frame per frame, at 10 Hz
     assert cup["speed_mps"] == pytest.approx(4.0, rel=1e-6)
     assert set(cup["box"]) == {"center_m", "extent_m", "R"}

@@ -201,7 +201,7 @@ def test_cli_perceive_info_check(tmp_path, probe_registry):
     log = _tum_log(tmp_path / "kitchen")
     kb = tmp_path / "scene.hiper"
     result = runner.invoke(app, ["perceive", str(log), "--kb", str(kb), "--stages", "probe",
-                                 "-o", "probe.track_frames=2", "--json"])
+                                 "-o", "probe.track_frames=2", "--keep-observations", "all", "--json"])
     assert result.exit_code == 0, result.output
     data = json.loads(result.output)
     assert data["frames_read"] == 6 and data["environment"] == "kitchen"

@@ -246,6 +246,26 @@ def _ask(ctx: ToolContext, args: dict[str, Any]) -> ToolResult:
     return ToolResult(ask(ctx.kb, args["question"], **frame, limit=args.get("limit")).to_dict())
 
 
+def _changes(ctx: ToolContext, args: dict[str, Any]) -> ToolResult:
+    from hiper_cli.query.engine import make_context
+    from hiper_cli.query.history import ChangeQuestion, answer_change
+
+    question = ChangeQuestion("changes", args.get("kind"), None, str(args.get("when") or "").strip().lower())
+    qctx = make_context(ctx.kb)
+    return ToolResult(answer_change(qctx, question, f"changes {question.kind or ''} {question.when}".strip())
+                      .to_dict())
+
+
+def _where_is(ctx: ToolContext, args: dict[str, Any]) -> ToolResult:
+    from hiper_cli.query.engine import make_context
+    from hiper_cli.query.history import answer_change, match
+
+    text = f"where is the {args['what']} now"
+    question = match(text)
+    assert question is not None
+    return ToolResult(answer_change(make_context(ctx.kb), question, text).to_dict())
+
+
 # ---- the registry ----------------------------------------------------------------------------
 
 _FIND_INPUT = s.obj({"what": WHAT, **FILTERS, "sort": SORT, "limit": LIMIT, **FRAME_INPUTS})
@@ -312,6 +332,19 @@ TOOLS: tuple[Tool, ...] = (
          s.obj({"question": s.STRING, "limit": LIMIT, **FRAME_INPUTS}, ("question",)),
          s.obj({"format": {"const": "hiper-query-answer"}, "kind": s.STRING, "text": s.STRING},
                ("format", "kind", "text"), strict=False), _ask),
+    Tool("changes", "What changed in the place over its sessions: objects added, removed (their place "
+         "seen empty) or moved (from, to), each with its session and time; parsed.changes lists them.",
+         s.obj({"kind": {"enum": ["added", "removed", "moved"],
+                         "description": "Only this kind (default all)."},
+                "when": {"type": "string", "description": "A time phrase: 'since 10:00', 'today', "
+                         "'since yesterday', 'in the last 5 minutes' (default: ever)."}}),
+         s.obj({"format": {"const": "hiper-query-answer"}, "kind": s.STRING, "text": s.STRING},
+               ("format", "kind", "text"), strict=False), _changes),
+    Tool("where_is", "Where the objects of a class are now (not those whose place was since seen empty), "
+         "the session and time each was last seen, and where it moved from.",
+         s.obj({"what": WHAT}, ("what",)),
+         s.obj({"format": {"const": "hiper-query-answer"}, "kind": s.STRING, "text": s.STRING},
+               ("format", "kind", "text"), strict=False), _where_is),
 )
 
 

@@ -36,6 +36,9 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
         f"(environment {safe_text(repr(data['environment']))}, "
         f"session {data['session_id']})"
     )
+    align = data.get("alignment")
+    if align and align["method"] == "registration":
+        out.print(f"aligned to the place's map: fitness {align['fitness']:.2f}, rmse {align['rmse_m']:.3f} m")
     again = data.get("earlier_sessions", {})
     if any(again.values()):
         out.print(f"earlier sessions' objects: {again['found_again']} found again "
@@ -260,6 +263,31 @@ def show_kb_info(out: Any, data: dict[str, Any]) -> None:
                          "yes" if s["ended_s"] else "no")
     if data["sessions"]:
         out.print(sessions)
+
+
+def show_sessions(out: Any, rows: list[dict[str, Any]]) -> None:
+    """``hiper kb sessions``: one row per session, with its log stamps and alignment."""
+    import datetime
+
+    from rich.table import Table
+
+    def clock(t: float | None) -> str:
+        stamp = datetime.datetime.fromtimestamp(t or 0.0, datetime.UTC)
+        return "" if t is None else stamp.strftime("%Y-%m-%d %H:%M")
+
+    def span(s: dict[str, Any]) -> str:
+        first, last = s["first_stamp_s"], s["last_stamp_s"]
+        return "" if first is None else f"{first:.1f}-{last:.1f}"
+
+    def aligned(a: dict[str, Any] | None) -> str:
+        return "" if a is None else f"{a['method']} (fitness {a['fitness']:.2f})"
+
+    table = Table("session", "place", "log", "frames", "stamps (s)", "started (UTC)", "alignment")
+    for s in rows:
+        table.add_row(str(s["id"]), s["environment"], s["log_path"], str(s["frames"]), span(s),
+                      clock(s["started_s"]) + ("" if s["ended_s"] else " (unfinished)"),
+                      aligned(s["alignment"]))
+    out.print(table if rows else "no sessions")
 
 
 def show_bench_size(out: Any, r: dict[str, Any]) -> None:

@@ -37,7 +37,15 @@ Replace = Annotated[bool, typer.Option(
     "--replace", help="Drop this log's earlier session (one transaction), then perceive it again.")]
 Again = Annotated[bool, typer.Option(
     "--again", help="Perceive a log the knowledge base holds already, as a new session.")]
-Env = Annotated[Text, typer.Option("--env", help="Environment name (default: the log folder's name).")]
+Env = Annotated[Text, typer.Option("--env", help=(
+    "Place (environment) name; default: the one place the knowledge base holds, or the log folder's "
+    "name in a new one. A new name starts another place."))]
+Align = Annotated[str, typer.Option("--align", help=(
+    "How the log's poses join the place's map frame: auto (register its background to the map; the "
+    "first session defines the frame), none (its poses are map poses) or FILE (a 4x4 T_map_log)."))]
+Keep = Annotated[str, typer.Option("--keep-observations", help=(
+    "Keep raw observations this long before the newest stamp ('10 minutes', '2 h'); older ones that add "
+    "nothing are summarised at the end of the session. 0 (default) summarises all; 'all' keeps all."))]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(
@@ -61,8 +69,9 @@ def perceive_command(
     detector: Detector = None, no_background_filter: NoFilter = False, classes: Classes = None,
     exclude_classes: Exclude = None, mapping_hz: MappingHz = None, option: Options = None,
     resume: Resume = False, replace: Replace = False, again: Again = False, env: Env = None,
-    view: View = False, timings: Timings = False, idle_timeout: IdleTimeout = None, queue: Queue = 1,
-    look_ahead: LookAhead = False, stats: Stats = False, as_json: bool = JSON_OPTION, *,
+    align: Align = "auto", keep_observations: Keep = "0", view: View = False, timings: Timings = False,
+    idle_timeout: IdleTimeout = None, queue: Queue = 1, look_ahead: LookAhead = False, stats: Stats = False,
+    as_json: bool = JSON_OPTION, *,
     log_options: LogOptions,
 ) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
@@ -88,7 +97,8 @@ def perceive_command(
         raise ConfigError("choose one of --resume, --replace and --again")
     options = PerceiveOptions.from_text(
         stages=stages, options=option or [], env_name=env, resume=resume,
-        on_existing="replace" if replace else "again" if again else "refuse",
+        on_existing="replace" if replace else "again" if again else "refuse", align=align,
+        keep_observations_s=keep_duration_s(keep_observations),
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
     from hiper_cli.commands._live import is_live, perceive_live_command
     from hiper_cli.errors import ConfigError
@@ -124,6 +134,24 @@ def perceive_command(
         show_perceive(out, summary.to_dict())
         if timings:
             show_steps(out, summary.to_dict()["steps"])
+
+
+def keep_duration_s(text: str) -> float | None:
+    """``--keep-observations``: seconds, or None for 'all' (no summarising)."""
+    if text.strip().lower() in ("all", "forever", "none"):
+        return None
+    try:
+        return max(0.0, float(text))
+    except ValueError:
+        pass
+    from hiper_cli.agent.times import resolve_span_s
+    from hiper_cli.errors import ConfigError, QueryError
+
+    try:
+        return resolve_span_s(text)
+    except QueryError as err:
+        raise ConfigError(f"--keep-observations {text!r}: expected a duration such as '10 minutes', "
+                          "'2 h', 0 or 'all'") from err
 
 
 def register(app: typer.Typer) -> None:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -15,7 +15,8 @@ HELP = (
     "plus ground truth in OUT/gt (instances, people tracks, per-pixel ids, noisy truth detections). A "
     "mapping phase without people comes first. --sensor records it as a real camera and pose "
     "source would (structured-light by default; ideal gives the exact render).\n\n"
-    "Example: hiper sim --world hospital --seconds 60 --seed 1 -o out/hospital"
+    "Example: hiper sim --world hospital --seconds 60 --seed 1 -o out/hospital\n\n"
+    "Several sessions of one place with changes between them: hiper sim --sessions 3 --changes 6 -o out/days"
 )
 Out = Annotated[Path, typer.Option("--out", "-o", help="Output folder (created; must be empty).")]
 
@@ -44,6 +45,10 @@ def sim(
         "structured-light", "--sensor", help="Sensor profile: structured-light, tof, stereo or ideal (exact "
         "depth with --depth-noise, exact poses); see docs/sensors.md."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Write into a non-empty output folder."),
+    sessions: int = typer.Option(
+        1, "--sessions", help="Logs of one place, each in its own odometry frame (OUT/session_K)."),
+    changes: int = typer.Option(
+        0, "--changes", help="Objects moved, removed or added between sessions (truth: OUT/changes.json)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     from hiper_cli.sim import SimConfig, simulate
@@ -54,6 +59,9 @@ def sim(
         false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression,
         sensor=sensor)
     screen = console()
+    if sessions > 1 or changes:
+        _sessions(world, sessions, changes, seconds, seed, out, config, overwrite, as_json)
+        return
     with frame_progress(f"sim {safe_text(world)}", screen, enabled=not as_json) as bar:
         result = simulate(world, seconds, seed, out, config, overwrite=overwrite,
                           progress=bar.update if bar else None)
@@ -67,6 +75,24 @@ def sim(
         f"{result.sensor} sensor; "
         f"{result.frames_per_s:.1f} frames/s"
     )
+
+
+def _sessions(world: str, sessions: int, changes: int, seconds: float, seed: int, out: Path, config: Any,
+              overwrite: bool, as_json: bool) -> None:
+    """``--sessions N --changes K``: N logs of one place (``hiper_cli.sim.sessions``)."""
+    from hiper_cli.sim.sessions import simulate_sessions
+
+    screen = console()
+    with frame_progress(f"sim {world} x{sessions}", screen, enabled=not as_json) as bar:
+        result = simulate_sessions(world, sessions, changes, seconds, seed, out, config, overwrite=overwrite,
+                                   progress=bar.update if bar else None)
+    if as_json:
+        print_json(result.to_dict())
+        return
+    kinds = ", ".join(f"{sum(c['kind'] == k for c in result.changes)} {k}"
+                      for k in ("moved", "removed", "added"))
+    screen.print(f"[green]wrote[/] {result.out}: {sessions} sessions of {world} (seed {seed}) in their own "
+                 f"frames; changes: {kinds} (truth: {result.out / 'changes.json'})")
 
 
 def register(app: HiperTyper) -> None:

@@ -403,7 +403,8 @@ class DocumentStore(ChangeFeed, Lookups):
             stored = doc
             if doc["type"] == "instance":  # the observation list lives in ``links`` only
                 stored = {k: v for k, v in doc.items() if k != "observation_uuids"}
-                stored["observation_count"] = len(doc.get("observation_uuids", []))
+                stored["observation_count"] = len(doc.get("observation_uuids", [])) + int(
+                    (doc.get("data") or {}).get("observations_summarised", 0))  # see compact.py
                 stored, apart = self._traj.split(stored)  # long trajectories: see trajectories.py
                 trajectories.append((doc["uuid"], apart))
             rows.append((doc["uuid"], doc["type"], doc.get("layer"), doc.get("class"), stamp,

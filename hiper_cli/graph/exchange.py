@@ -30,6 +30,7 @@ import pyoxigraph as ox
 
 from hiper_cli.errors import DataError, KnowledgeBaseError
 from hiper_cli.files import atomic_output, os_error, refuse_inside
+from hiper_cli.graph.history import validity
 from hiper_cli.graph.import_check import check_documents, check_json_shape, check_unique, read_json_export
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, doc_quads, h, layer_graph, link_quad, speed_mps
@@ -40,7 +41,8 @@ __all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_exp
 EXPORT_FORMATS = ("turtle", "nquads", "jsonld", "graphml", "json")
 _SUFFIX = {".ttl": "turtle", ".nq": "nquads", ".jsonld": "jsonld", ".graphml": "graphml", ".json": "json"}
 JSON_FORMAT_NAME = "hiper-kb-export"
-JSON_FORMAT_VERSION = 1
+JSON_FORMAT_VERSION = 2  # 2: instances' "state" is present | removed, their motion is "motion"
+CHANGE_FIELDS = ("uuid", "kind", "class", "instance_uuid", "session", "stamp_s", "from_m", "to_m")
 
 
 def guess_format(path: Path) -> str:
@@ -220,7 +222,8 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
             "box": {"center_m": box["center_m"], "extent_m": box["extent_m"], "R": box.get("R")},
             "plane": _plane(d),
             "frame": d.get("frame_id", "map"),
-            "first_seen_s": d["first_seen_s"], "last_seen_s": d["last_seen_s"], "state": d.get("state"),
+            "first_seen_s": d["first_seen_s"], "last_seen_s": d["last_seen_s"], "motion": d.get("state"),
+            **validity(d),  # valid_from_s, valid_to_s, state: present | removed
             "confidence": d.get("confidence"),
             "observation_count": len(d.get("observation_uuids", [])),
             "speed_mps": speed_mps(d),
@@ -238,6 +241,7 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
         "sessions": [s.to_dict() for s in docs.sessions()],
         "instances": instances,
         "analyses": [{k: v for k, v in d.items() if k != "type"} for d in docs.find(type="analysis")],
+        "changes": [{k: d.get(k) for k in CHANGE_FIELDS} for d in docs.find(type="change")],
         "observations": docs.find(type="observation") if observations else [],
     }
 
@@ -260,7 +264,8 @@ def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]
         out.append((f"instances[{k}]", {
             "uuid": i.get("uuid"), "type": "instance", "layer": i.get("layer"), "class": i.get("class"),
             "box": box, "first_seen_s": i.get("first_seen_s"), "last_seen_s": i.get("last_seen_s"),
-            "state": i.get("state") or "static",
+            "state": i.get("motion") or (i.get("state") if i.get("state") in ("static", "dynamic") else None)
+            or "static",
             "confidence": 1.0 if i.get("confidence") is None else i["confidence"],
             "observation_uuids": i.get("observation_uuids", []), "frame_id": i.get("frame", "map"),
             "data": {**(i.get("data") or {}),
@@ -268,6 +273,8 @@ def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]
         }))
     for k, a in enumerate(data.get("analyses", [])):
         out.append((f"analyses[{k}]", {**a, "type": "analysis"}))
+    for k, c in enumerate(data.get("changes", [])):
+        out.append((f"changes[{k}]", {**c, "type": "change", "layer": "foreground"}))
     live = {d["uuid"] for _, d in out if d["type"] == "instance"}
     for k, o in enumerate(data.get("observations", [])):
         if o.get("instance_uuid") not in live:  # its instance was merged away before the export

@@ -26,7 +26,7 @@ MAX_DEPTH = 64  # an export nests a few levels (instances[k].box.R[i][j]); more 
 UUID_RE = re.compile(r"^[0-9a-fA-F]{8}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{12}$")
 PERCEIVED_LAYERS = ("background", "foreground")
 STATES = ("static", "dynamic")
-SECTIONS = ("environments", "sessions", "instances", "analyses", "observations")
+SECTIONS = ("environments", "sessions", "instances", "analyses", "changes", "observations")
 MAX_ABS = 1e12  # larger coordinates or stamps are taken for damage
 
 
@@ -198,8 +198,26 @@ def _check(doc: dict[str, Any]) -> None:
             _number(doc, key)
         if not isinstance(doc.get("values"), dict):
             raise _Bad("values", "is not an object")
+    elif kind == "change":
+        _change(doc)
     else:
-        raise _Bad("type", f"is {kind!r}, expected environment, instance, observation or analysis")
+        raise _Bad("type", f"is {kind!r}, expected environment, instance, observation, analysis or change")
+
+
+def _change(doc: dict[str, Any]) -> None:
+    """A change event (``history.py``): its kind, instance, session, stamp and positions."""
+    if doc.get("kind") not in ("added", "removed", "moved"):
+        raise _Bad("kind", f"is {doc.get('kind')!r}, expected added, removed or moved")
+    _text(doc, "class")
+    _uuid(doc, "instance_uuid")
+    _number(doc, "stamp_s")
+    if not isinstance(doc.get("session"), int) or isinstance(doc.get("session"), bool):
+        raise _Bad("session", f"is {doc.get('session')!r}, expected a session id")
+    for key in ("from_m", "to_m"):
+        value = doc.get(key)
+        if value is not None and not (isinstance(value, list) and len(value) == 3
+                                      and all(isinstance(v, int | float) for v in value)):
+            raise _Bad(key, f"is {value!r}, expected null or [x, y, z] in metres")
 
 
 def _uuid(doc: dict[str, Any], key: str) -> None:

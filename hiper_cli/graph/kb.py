@@ -247,6 +247,43 @@ class KnowledgeBase(KbReads):
         assert restarted is not None
         return restarted
 
+    def record_alignment(self, session: Session, alignment: Any) -> None:
+        """The transform that carried ``session``'s log into the map frame (``sessions.py``)."""
+        from hiper_cli.graph.sessions import record_alignment
+
+        with self.docs.transaction():
+            record_alignment(self.docs, session.id, alignment)
+
+    def map_cloud(self, env: Environment) -> Any:
+        """The place's background cloud (map frame, ``mapcloud.py``), or None before its first session."""
+        from hiper_cli.graph.mapcloud import load_map_cloud
+
+        return load_map_cloud(self.docs, env.uuid)
+
+    def store_map_cloud(self, env: Environment, points_m: Any) -> int:
+        from hiper_cli.graph.mapcloud import store_map_cloud
+
+        with self.docs.transaction():
+            return store_map_cloud(self.docs, env.uuid, points_m)
+
+    def write_changes(self, session: Session, changes: Sequence[Any]) -> None:
+        """Store a session's change events (``history.Change``) in one transaction."""
+        if changes:
+            with self.docs.transaction():
+                self.docs.put_many([(c.to_dict(), None) for c in changes], session_id=session.id,
+                                   env_uuid=session.env_uuid)
+
+    def instance_sessions(self, uuid: str) -> list[int]:
+        """The sessions whose observations an instance holds."""
+        rows = self.docs._db.execute(
+            "SELECT DISTINCT d.session_id FROM all_links l JOIN docs d ON d.uuid = l.observation_uuid "
+            "WHERE l.instance_uuid = ? AND d.session_id IS NOT NULL", (uuid,))
+        return sorted(int(s) for (s,) in rows)
+
+    def changes(self, env: Environment | None = None) -> list[dict[str, Any]]:
+        """Every change event (documents of type ``change``), in stamp order."""
+        return self.docs.find(type="change", env_uuid=None if env is None else env.uuid)
+
     def end_session(self, session: Session) -> None:
         with self.docs.transaction():
             self.docs.end_session(session.id)
@@ -438,6 +475,13 @@ class KnowledgeBase(KbReads):
             world.layer(inst.layer)[inst.uuid] = inst
         world.analyses = [Analysis.from_dict(d) for d in self.docs.find(type="analysis")]
         return world
+
+    def session_records(self) -> list[dict[str, Any]]:
+        """Every session with its place, log stamps and alignment (``sessions.session_record``)."""
+        from hiper_cli.graph.sessions import session_record
+
+        names = {e.uuid: e.name for e in self.environments()}
+        return [session_record(self.docs, s, names) for s in self.docs.sessions()]
 
     def observation(self, uuid: str) -> Observation | None:
         doc = self.docs.get(uuid)

@@ -66,6 +66,7 @@ OBSERVATION_BATCH_S = 60.0
 LAYER_OF_TYPE = {"environment": "environment", "session": "environment", "analysis": "map"}
 
 WAS_DERIVED_FROM = ox.NamedNode(PROV + "wasDerivedFrom")
+PROV_USED = ox.NamedNode(PROV + "used")
 _OBSERVATION = ox.NamedNode(HIPER + "Observation")
 
 
@@ -152,8 +153,20 @@ def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[
         vacated = (doc.get("data") or {}).get("vacated_s")
         if vacated is not None:
             t.append((h("vacatedS"), _dbl(vacated)))
+            t.append((h("validToS"), _dbl(vacated)))
+        t += [(h("validFromS"), _dbl(doc["first_seen_s"])),
+              (h("presence"), ox.Literal("present" if vacated is None else "removed"))]
         if doc.get("env_uuid"):
             t.append((h("inEnvironment"), node(doc["env_uuid"])))
+    elif kind == "change":  # an event (``history.py``): PROV-O activity over the instance
+        t += [(RDF_TYPE, h("Change")), (h("uuid"), ox.Literal(doc["uuid"])),
+              (h("changeKind"), ox.Literal(doc["kind"])), (h("className"), ox.Literal(doc["class"])),
+              (PROV_USED, node(doc["instance_uuid"])),
+              (h("inSession"), session_node(kb_id, int(doc["session"]))),
+              (h("stampS"), _dbl(doc["stamp_s"]))]
+        for name, key in (("fromM", "from_m"), ("toM", "to_m")):
+            if doc.get(key) is not None:
+                t.append((h(name), _vec(doc[key])))
     elif kind == "analysis":
         t += [(RDF_TYPE, h("Analysis")), (h("uuid"), ox.Literal(doc["uuid"])), (h("layer"), h(layer)),
               (h("kind"), ox.Literal(doc["kind"])), (h("className"), ox.Literal(doc["class"])),
@@ -216,4 +229,9 @@ def session_quads(kb_id: str, session: dict[str, Any]) -> list[ox.Quad]:
     ]
     if session.get("ended_s") is not None:
         t.append((h("endedS"), _dbl(session["ended_s"])))
+    if session.get("alignment") is not None:  # the transform into the place's map frame
+        align = session["alignment"]
+        t += [(h("alignmentJson"), ox.Literal(json.dumps(align["T_map_log"]))),
+              (h("alignmentMethod"), ox.Literal(align["method"])),
+              (h("alignmentFitness"), _dbl(align["fitness"]))]
     return [ox.Quad(s, p, o, g) for p, o in t]

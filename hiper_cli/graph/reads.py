@@ -81,7 +81,15 @@ class KbReads:
         return self.docs.observation_links(instance_uuids)
 
     def observation_stamps_of(self, instance_uuid: str) -> list[float]:
-        return self.docs.observation_stamps(instance_uuid)
+        """The stamps of an instance's observations, with those its summarised stretches in
+        view stand for (``compact.py``)."""
+        from hiper_cli.graph.compact import VIEW_SPANS, span_stamps
+
+        stamps = self.docs.observation_stamps(instance_uuid)
+        doc = self.docs.get(instance_uuid)
+        if doc is not None and (doc.get("data") or {}).get(VIEW_SPANS):
+            stamps = sorted([*stamps, *span_stamps(doc)])
+        return stamps
 
     def observations_near(
         self, lo: Sequence[float], hi: Sequence[float], class_name: str | None = None

@@ -324,6 +324,12 @@ class LocalGraph:
         if not self.read_only:
             self._store.flush()
 
+    def optimize(self) -> None:
+        """Compact the on-disk store (after many deletes, e.g. ``kb compact``)."""
+        if not self.read_only:
+            self._store.optimize()
+            self._store.flush()
+
     def close(self) -> None:
         self.flush()
         del self._store

@@ -39,7 +39,7 @@ from hiper_cli.graph.ontology import (
 )
 
 if TYPE_CHECKING:
-    from hiper_cli.graph.documents import DocumentStore
+    from hiper_cli.graph.documents import DocumentStore, Session
     from hiper_cli.graph.scenegraph import LocalGraph, SparqlGraph
 
 __all__ = ["SyncReport", "sync_graph"]
@@ -112,7 +112,7 @@ def sync_graph(
     sessions = docs.sessions(after_seq=after, upto_seq=upto)
     if sessions:
         graph.write(kb_id, [session_node(kb_id, s.id).value for s in sessions], [],
-                    [q for s in sessions for q in session_quads(kb_id, s.to_dict())])
+                    [q for s in sessions for q in session_quads(kb_id, _with_alignment(docs, s))])
     report.sessions = len(sessions)
     graph.set_synced_seq(kb_id, upto)
     # RocksDB keeps one write buffer per index in memory until flushed: flushing after each
@@ -148,3 +148,11 @@ def _sync_batches(docs: DocumentStore, graph: LocalGraph | SparqlGraph, kb_id: s
     graph.write(kb_id, refresh, [], quads)
     return n
 
+
+
+def _with_alignment(docs: DocumentStore, session: Session) -> dict[str, Any]:
+    """The session's fields plus the transform that aligned it (``sessions.py``), if any."""
+    from hiper_cli.graph.sessions import alignment_of
+
+    align = alignment_of(docs, session.id)
+    return session.to_dict() | ({} if align is None else {"alignment": align.to_dict()})

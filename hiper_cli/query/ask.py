@@ -11,7 +11,7 @@ import numpy as np
 
 from hiper_cli.errors import QueryError
 from hiper_cli.graph.kb import KnowledgeBase
-from hiper_cli.query import engine
+from hiper_cli.query import engine, history
 from hiper_cli.query import geometry as geo
 from hiper_cli.query.engine import Context, make_context
 from hiper_cli.query.grammar import ParsedQuery, parse, with_limit
@@ -153,6 +153,9 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
+    change = history.match(text)  # questions about change between sessions: query/history.py
+    if change is not None:
+        return history.answer_change(ctx, change, text)
     envs = kb.environments()
     whole = [envs[0].name] if len(envs) == 1 else []  # "in the house": the KB's one place
     parsed = with_limit(parse(text, now_s=ctx.now_s, config=ctx.config, whole_place=whole), limit)

@@ -139,8 +139,12 @@ def simulate(
     *,
     overwrite: bool = False,
     progress: Callable[[int, int], None] | None = None,
+    T_log_map: np.ndarray | None = None,
 ) -> SimResult:
-    """Write a simulated log of ``seconds`` to ``out``; the same arguments give identical files."""
+    """Write a simulated log of ``seconds`` to ``out``; the same arguments give identical files.
+
+    ``T_log_map``: the log's poses are written in this frame (a session's own odometry frame,
+    ``hiper sim --sessions``); the truth in ``gt/`` stays in the world's map frame."""
     import cv2
 
     from hiper_cli.perceive.logs import TumWriter
@@ -258,7 +262,7 @@ def simulate(
                 rgb=image.rgb,
                 depth_m=image.depth_m,
                 camera=renderer.camera,
-                T_map_cam=T,
+                T_map_cam=T if T_log_map is None else T_log_map @ T,
                 pose_id=k,
                 source=f"sim:{w.name}:{k}",
             ))

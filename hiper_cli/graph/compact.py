@@ -1,0 +1,270 @@
+"""Bounded storage: observations that add nothing are summarised, debris is not kept.
+
+A memory meant for months cannot append every sighting of a chair that stands where it
+stood: at 15-30 Hz that is gigabytes a day whatever changed. ``compact`` keeps, per static
+instance, the observations that say something:
+
+- the first of each session;
+- every observation that gives a class none kept gave (class evidence);
+- every observation of a foreground object whose map box centre lies ``MOVE_M`` from every
+  one kept (the object somewhere new; a plane's pieces lie all along it, and its instance has
+  fused their outline);
+
+and summarises the others into the instance's stretches in view (``data.view_spans``: first
+and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
+them, ``span_stamps``);
+
+and drops the others, counting them in the instance (``data.observations_summarised``: its
+``observation_count`` stays what was seen). Observations of a session whose stamps fall inside
+a stretch already covered by earlier sessions of a found-again object (the same log perceived
+again) add nothing either. Observations no instance holds (debris that never became an
+object, tracks merged away) are dropped. Movers keep every observation, as a stub: their
+sightings are their trajectory. Only observations older than ``keep_raw_s`` before the newest stamp are
+touched (``--keep-observations``).
+
+The graph is rebuilt from the documents afterwards (observation batches change); queries over
+instances, events and trajectories answer the same. What is dropped cannot be re-anchored to an
+optimised trajectory later (``hiper reanchor``): keep the raw observations of the window a loop
+closure may still change with ``--keep-observations``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import defaultdict
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from hiper_cli.graph.codec import dumps, loads
+
+if TYPE_CHECKING:
+    from hiper_cli.graph.kb import KnowledgeBase
+
+__all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps"]
+
+STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
+MOVE_M = 0.25  # an observation this far from every one kept shows the object somewhere new
+SUMMARISED = "observations_summarised"
+VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
+
+
+@dataclass
+class CompactReport:
+    observations_before: int = 0
+    debris_dropped: int = 0
+    summarised: int = 0
+    observations_after: int = 0
+    bytes_before: int = 0
+    bytes_after: int = 0
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+Row = tuple[int, str, float, str | None, int | None, float, float]  # id, uuid, stamp, class, session, x, y
+
+
+def _keep(rows: list[Row], covered: list[tuple[float, float]], keep_after_s: float,
+          background: bool = False) -> tuple[set[int], list[tuple[float, float]]]:
+    """Ids of the observations of one static instance (one session) kept, and the stretches in
+    view the others are summarised into (module docstring). ``covered``: stretches earlier
+    sessions' observations of the instance span; one inside them adds nothing."""
+    keep: set[int] = set()
+    spans: list[tuple[float, float]] = []
+    classes: set[str | None] = set()  # the classes the kept observations give
+    places: list[tuple[float, float]] = []  # where the kept observations lie
+    for row in rows:
+        oid, _, stamp, cls, _, x, y = row
+        if spans and stamp - spans[-1][1] <= STRETCH_GAP_S:
+            spans[-1] = (spans[-1][0], stamp)
+        else:
+            spans.append((stamp, stamp))
+        # a plane's pieces lie all along it: its instance has fused their outline already
+        new_place = not background and all((x - px) ** 2 + (y - py) ** 2 > MOVE_M ** 2 for px, py in places)
+        if (stamp >= keep_after_s or cls not in classes
+                or (new_place and not any(a <= stamp <= b for a, b in covered))):
+            keep.add(oid)
+            classes.add(cls)
+            places.append((x, y))
+    return keep, spans
+
+
+def merge_spans(spans: Iterable[Sequence[float]]) -> list[list[float]]:
+    """Stretches in view, sorted and joined where they overlap or lie ``STRETCH_GAP_S`` apart."""
+    out: list[list[float]] = []
+    for a, b in sorted((float(a), float(b)) for a, b in spans):
+        if out and a - out[-1][1] <= STRETCH_GAP_S:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return out
+
+
+def _covered(row: Row, stretches: dict[int | None, list[tuple[float, float]]]) -> bool:
+    """Whether an earlier session saw the instance at this observation's stamp."""
+    return any(a <= row[2] <= b for other, spans in stretches.items()
+               if other != row[4] and (other or 0) < (row[4] or 0) for a, b in spans)
+
+
+def _stretches(rows: Iterable[Row]) -> dict[int | None, list[tuple[float, float]]]:
+    """Per session: the stretches in view its observations of one instance span."""
+    out: dict[int | None, list[tuple[float, float]]] = defaultdict(list)
+    by_session: dict[int | None, list[float]] = defaultdict(list)
+    for row in rows:
+        by_session[row[4]].append(row[2])
+    for session, stamps in by_session.items():
+        stamps.sort()
+        start = prev = stamps[0]
+        for s in stamps[1:]:
+            if s - prev > STRETCH_GAP_S:
+                out[session].append((start, prev))
+                start = s
+            prev = s
+        out[session].append((start, prev))
+    return out
+
+
+def _instances(db: Any) -> dict[str, dict[str, Any]]:
+    return {u: loads(body) for u, body in db.execute("SELECT uuid, body FROM docs WHERE type = 'instance'")}
+
+
+def _observation_rows(db: Any) -> dict[str, list[Row]]:
+    """Per instance, its observations (id, uuid, stamp, class, session, map x, y), oldest first."""
+    cursor = db.execute(
+        "SELECT d.id, d.uuid, d.stamp_s, d.class, d.session_id, l.instance_uuid, "
+        "COALESCE(c.min_x + c.max_x, n.min_x + n.max_x, 0) / 2.0, "
+        "COALESCE(c.min_y + c.max_y, n.min_y + n.max_y, 0) / 2.0 "
+        "FROM all_links l JOIN docs d ON d.uuid = l.observation_uuid "
+        "LEFT JOIN obs_cells c ON c.id = d.id LEFT JOIN obs_cells_new n ON n.id = d.id "
+        "ORDER BY l.instance_uuid, d.stamp_s, d.id")
+    out: dict[str, list[Row]] = defaultdict(list)
+    seen: set[tuple[str, int]] = set()
+    for oid, uuid, stamp, cls, session, inst, x, y in cursor:
+        if (inst, oid) not in seen:  # obs_cells may hold a row per cell
+            seen.add((inst, oid))
+            out[inst].append((int(oid), str(uuid), float(stamp or 0.0), cls, session, float(x), float(y)))
+    return out
+
+
+def _drop(db: Any, ids: list[int]) -> None:
+    """Delete observation documents by row id, with their index rows and links."""
+    db.execute("CREATE TEMP TABLE IF NOT EXISTS drop_ids (id INTEGER PRIMARY KEY, uuid TEXT)")
+    db.execute("DELETE FROM drop_ids")
+    db.executemany("INSERT OR IGNORE INTO drop_ids (id) VALUES (?)", [(i,) for i in ids])
+    db.execute("UPDATE drop_ids SET uuid = (SELECT uuid FROM docs WHERE docs.id = drop_ids.id)")
+    db.execute("CREATE INDEX IF NOT EXISTS temp.drop_ids_uuid ON drop_ids (uuid)")
+    for table in ("obs_cells", "obs_cells_new", "docs_box"):
+        db.execute(f"DELETE FROM {table} WHERE id IN (SELECT id FROM drop_ids)")
+    for table in ("links", "links_new"):
+        db.execute(f"DELETE FROM {table} WHERE observation_uuid IN (SELECT uuid FROM drop_ids)")
+    db.execute("DELETE FROM docs WHERE id IN (SELECT id FROM drop_ids)")
+
+
+def _stub(db: Any, ids: list[int]) -> None:
+    """Observations kept for their stamp and place only: their low-level data goes."""
+    for k in range(0, len(ids), 900):
+        chunk = ids[k:k + 900]
+        rows = db.execute(f"SELECT id, body FROM docs WHERE id IN ({','.join('?' * len(chunk))})", chunk)
+        updates = []
+        for oid, body in rows.fetchall():
+            doc = loads(body)
+            if doc.get("data"):
+                doc["data"] = {"summary": True}
+                updates.append((dumps(doc), oid))
+        db.executemany("UPDATE docs SET body = ? WHERE id = ?", updates)
+
+
+def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) -> CompactReport:
+    """Summarise the observations of ``kb`` (module docstring); one transaction, then the
+    graph is rebuilt and (``vacuum``) the file shrunk."""
+    started = time.perf_counter()
+    report = CompactReport(bytes_before=_bytes(kb))
+    docs = kb.docs
+    db = docs._db
+    report.observations_before = int(docs._scalar("SELECT COUNT(*) FROM docs WHERE type = 'observation'"))
+    newest = float(docs._scalar("SELECT MAX(stamp_s) FROM docs WHERE type = 'observation'") or 0.0)
+    keep_after_s = newest - keep_raw_s if keep_raw_s > 0 else float("inf")
+    with docs.transaction() as seq:
+        debris = [int(i) for (i,) in db.execute(  # NOT IN: one index over the links, not a scan each
+            "SELECT d.id FROM docs d WHERE d.type = 'observation' AND d.stamp_s < ? AND d.uuid NOT IN "
+            "(SELECT observation_uuid FROM all_links)", (keep_after_s,))]
+        instances = _instances(db)
+        drop: list[int] = []
+        summarised: dict[str, int] = {}
+        stub_ids: list[int] = []
+        spans: dict[str, list[tuple[float, float]]] = {}
+        for inst, rows in _observation_rows(db).items():
+            stretches = _stretches(rows)
+            if inst not in instances:
+                continue
+            if instances[inst].get("state", "static") != "static":  # a mover: stubs, but not twice
+                again = {r[0] for r in rows if r[2] < keep_after_s and _covered(r, stretches)}
+                stub_ids += [r[0] for r in rows if r[2] < keep_after_s and r[0] not in again]
+                if again:
+                    drop += sorted(again)
+                    summarised[inst] = len(again)
+                continue
+            keep: set[int] = set()
+            for session in {r[4] for r in rows}:
+                mine = [r for r in rows if r[4] == session]
+                covered = [s for other, spans_ in stretches.items() if other != session
+                           and (other or 0) < (session or 0) for s in spans_]
+                kept, session_spans = _keep(mine, covered, keep_after_s,
+                                            instances[inst].get("layer") == "background")
+                keep |= kept
+                spans.setdefault(inst, []).extend(session_spans)
+            gone = [r[0] for r in rows if r[0] not in keep]
+            if gone:
+                drop += gone
+                summarised[inst] = len(gone)
+        _stub(db, stub_ids)
+        _drop(db, debris + drop)
+        for inst, n in summarised.items():
+            doc = instances[inst]
+            data = doc.setdefault("data", {})
+            data[SUMMARISED] = int(data.get(SUMMARISED, 0)) + n
+            if inst in spans:
+                data[VIEW_SPANS] = merge_spans([*data.get(VIEW_SPANS, []), *spans[inst]])
+            db.execute("UPDATE docs SET body = ?, seq = ? WHERE uuid = ?", (dumps(doc), seq, inst))
+        report.debris_dropped, report.summarised = len(debris), len(drop)
+    docs._link_counts.clear()
+    docs._pending_link_counts.clear()
+    docs._staged = -1
+    kb.sync_graph(rebuild=True)
+    if vacuum:
+        db.execute("VACUUM")
+        db.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+        optimize = getattr(kb.graph, "optimize", None)  # a local graph store: shrink it too
+        if optimize is not None:
+            optimize()
+            kb.detach_graph()  # reopening lets the store drop its obsolete write-ahead logs
+            kb.attach_graph()
+    report.observations_after = int(docs._scalar("SELECT COUNT(*) FROM docs WHERE type = 'observation'"))
+    report.bytes_after = _bytes(kb)
+    report.seconds = time.perf_counter() - started
+    return report
+
+
+def _bytes(kb: KnowledgeBase) -> int:
+    """The documents' bytes on disk, write-ahead log included."""
+    path = kb.docs.path
+    wal = path.with_name(path.name + "-wal")
+    return path.stat().st_size + (wal.stat().st_size if wal.exists() else 0)
+
+
+def span_stamps(doc: dict[str, Any], step_s: float = 0.5) -> list[float]:
+    """Stamps standing for an instance's summarised stretches in view (``VIEW_SPANS``): each
+    stretch from its first to its last stamp in ``step_s`` steps, so "time in view" over them
+    is what it was over the observations they summarise."""
+    out: list[float] = []
+    for a, b in (doc.get("data") or {}).get(VIEW_SPANS, []):
+        n = max(1, int((b - a) / step_s))
+        out += [a + (b - a) * k / n for k in range(n + 1)]
+    return out
+
+
+def summarised_count(doc: dict[str, Any]) -> int:
+    """Observations of an instance summarised away (added to its link count)."""
+    return int((doc.get("data") or {}).get(SUMMARISED, 0))

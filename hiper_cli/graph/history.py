@@ -1,0 +1,145 @@
+"""Changes as data: what a session changed about the place, as events.
+
+At the end of a session the static objects of the place as they stood before it are compared
+with what they are after it (re-identification and the empty-place test have run: see
+``perceive/foreground/reidentify.py`` and ``vacated.py``):
+
+- **removed**: an object present before whose place this session saw empty (``vacated_s`` set
+  now): negative evidence, from views that would have shown it. An object this session did not
+  see keeps its state: unseen is not removed.
+- **moved**: an object found again whose centre is more than ``MOVED_M`` from where it was.
+- **added**: a new object where the earlier sessions saw free space (``FreeBefore``: their
+  background cloud holds the floor or table under it and nothing in its box); a new object in
+  a corner no session saw, or where something unrecognised stood, is not an addition.
+
+Each change is a document of type ``change`` (``Change.to_dict``), written with the session;
+the graph holds it as a ``hiper:Change`` (a ``prov:Activity``) that ``prov:used`` the
+instance. An instance's validity follows from its fields: valid from its first sighting, to
+``vacated_s`` when its place was seen empty (``validity``).
+"""
+
+from __future__ import annotations
+
+import uuid as _uuid
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.model import Instance
+
+__all__ = ["CHANGE_KINDS", "MOVED_M", "Change", "FreeBefore", "Placed", "session_changes", "snapshot",
+           "validity"]
+
+CHANGE_KINDS = ("added", "removed", "moved")
+MOVED_M = 0.5  # a static object found again this far (footprint centres) from where it was moved
+NOT_CHANGING = frozenset({"unknown", "person"})  # debris and walkers make no change events
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A static object as it stood before the session."""
+
+    uuid: str
+    class_name: str
+    center_m: tuple[float, float, float]
+    vacated_s: float | None
+
+
+@dataclass(frozen=True)
+class Change:
+    kind: str
+    class_name: str
+    instance_uuid: str
+    session_id: int
+    stamp_s: float
+    from_m: list[float] | None
+    to_m: list[float] | None
+    uuid: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"uuid": self.uuid or str(_uuid.uuid4()), "type": "change", "layer": "foreground",
+                "kind": self.kind, "class": self.class_name, "instance_uuid": self.instance_uuid,
+                "session": self.session_id, "stamp_s": self.stamp_s, "from_m": self.from_m, "to_m": self.to_m}
+
+
+def validity(doc: dict[str, Any]) -> dict[str, Any]:
+    """An instance document's validity: ``valid_from_s``, ``valid_to_s`` and ``state``
+    (present | removed)."""
+    vacated = (doc.get("data") or {}).get("vacated_s")
+    return {"valid_from_s": doc.get("first_seen_s"), "valid_to_s": vacated,
+            "state": "present" if vacated is None else "removed"}
+
+
+def _changes_here(inst: Instance) -> bool:
+    return inst.layer == "foreground" and inst.state == "static" and inst.class_name not in NOT_CHANGING
+
+
+def _centre(inst: Instance) -> tuple[float, float, float]:
+    c = inst.box.center_m
+    return (round(float(c[0]), 3), round(float(c[1]), 3), round(float(c[2]), 3))
+
+
+def snapshot(instances: Iterable[Instance]) -> dict[str, Placed]:
+    """The static objects that can change, as they stand now (copied: the stages fold into
+    the instances in place)."""
+    return {i.uuid: Placed(i.uuid, i.class_name, _centre(i), i.data.get("vacated_s"))
+            for i in instances if _changes_here(i)}
+
+
+def session_changes(
+    before: dict[str, Placed],
+    after: Iterable[Instance],
+    session_id: int,
+    *,
+    seen_before: Callable[[Instance], bool],
+) -> list[Change]:
+    """The change events of one session (see the module docstring), in stamp order."""
+    out: list[Change] = []
+    for inst in after:
+        if not _changes_here(inst):
+            continue
+        now = _centre(inst)
+        old = before.get(inst.uuid)
+        vacated = inst.data.get("vacated_s")
+        if old is None:
+            if before and vacated is None and seen_before(inst):
+                out.append(Change("added", inst.class_name, inst.uuid, session_id, float(inst.first_seen_s),
+                                  None, list(now)))
+        elif old.vacated_s is None and vacated is not None:
+            out.append(Change("removed", inst.class_name, inst.uuid, session_id, float(vacated),
+                              list(old.center_m), None))
+        elif vacated is None and float(np.hypot(now[0] - old.center_m[0],
+                                                now[1] - old.center_m[1])) > MOVED_M:
+            out.append(Change("moved", inst.class_name, inst.uuid, session_id, float(inst.last_seen_s),
+                              list(old.center_m), list(now)))
+    return sorted(out, key=lambda c: (c.stamp_s, c.kind, c.instance_uuid))
+
+
+class FreeBefore:
+    """Whether the place's earlier sessions saw an object's space free: their background cloud
+    (``mapcloud.py``) holds the support under its footprint (``SUPPORT_POINTS`` points within
+    ``SUPPORT_M`` of its box's bottom) and hardly anything inside its box (at most
+    ``INSIDE_POINTS`` above the support band: ``SUPPORT_M``, or 30 % of a small object's
+    height). A space never seen, or one where something stood that was not recognised then,
+    is not free: an object found there is not an addition."""
+
+    SUPPORT_M = 0.08
+    SUPPORT_POINTS = 2
+    INSIDE_POINTS = 1
+
+    def __init__(self, points_m: np.ndarray | None) -> None:
+        self.points = np.zeros((0, 3)) if points_m is None else np.asarray(points_m, dtype=np.float64)
+
+    def __call__(self, inst: Instance) -> bool:
+        if len(self.points) == 0:
+            return False
+        lo, hi = inst.box.aabb()
+        p = self.points
+        over = (p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0]) & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1])
+        z = p[over, 2]
+        margin = min(self.SUPPORT_M, 0.3 * float(hi[2] - lo[2]))  # a cup is barely taller than this
+        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
+        inside = int(((z >= lo[2] + margin) & (z <= hi[2])).sum())
+        return support >= self.SUPPORT_POINTS and inside <= self.INSIDE_POINTS

@@ -1,0 +1,114 @@
+"""A session joins its place: the log's frame is aligned to the place's map before perception.
+
+``perceive --align auto`` (the default): the first session of a place defines its map frame;
+every later one is registered to the place's background cloud (``perceive.align``) from frames
+spread over its log, and refused when it does not fit. ``--align none`` takes the log's poses
+as map-frame poses; ``--align FILE`` reads ``T_map_log`` (a 4×4 matrix, JSON or 16 numbers).
+Frames are then handed to the stages with ``T_map_cam = T_map_log · T_log_cam``, so everything
+stored is in the place's one map frame; and during the run the session's own background adds
+to the place's cloud (``MapCloudGrower``).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiper_cli.errors import ConfigError, KnowledgeBaseError
+from hiper_cli.graph import KnowledgeBase
+from hiper_cli.graph.sessions import Alignment
+from hiper_cli.model import Environment
+from hiper_cli.perceive.align import BackgroundCloud, register
+from hiper_cli.types import Frame
+
+__all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment"]
+
+ALIGN_FRAMES = 40  # frames spread over the log make its cloud
+MIN_FITNESS = 0.4  # below this share of the log's background on the map, the log is refused
+CLOUD_EVERY_S = 0.5  # the place's cloud takes a frame this often
+
+
+def _read_matrix(path: Path) -> np.ndarray:
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ConfigError(f"--align {path}: cannot read it ({err.strerror}); pass none, auto or a file "
+                          "with a 4x4 matrix") from err
+    try:
+        values = np.asarray(json.loads(text), dtype=np.float64)
+    except ValueError:
+        try:
+            values = np.asarray([float(v) for v in text.replace(",", " ").split()], dtype=np.float64)
+        except ValueError:
+            values = np.zeros(0)
+    if values.size != 16 or not np.allclose(values.reshape(4, 4)[3], [0, 0, 0, 1]):
+        raise ConfigError(f"--align {path}: expected a 4x4 rigid transform T_map_log (JSON or 16 numbers, "
+                          "last row 0 0 0 1)")
+    return values.reshape(4, 4)
+
+
+def log_cloud(reader: Any, n: int = ALIGN_FRAMES) -> np.ndarray:
+    """The log's background cloud in its own frame, from ``n`` frames spread over it."""
+    cloud = BackgroundCloud()
+    total = len(reader)
+    for k in np.unique(np.linspace(0, max(total - 1, 0), min(n, total)).astype(int)):
+        cloud.add_frame(reader.read_frame(int(k)))
+    return cloud.points()
+
+
+def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: str,
+                     log_name: str) -> Alignment:
+    """The transform this session's log gets (see the module docstring); refuses a poor fit."""
+    if align == "none":
+        return Alignment.identity()
+    if align != "auto":
+        return Alignment(_read_matrix(Path(align)), "file")
+    place = kb.map_cloud(env)
+    if place is None or len(place) < 100 or not hasattr(reader, "read_frame"):
+        return Alignment.identity()  # the first session of a place defines its map frame
+    found = register(log_cloud(reader), place)
+    if found.fitness < MIN_FITNESS:
+        raise KnowledgeBaseError(
+            f"{log_name}: does not align with place {env.name!r} of {kb.location} (fitness "
+            f"{found.fitness:.2f} < {MIN_FITNESS}: too little of its background matches the map); pass "
+            "--env NEW if it shows another place, or --align FILE with its transform, or --align none if "
+            "its poses are in the map frame")
+    return Alignment(found.T_map_log, "registration", found.fitness, found.rmse_m)
+
+
+def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:
+    """The frames with their poses carried into the map frame."""
+    T = np.asarray(alignment.T_map_log, dtype=np.float64)
+    if np.allclose(T, np.eye(4)):
+        yield from frames
+        return
+    for frame in frames:
+        yield replace(frame, T_map_cam=T @ frame.T_map_cam)
+
+
+class MapCloudGrower:
+    """The place's background cloud, grown by this session's frames (map frame) and stored at
+    the end of the session."""
+
+    def __init__(self, kb: KnowledgeBase, env: Environment) -> None:
+        self.kb, self.env = kb, env
+        self.cloud = BackgroundCloud()
+        stored = kb.map_cloud(env)
+        self.before = stored  # the place as the earlier sessions saw it (for ``FreeBefore``)
+        if stored is not None:
+            self.cloud.add_points(stored)
+        self._last_s = -np.inf
+
+    def add(self, frame: Frame) -> None:
+        if abs(frame.stamp_s - self._last_s) >= CLOUD_EVERY_S:
+            self._last_s = frame.stamp_s
+            self.cloud.add_frame(frame)
+
+    def store(self) -> int:
+        """Write the cloud (its own transaction); bytes stored."""
+        return self.kb.store_map_cloud(self.env, self.cloud.points())
