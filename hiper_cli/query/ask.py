@@ -153,8 +153,10 @@ def ask(
     ``at_s`` (default: its last); relative times count back from ``now_s`` (default: ``at_s``,
     else the KB's last stamp)."""
     ctx = make_context(kb, pose=pose, at_s=at_s, now_s=now_s, config=config)
-    change = history.match(text)  # questions about change between sessions: query/history.py
-    if change is not None:
+    # Change words read the memory's change events (query/history.py) once it has any; a memory
+    # of one log has none, and there they mean what was seen moving, appearing or leaving.
+    change = history.match(text)
+    if change is not None and (change.intent != "changes" or kb.changes()):
         return history.answer_change(ctx, change, text)
     envs = kb.environments()
     whole = [envs[0].name] if len(envs) == 1 else []  # "in the house": the KB's one place
