@@ -88,6 +88,10 @@ OPTION_RANGES: dict[str, Range] = {
     "timeout_s": Range(0.0, 24 * 3600.0, lo_open=True),
     "short_s": Range(0.0, 1e9, lo_open=True), "glimpse_s": Range(0.0, 1e9),
     "image_hz": Range(0.0, 1000.0, lo_open=True),
+    # hiper perceive zenoh:// and hiper replay (live)
+    "idle_timeout": Range(0.0, 24 * 3600.0, lo_open=True), "queue": Range(1, 10_000, integer=True),
+    "rate": Range(0.0, 1000.0, lo_open=True), "hz": Range(0.0, 1000.0, lo_open=True),
+    "wait": Range(0.0, 3600.0),
     # hiper bench
     "runs": Range(1, 1000, integer=True), "log_s": Range(10.0, 24 * 3600.0),
     "time_limit_s": Range(1.0, 24 * 3600.0),

@@ -26,7 +26,8 @@ def _numeric_options() -> list[tuple[str, str]]:
             return
         for name, p in inspect.signature(callback).parameters.items():
             hint = str(p.annotation)
-            if any(t in hint for t in ("int", "float")) and "list" not in hint:
+            numeric = hint.split(",")[0]  # Annotated[int, typer.Option(help=...)]: the type alone
+            if any(t in numeric for t in ("int", "float")) and "list" not in numeric and "bool" not in numeric:
                 found.append((path, name))
 
     walk(typer.main.get_command(app), "")
