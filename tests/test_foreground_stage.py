@@ -12,7 +12,7 @@ from hiper_cli.learned import AltitudeFeature, SizeFeature
 from hiper_cli.perceive.foreground import ForegroundConfig, ForegroundStage
 from hiper_cli.perceive.foreground.segment import segment
 from hiper_cli.perceive.runner import run_stages
-from hiper_cli.perceive.stage import World, make_stage
+from hiper_cli.perceive.stage import FrameResult, World, make_stage
 from tests.fg_scene import (
     CAMERA,
     SceneBox,
@@ -293,6 +293,41 @@ def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker():
     assert len(a.data["trajectory"]) == 4
     assert np.allclose(a.data["trajectory"], b.data["trajectory"])
     assert len(a.observation_uuids) == len(b.observation_uuids) == 4
+
+
+def test_live_the_detector_starts_on_each_frame_before_the_stages_before_it():
+    """``look_ahead=False`` (a live stream): no next frame to hand over, so each frame goes to
+    the detector before the first stage (the background) processes it; same result."""
+    detector = _RecordingDetector()
+    stage = ForegroundStage(detector_instance=detector, pixel_step=2)
+    calls = []
+    prepare, process = stage.prepare, stage.process
+    stage.prepare = lambda frame: (calls.append(("prepare", frame.pose_id)), prepare(frame))[1]
+    stage.process = lambda frame, world: (calls.append(("process", frame.pose_id)), process(frame, world))[1]
+
+    class Before:  # stands for the background: runs first, records its turn
+        name = "before"
+
+        def process(self, frame, world):
+            calls.append(("before", frame.pose_id))
+            return FrameResult()
+
+        def finish(self, world):
+            return FrameResult()
+
+    world, _ = run_stages(walker_frames(n=4), [Before(), stage],
+                          World(background=background_instances(room())), look_ahead=False)
+    assert calls == [
+        ("prepare", 0), ("before", 0), ("process", 0), ("prepare", 1), ("before", 1), ("process", 1),
+        ("prepare", 2), ("before", 2), ("process", 2), ("prepare", 3), ("before", 3), ("process", 3),
+    ]  # fmt: skip
+    assert sorted(pose for pose, _ in detector.seen) == [0, 1, 2, 3]  # once per frame, in the worker
+    assert all(name.startswith("hiper-detect") for _, name in detector.seen)
+    plain = ForegroundStage(detector="log", pixel_step=2, detector_threads=0)
+    world_plain, _ = run_stages(walker_frames(n=4), [plain], World(background=background_instances(room())))
+    ((a,), (b,)) = world.foreground.values(), world_plain.foreground.values()
+    assert len(a.data["trajectory"]) == 4
+    assert np.allclose(a.data["trajectory"], b.data["trajectory"])
 
 
 def test_each_learned_dynamics_prior_switches_alone():

@@ -346,3 +346,30 @@ def test_a_follower_process_keeps_the_graph_up_to_date(kb_location):
         rows = kb.query(f"SELECT (SUM(?k) AS ?n) WHERE {{ GRAPH {g} {{ ?b a hiper:ObservationBatch ; "
                         "hiper:observationCount ?k } }")
         assert int(rows[0]["n"].value) == 40
+
+
+def test_small_syncs_are_not_flushed_yet_readers_see_them(tmp_path, monkeypatch):
+    """A store flush costs ~70 ms whatever its size: a sync after each frame leaves its quads in
+    the write-ahead log, which a reader opening the store sees; a large catch-up flushes."""
+    from hiper_cli.graph import sync as graph_sync
+    from hiper_cli.graph.scenegraph import LocalGraph
+
+    location = tmp_path / "scene.hiper"
+    with open_kb(str(location)) as kb:
+        env, _, _ = _fill(kb)
+        kb.sync_graph()
+        buffered = kb.graph.buffered_quads()
+        assert buffered > 0  # the catch-up was small: nothing flushed
+        reader = LocalGraph(location / "graph", read_only=True)
+        try:
+            assert reader.synced_seq(kb.kb_id) == kb.docs.seq
+            counts = {r["t"].value: int(r["n"].value) for r in reader.query(
+                "SELECT ?t (COUNT(?s) AS ?n) WHERE { GRAPH ?g { ?s a ?t } } GROUP BY ?t")}
+            assert counts and sum(counts.values()) >= kb.docs.count(type="instance")
+        finally:
+            reader.close()
+        monkeypatch.setattr(graph_sync, "FLUSH_MIN_QUADS", buffered + 1)
+        cup = Instance("foreground", "cup", Box3D(np.zeros(3), np.ones(3)), 40.0, 40.0)
+        kb.put_documents([cup.to_dict()], env_uuid=env.uuid)
+        kb.sync_graph()  # past the threshold now
+        assert kb.graph.buffered_quads() == 0

@@ -50,7 +50,8 @@ def run_stages(
     method is handed the next frame before the current one is processed, to start work that
     needs no world (the foreground stage runs its detector on it in a worker thread, so the
     detector is busy while this frame's point cloud is processed); ``look_ahead=False`` processes
-    each frame as soon as it is read, without waiting for the next (a live stream). A frame
+    each frame as soon as it is read, without waiting for the next (a live stream), and hands
+    the frame itself to ``prepare`` first (its detector runs while the stages before run). A frame
     that cannot be read raises its error after the frames before it are processed and handed
     to ``on_frame``; ``finish`` does not run then.
     """
@@ -74,9 +75,12 @@ def run_stages(
         else:
             upcoming = None
         start = time.perf_counter()
-        if upcoming is not None:
+        # the next frame when reading ahead; else this one, so that the detector runs while
+        # the stages before the foreground (the background) process it
+        early = upcoming if look_ahead else frame
+        if early is not None:
             for prepare in ahead:
-                prepare(upcoming)
+                prepare(early)
         merged = FrameResult()
         for stage in stages:
             t0 = time.perf_counter()
