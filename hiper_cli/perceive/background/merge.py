@@ -76,6 +76,12 @@ def to_map(obs: Observation, T_map_cam: FloatArray) -> MapObservation:
     )
 
 
+def _fused(inst: Instance) -> bool:
+    """Whether ``inst`` carries its fused plane (fit, plane and contour in the map frame): one
+    known only by its summary, as an import writes it, has no evidence to merge new views into."""
+    return all(key in inst.data for key in ("fit", "plane_map", "contour_map"))
+
+
 def _geometry(inst: Instance) -> tuple[FloatArray, FloatArray, FloatArray]:
     d = inst.data
     fit = d["fit"]
@@ -233,7 +239,7 @@ def match_instances(mo: MapObservation, instances: Sequence[Instance],
     """The instances ``mo`` belongs to, oldest first."""
     found = [
         inst for inst in instances
-        if _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map, inst, cfg,
+        if _fused(inst) and _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map, inst, cfg,
                     mo.hidden_map)
     ]
     return sorted(found, key=lambda i: (i.first_seen_s, i.uuid))
@@ -241,6 +247,8 @@ def match_instances(mo: MapObservation, instances: Sequence[Instance],
 
 def instance_matches(a: Instance, b: Instance, cfg: BackgroundConfig) -> bool:
     """Whether two instances satisfy the merge criteria (used to find duplicates)."""
+    if not (_fused(a) and _fused(b)):
+        return False
     plane, contour, centroid = _geometry(a)
     return _matches(a.class_name, plane, contour, centroid, b, cfg)
 
