@@ -63,8 +63,8 @@ def measure(out: Path, log: Path, extra: list[str]) -> dict[str, object]:
     unknowns = fg["unknown_predicted"]
     dup = sum(n for k, n in mis.items() if k.split("->")[0] == k.split("->")[1] != "unknown")
     inst = json.loads(export.read_text())["instances"]
-    moving_static = sum(1 for i in inst if i["layer"] == "foreground" and i.get("motion", i["state"]) == "static"
-                        and (i.get("speed_mps") or 0.0) > 0.05)
+    moving_static = sum(1 for i in inst if i["layer"] == "foreground"
+                        and i.get("motion", i["state"]) == "static" and (i.get("speed_mps") or 0.0) > 0.05)
     return {"log": name, "prec_cls": fg["precision_classified"], "tp": fg["tp"],
             "fp_cls": fg["fp_classified"], "rec_name": fg["recall_nameable"],
             "n_name": fg["nameable_observed"], "rec_loc": fg["recall_located"],

@@ -27,7 +27,7 @@ def _numeric_options() -> list[tuple[str, str]]:
         for name, p in inspect.signature(callback).parameters.items():
             hint = str(p.annotation)
             numeric = hint.split(",")[0]  # Annotated[int, typer.Option(help=...)]: the type alone
-            if any(t in numeric for t in ("int", "float")) and "list" not in numeric and "bool" not in numeric:
+            if any(t in numeric for t in ("int", "float")) and not any(t in numeric for t in ("list", "bool")):
                 found.append((path, name))
 
     walk(typer.main.get_command(app), "")

@@ -239,8 +239,8 @@ def match_instances(mo: MapObservation, instances: Sequence[Instance],
     """The instances ``mo`` belongs to, oldest first."""
     found = [
         inst for inst in instances
-        if _fused(inst) and _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map, inst, cfg,
-                    mo.hidden_map)
+        if _fused(inst) and _matches(mo.obs.class_name, mo.plane_map, mo.contour_map, mo.centroid_map,
+                                     inst, cfg, mo.hidden_map)
     ]
     return sorted(found, key=lambda i: (i.first_seen_s, i.uuid))
 
