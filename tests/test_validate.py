@@ -27,7 +27,8 @@ def _numeric_options() -> list[tuple[str, str]]:
         for name, p in inspect.signature(callback).parameters.items():
             hint = str(p.annotation)
             numeric = hint.split(",")[0]  # Annotated[int, typer.Option(help=...)]: the type alone
-            if any(t in numeric for t in ("int", "float")) and not any(t in numeric for t in ("list", "bool")):
+            numeric_type = any(t in numeric for t in ("int", "float"))
+            if numeric_type and not any(t in numeric for t in ("list", "bool")):
                 found.append((path, name))
 
     walk(typer.main.get_command(app), "")
