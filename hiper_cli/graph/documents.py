@@ -749,7 +749,9 @@ class DocumentStore(ChangeFeed, Lookups):
 
     def integrity_problems(self) -> list[str]:
         """SQLite's own integrity check plus the store's invariants; empty when all is well."""
-        damage = [str(r[0]) for r in self._db.execute("PRAGMA quick_check") if r[0] != "ok"]
+        # SQLite may report several problems in one row, one per line, under a "*** in database" header
+        damage = [line for r in self._db.execute("PRAGMA quick_check") if r[0] != "ok"
+                  for line in str(r[0]).splitlines() if line.strip() and not line.startswith("***")]
         if damage:
             raise damaged_error(self.path, f"{len(damage)} problems, first: {damage[0]}")
         problems: list[str] = []
