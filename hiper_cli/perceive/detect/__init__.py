@@ -22,7 +22,7 @@ from typing import Any, Protocol, runtime_checkable
 from hiper_cli.errors import ConfigError
 from hiper_cli.types import Detections, Frame
 
-__all__ = ["DETECTOR_NAMES", "Detector", "make_detector"]
+__all__ = ["DETECTOR_NAMES", "Detector", "check_class_names", "make_detector"]
 
 
 @runtime_checkable
@@ -89,3 +89,40 @@ def _catalog_detector(name: str, options: dict[str, Any]) -> Detector:
         f"unknown detector {name!r}; expected one of {', '.join(DETECTOR_NAMES)}, or a model of "
         f"'hiper models list' ({', '.join(known)})"
     )
+
+
+def check_class_names(wanted: tuple[str, ...], excluded: tuple[str, ...], detector: Any, name: str) -> None:
+    """Refuse ``--classes`` the detector can never report and ``--exclude-classes`` that name no
+    class any detector reports: a typo would silently keep nothing, or exclude nothing."""
+    known = getattr(detector, "class_names", None)
+    _check_classes(wanted, known, name)
+    _check_excluded(excluded, known or ())
+
+
+def _check_excluded(excluded: tuple[str, ...], detector_classes: Any) -> None:
+    """Refuse ``--exclude-classes`` that name no class any detector reports (a typo)."""
+    from hiper_cli.perceive.detect._onnx import COCO_NAMES
+
+    known = {*COCO_NAMES, *detector_classes}
+    unknown = [c for c in excluded if c not in known]
+    if unknown:
+        import difflib
+
+        near = difflib.get_close_matches(unknown[0], sorted(known), n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise ConfigError(f"--exclude-classes {', '.join(unknown)}: no detector has such a class; {hint}"
+                          "expected COCO class names such as 'boat,traffic light'")
+
+
+def _check_classes(wanted: tuple[str, ...], known: Any, detector: str) -> None:
+    """Refuse ``--classes`` the detector can never report (a typo would silently keep nothing)."""
+    if not wanted or not known:
+        return
+    unknown = [c for c in wanted if c not in known]
+    if unknown:
+        import difflib
+
+        near = difflib.get_close_matches(unknown[0], list(known), n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise ConfigError(f"--classes {', '.join(unknown)}: detector {detector!r} has no such class; {hint}"
+                          f"its classes: {', '.join(known)}")

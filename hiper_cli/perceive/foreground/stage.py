@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import ConfigError, DataError, PerceptionError
+from hiper_cli.errors import DataError, PerceptionError
 from hiper_cli.learned import (
     FEATURE_KINDS,
     KIND_ALTITUDE,
@@ -25,7 +25,7 @@ from hiper_cli.learned import (
     feature_from_analysis,
 )
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
-from hiper_cli.perceive.detect import Detector, make_detector
+from hiper_cli.perceive.detect import Detector, check_class_names, make_detector
 from hiper_cli.perceive.foreground.amodal import (
     FLOOR_STANDING,
     LEAST_HEIGHT_M,
@@ -147,8 +147,7 @@ class ForegroundStage:
         import scipy.sparse.csgraph  # noqa: F401
 
         self.detector: Detector = detector_instance or make_detector(cfg.detector, log_path=log_path)
-        _check_classes(cfg.classes, getattr(self.detector, "class_names", None), cfg.detector)
-        _check_excluded(cfg.exclude_classes, getattr(self.detector, "class_names", None) or ())
+        check_class_names(cfg.classes, cfg.exclude_classes, self.detector, cfg.detector)
         # the ``log`` detector reads the log's own detections: perceive checks the log has them
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
@@ -771,31 +770,3 @@ def _corners(blob: Blob) -> tuple[FloatArray, FloatArray]:
     lo[2], hi[2] = centre[2] - extent[2] / 2.0, centre[2] + extent[2] / 2.0
     return lo, hi
 
-
-def _check_excluded(excluded: tuple[str, ...], detector_classes: Any) -> None:
-    """Refuse ``--exclude-classes`` that name no class any detector reports (a typo)."""
-    from hiper_cli.perceive.detect._onnx import COCO_NAMES
-
-    known = {*COCO_NAMES, *detector_classes}
-    unknown = [c for c in excluded if c not in known]
-    if unknown:
-        import difflib
-
-        near = difflib.get_close_matches(unknown[0], sorted(known), n=1)
-        hint = f"did you mean {near[0]!r}? " if near else ""
-        raise ConfigError(f"--exclude-classes {', '.join(unknown)}: no detector has such a class; {hint}"
-                          "expected COCO class names such as 'boat,traffic light'")
-
-
-def _check_classes(wanted: tuple[str, ...], known: Any, detector: str) -> None:
-    """Refuse ``--classes`` the detector can never report (a typo would silently keep nothing)."""
-    if not wanted or not known:
-        return
-    unknown = [c for c in wanted if c not in known]
-    if unknown:
-        import difflib
-
-        near = difflib.get_close_matches(unknown[0], list(known), n=1)
-        hint = f"did you mean {near[0]!r}? " if near else ""
-        raise ConfigError(f"--classes {', '.join(unknown)}: detector {detector!r} has no such class; {hint}"
-                          f"its classes: {', '.join(known)}")
