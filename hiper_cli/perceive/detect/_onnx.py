@@ -93,3 +93,16 @@ def clip_boxes(xyxy: NDArray[np.float64], width: int, height: int) -> NDArray[np
     out[:, [0, 2]] = np.clip(out[:, [0, 2]], 0.0, float(width))
     out[:, [1, 3]] = np.clip(out[:, [1, 3]], 0.0, float(height))
     return out
+
+
+def letterboxed_boxes(
+    pred: NDArray[np.float64], class_ids: NDArray[np.int64], scores: NDArray[np.float64],
+    pad_xy: tuple[float, float], scale: float, nms_iou: float,
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
+    """Rows whose first four columns are (cx, cy, w, h) in letterboxed input pixels, as xyxy boxes
+    in the original image's pixels, with class ids and scores, after class-wise NMS."""
+    cxcy, wh = pred[:, :2], pred[:, 2:4]
+    xyxy = np.concatenate([cxcy - wh / 2.0, cxcy + wh / 2.0], axis=1)
+    xyxy = (xyxy - np.array([*pad_xy, *pad_xy])) / scale
+    kept = nms(xyxy, scores, class_ids, nms_iou)
+    return xyxy[kept], class_ids[kept], scores[kept]

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.perceive.detect._onnx import COCO_NAMES, nms
+from hiper_cli.perceive.detect._onnx import COCO_NAMES, letterboxed_boxes
 
 __all__ = ["LAYOUTS_TEXT", "LAYOUT_NAMES", "class_names", "coco91_names", "decode_detr", "decode_yolov5",
            "grid_cells", "identify_layout"]
@@ -78,12 +78,7 @@ def decode_yolov5(
     class_ids = np.argmax(cls_scores, axis=1)
     scores = pred[:, 4] * cls_scores[np.arange(len(pred)), class_ids]
     keep = scores >= score_threshold
-    pred, class_ids, scores = pred[keep], class_ids[keep], scores[keep]
-    cxcy, wh = pred[:, :2], pred[:, 2:4]
-    xyxy = np.concatenate([cxcy - wh / 2.0, cxcy + wh / 2.0], axis=1)
-    xyxy = (xyxy - np.array([*pad_xy, *pad_xy])) / scale
-    kept = nms(xyxy, scores, class_ids, nms_iou)
-    return xyxy[kept], class_ids[kept], scores[kept]
+    return letterboxed_boxes(pred[keep], class_ids[keep], scores[keep], pad_xy, scale, nms_iou)
 
 
 def decode_detr(

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
-from hiper_cli.perceive.detect._onnx import COCO_NAMES, nms
+from hiper_cli.perceive.detect._onnx import COCO_NAMES, letterboxed_boxes
 
 __all__ = ["decode_yolov8", "parse_names"]
 
@@ -56,9 +56,4 @@ def decode_yolov8(
     class_ids = np.argmax(cls_scores, axis=1)
     scores = cls_scores[np.arange(len(pred)), class_ids]
     keep = scores >= score_threshold
-    pred, class_ids, scores = pred[keep], class_ids[keep], scores[keep]
-    cxcy, wh = pred[:, :2], pred[:, 2:4]
-    xyxy = np.concatenate([cxcy - wh / 2.0, cxcy + wh / 2.0], axis=1)
-    xyxy = (xyxy - np.array([*pad_xy, *pad_xy])) / scale
-    kept = nms(xyxy, scores, class_ids, nms_iou)
-    return xyxy[kept], class_ids[kept], scores[kept]
+    return letterboxed_boxes(pred[keep], class_ids[keep], scores[keep], pad_xy, scale, nms_iou)
