@@ -24,12 +24,7 @@ from hiper_cli.perceive.live.rmw import Attachment, open_session
 from hiper_cli.perceive.live.sync import FrameSync, RawImage, ReadyFrame
 from hiper_cli.perceive.logs.bag_writer import BagLayout
 from hiper_cli.perceive.logs.base import LogInfo
-from hiper_cli.perceive.logs.images import (
-    decode_compressed_depth,
-    decode_compressed_rgb,
-    decode_depth,
-    decode_rgb,
-)
+from hiper_cli.perceive.logs.images import decode_image_msg
 from hiper_cli.perceive.logs.options import LogOptions
 from hiper_cli.perceive.logs.ros_types import typestore
 from hiper_cli.types import CameraIntrinsics, Frame
@@ -257,13 +252,4 @@ class LiveSource:
 
     def _image(self, store: Any, role: str, image: RawImage, where: str) -> Any:
         msg = store.deserialize_cdr(image.raw, image.msgtype)
-        if image.msgtype == COMPRESSED:
-            data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
-            if role == "rgb":
-                return decode_compressed_rgb(msg.format, data, where)
-            return decode_compressed_depth(msg.format, data, where, self.depth_scale)
-        args = (str(msg.encoding), int(msg.height), int(msg.width), int(msg.step),
-                np.asarray(msg.data, dtype=np.uint8), bool(msg.is_bigendian), where)
-        if role == "rgb":
-            return decode_rgb(*args)
-        return decode_depth(*args, depth_scale=self.depth_scale)
+        return decode_image_msg(msg, image.msgtype == COMPRESSED, role, where, self.depth_scale)

@@ -23,6 +23,7 @@ __all__ = [
     "decode_compressed_depth",
     "decode_compressed_rgb",
     "decode_depth",
+    "decode_image_msg",
     "decode_rgb",
     "read_depth_png",
     "read_rgb_file",
@@ -218,3 +219,18 @@ def decode_compressed_depth(fmt: str, data: NDArray[np.uint8], source: str,
         raise LogError(f"{source}: cannot decode the compressed depth image (format '{fmt}'); expected "
                        "16-bit png")
     return _depth_from_array(image, depth_scale, source)
+
+
+def decode_image_msg(msg: Any, compressed: bool, role: str, where: str, depth_scale: float) -> Any:
+    """A deserialised ``sensor_msgs`` Image (or CompressedImage when ``compressed``) as RGB
+    (``role`` "rgb") or depth in metres; ``where`` names the message in errors."""
+    if compressed:
+        data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
+        if role == "rgb":
+            return decode_compressed_rgb(msg.format, data, where)
+        return decode_compressed_depth(msg.format, data, where, depth_scale)
+    args = (str(msg.encoding), int(msg.height), int(msg.width), int(msg.step),
+            np.asarray(msg.data, dtype=np.uint8), bool(msg.is_bigendian), where)
+    if role == "rgb":
+        return decode_rgb(*args)
+    return decode_depth(*args, depth_scale=depth_scale)

@@ -25,14 +25,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.errors import LogError
 from hiper_cli.perceive.logs.base import FrameEntry, IndexedLog
-from hiper_cli.perceive.logs.images import (
-    DEPTH_ENCODINGS,
-    RGB_ENCODINGS,
-    decode_compressed_depth,
-    decode_compressed_rgb,
-    decode_depth,
-    decode_rgb,
-)
+from hiper_cli.perceive.logs.images import DEPTH_ENCODINGS, RGB_ENCODINGS, decode_image_msg
 from hiper_cli.perceive.logs.ros_types import typestore
 from hiper_cli.perceive.logs.tf import TfTree, pose_msg_to_matrix, transform_msg_to_matrix
 from hiper_cli.perceive.logs.topics import BagTopics
@@ -198,16 +191,7 @@ class BagReader(IndexedLog):
             msg = reader.deserialize(raw, conn.msgtype)
         except _bag_errors() as err:
             raise LogError(f"{where}: cannot deserialize the message ({err})") from err
-        if conn.msgtype == COMPRESSED:
-            data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
-            if role == "rgb":
-                return decode_compressed_rgb(msg.format, data, where)
-            return decode_compressed_depth(msg.format, data, where, self.depth_scale)
-        args = (str(msg.encoding), int(msg.height), int(msg.width), int(msg.step),
-                np.asarray(msg.data, dtype=np.uint8), bool(msg.is_bigendian), where)
-        if role == "rgb":
-            return decode_rgb(*args)
-        return decode_depth(*args, depth_scale=self.depth_scale)
+        return decode_image_msg(msg, conn.msgtype == COMPRESSED, role, where, self.depth_scale)
 
     def _decoded(self) -> Iterator[tuple[int, ImagePair | LogError]]:
         need: dict[tuple[str, int], list[tuple[int, str]]] = {}
