@@ -11,7 +11,7 @@ import pytest
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "hiper_cli"
 
-_UI = ("hiper_cli.commands", "hiper_cli.cli", "typer", "rich")
+_UI = ("hiper_cli.commands", "hiper_cli.cli", "hiper_cli.cmdline", "hiper_cli.render", "typer", "rich")
 _ABOVE_PERCEIVE = ("hiper_cli.graph", "hiper_cli.analyze", "hiper_cli.query", "hiper_cli.pipeline",
                    "hiper_cli.reanchor", "hiper_cli.sim", "hiper_cli.evaluate", "hiper_cli.view",
                    "hiper_cli.agent", "hiper_cli.mcp", "hiper_cli.qa")
@@ -74,6 +74,10 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     "session_align": ("hiper_cli.analyze", "hiper_cli.query", "hiper_cli.sim", "hiper_cli.evaluate", *_UI),
     # hiper bench: simulates, perceives, scores and runs tasks on top of all the library
     "bench": ("hiper_cli.serve", "hiper_cli.view", "hiper_cli.reanchor", *_UI),
+    # how results look on a terminal (rich): shows result dicts, never parses a command line
+    "render": ("hiper_cli.commands", "hiper_cli.cli", "hiper_cli.cmdline", "typer", "click"),
+    # the command line's shared parts (typer): app class, shared options, usage errors
+    "cmdline": ("hiper_cli.commands", "hiper_cli.cli"),
     # the command line sits on top of everything
     "commands": (),
     "cli": (),

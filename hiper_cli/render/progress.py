@@ -1,0 +1,77 @@
+"""Progress bars of long runs: frames (perceive, sim, convert), downloads, benchmark units."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+__all__ = ["FrameBar", "download_bar", "frame_progress", "unit_progress"]
+
+
+class FrameBar:
+    """A rich progress bar over frames: ``start(total)`` once, then ``update(done, total)``."""
+
+    def __init__(self, bar: Any) -> None:
+        self._bar = bar
+        self._task: Any = None
+
+    def start(self, total: int) -> None:
+        self._task = self._bar.add_task("frames", total=total, rate=0.0)
+
+    def advance(self, *_: Any) -> None:
+        self._bar.advance(self._task)
+
+    def update(self, done: int, total: int) -> None:
+        if self._task is None:
+            self.start(total)
+        elapsed = self._bar.tasks[0].elapsed or 0.0
+        self._bar.update(self._task, completed=done, total=total, rate=done / elapsed if elapsed > 0 else 0.0)
+
+
+@contextmanager
+def frame_progress(label: str, out: Any, *, enabled: bool = True, total: int | None = None
+                   ) -> Iterator[FrameBar | None]:
+    """A ``FrameBar`` labelled ``label`` on console ``out`` (started when ``total`` is given);
+    ``None`` when not ``enabled`` (``--json``)."""
+    if not enabled:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("{task.fields[rate]:.1f} frames/s"), TimeElapsedColumn(), console=out) as bar:
+        frame_bar = FrameBar(bar)
+        if total is not None:
+            frame_bar.start(total)
+        yield frame_bar
+
+
+@contextmanager
+def download_bar(name: str) -> Iterator[Any]:
+    """A transient download bar on stderr; yields ``progress(done, total)`` for ``fetch_model``."""
+    from rich.console import Console
+    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TransferSpeedColumn
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TransferSpeedColumn(),
+                  console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(name, total=None)
+
+        def progress(done: int, size: int | None) -> None:
+            bar.update(task, completed=done, total=size)
+
+        yield progress
+
+
+@contextmanager
+def unit_progress(label: str, out: Any, total: int, *, enabled: bool = True) -> Iterator[Any]:
+    """A bar over ``total`` units of work; yields ``step(what, n)`` (None when not ``enabled``)."""
+    if not enabled:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("{task.description}"), TimeElapsedColumn(), console=out) as bar:
+        task = bar.add_task("", total=total)
+        yield lambda what, n: bar.update(task, advance=n, description=what)
