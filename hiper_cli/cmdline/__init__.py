@@ -8,8 +8,18 @@ commands and ``cli.py`` import it: it sits above the library, beside ``hiper_cli
 
 from hiper_cli.cmdline.app import HiperTyper, group
 from hiper_cli.cmdline.log_flags import LOG_FLAGS, with_log_flags
-from hiper_cli.cmdline.options import DEFAULT_KB, JSON_OPTION, LOG_ARGUMENT, KbDocsOption, KbOption
-from hiper_cli.cmdline.values import host_port, keep_duration_s
+from hiper_cli.cmdline.options import (
+    DEFAULT_KB,
+    JSON_OPTION,
+    LOG_ARGUMENT,
+    Json,
+    Kb,
+    KbDocs,
+    KbDocsOption,
+    KbOption,
+    Log,
+)
+from hiper_cli.cmdline.values import keep_duration_s
 
-__all__ = ["DEFAULT_KB", "JSON_OPTION", "LOG_ARGUMENT", "LOG_FLAGS", "HiperTyper", "KbDocsOption", "KbOption",
-           "group", "host_port", "keep_duration_s", "with_log_flags"]
+__all__ = ["DEFAULT_KB", "JSON_OPTION", "LOG_ARGUMENT", "LOG_FLAGS", "HiperTyper", "Json", "Kb", "KbDocs",
+           "KbDocsOption", "KbOption", "Log", "group", "keep_duration_s", "with_log_flags"]

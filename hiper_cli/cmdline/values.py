@@ -1,10 +1,10 @@
-"""Parsers of option values that several commands share: a duration to keep, a HOST:PORT."""
+"""Parsers of option values that several commands share: a duration to keep."""
 
 from __future__ import annotations
 
 from hiper_cli.errors import ConfigError
 
-__all__ = ["host_port", "keep_duration_s"]
+__all__ = ["keep_duration_s"]
 
 
 def keep_duration_s(text: str) -> float | None:
@@ -23,11 +23,3 @@ def keep_duration_s(text: str) -> float | None:
     except QueryError as err:
         raise ConfigError(f"--keep-observations {text!r}: expected a duration such as '10 minutes', "
                           "'2 h', 0 or 'all'") from err
-
-
-def host_port(text: str, flag: str = "--http") -> tuple[str, int]:
-    """``HOST:PORT`` (HOST defaults to 127.0.0.1)."""
-    host, sep, port = text.rpartition(":")
-    if not sep or not port.isdigit() or not 0 <= int(port) <= 65535:
-        raise ConfigError(f"{flag} {text!r}: expected HOST:PORT, e.g. 127.0.0.1:8765")
-    return host or "127.0.0.1", int(port)

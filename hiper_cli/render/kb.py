@@ -34,8 +34,9 @@ def show_kb_info(out: Any, data: dict[str, Any]) -> None:
         out.print(sessions)
 
 
-def show_sessions(out: Any, rows: list[dict[str, Any]]) -> None:
+def show_sessions(out: Any, data: dict[str, Any]) -> None:
     """``hiper kb sessions``: one row per session, with its log stamps and alignment."""
+    rows = data["sessions"]
     import datetime
 
     from rich.table import Table
@@ -80,10 +81,10 @@ def show_kb_check(out: Any, data: dict[str, Any]) -> None:
     out.print("[green]consistent[/]" if data["ok"] else "[red]inconsistent[/]")
 
 
-def show_compact(out: Any, report: dict[str, Any]) -> None:
-    """``hiper kb compact``: observations and bytes before and after."""
+def show_compact(out: Any, report: dict[str, Any], kb: str) -> None:
+    """``hiper kb compact`` of ``kb``: observations and bytes before and after."""
     out.print(
-        f"[green]compacted[/] {safe_text(report['kb'])}: {report['observations_before']} -> "
+        f"[green]compacted[/] {safe_text(kb)}: {report['observations_before']} -> "
         f"{report['observations_after']} observations ({report['summarised']} summarised, "
         f"{report['debris_dropped']} debris), {report['bytes_before'] / 1e6:.2f} -> "
         f"{report['bytes_after'] / 1e6:.2f} MB of documents in {report['seconds']:.1f} s")

@@ -6,8 +6,8 @@ from typing import Any
 
 from hiper_cli.render.text import safe_text
 
-__all__ = ["show_converted", "show_degraded", "show_live", "show_log_info", "show_perceive", "show_replayed",
-           "show_run", "show_steps"]
+__all__ = ["show_converted", "show_live", "show_log_info", "show_perceive", "show_replay_start",
+           "show_replayed", "show_run", "show_steps"]
 
 
 def _skip(item: dict[str, Any]) -> str:
@@ -133,18 +133,26 @@ def _skipped(out: Any, skipped: list[dict[str, str]]) -> None:
 
 def show_converted(out: Any, data: dict[str, Any]) -> None:
     """``hiper convert``: frames written, where, in which format, and the frames skipped."""
+    if "profile" in data:
+        _show_degraded(out, data)
+        return
     out.print(f"wrote {data['frames_written']} frames to {safe_text(data['output'])} "
               f"({safe_text(data['to'])})")
     _skipped(out, data["skipped"])
 
 
-def show_degraded(out: Any, data: dict[str, Any]) -> None:
+def _show_degraded(out: Any, data: dict[str, Any]) -> None:
     """``hiper convert --degrade``: frames written as the sensor would, and the pose error."""
     err, where = data["pose_error"], safe_text(data["output"])
     out.print(f"wrote {data['frames_written']} frames to {where} as a {data['profile']} sensor "
               f"(seed {data['seed']}); pose error RMS {err['rms_m']:.3f} m, final {err['final_m']:.3f} m; "
               f"truth in {where}/gt")
     _skipped(out, data["skipped"])
+
+
+def show_replay_start(out: Any, log: object, frames: int, endpoint: str) -> None:
+    """``hiper replay`` before the first frame: which log, how many frames, where to."""
+    out.print(f"replaying {safe_text(log)} ({frames} frames) on zenoh://{safe_text(endpoint)}")
 
 
 def show_replayed(out: Any, data: dict[str, Any]) -> None:
