@@ -6,7 +6,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-__all__ = ["FrameBar", "download_bar", "frame_progress", "unit_progress"]
+__all__ = ["FrameBar", "UnitBar", "download_bar", "frame_progress", "unit_progress"]
 
 
 class FrameBar:
@@ -63,9 +63,23 @@ def download_bar(name: str) -> Iterator[Any]:
         yield progress
 
 
+class UnitBar:
+    """A rich progress bar over units of work: ``start(total)`` once, then ``step(what, n)``."""
+
+    def __init__(self, bar: Any) -> None:
+        self._bar = bar
+        self._task: Any = None
+
+    def start(self, total: int) -> None:
+        self._task = self._bar.add_task("", total=total)
+
+    def step(self, what: str, n: int) -> None:
+        self._bar.update(self._task, advance=n, description=what)
+
+
 @contextmanager
-def unit_progress(label: str, out: Any, total: int, *, enabled: bool = True) -> Iterator[Any]:
-    """A bar over ``total`` units of work; yields ``step(what, n)`` (None when not ``enabled``)."""
+def unit_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[UnitBar | None]:
+    """A ``UnitBar`` labelled ``label`` on console ``out``; ``None`` when not ``enabled``."""
     if not enabled:
         yield None
         return
@@ -73,5 +87,4 @@ def unit_progress(label: str, out: Any, total: int, *, enabled: bool = True) -> 
 
     with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.description}"), TimeElapsedColumn(), console=out) as bar:
-        task = bar.add_task("", total=total)
-        yield lambda what, n: bar.update(task, advance=n, description=what)
+        yield UnitBar(bar)
