@@ -6,9 +6,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["QUICK", "benchmark"]
+__all__ = ["QUICK_LOG_S", "QUICK_MAPPING_S", "QUICK_RUNS", "QUICK_WORLDS", "benchmark"]
 
-QUICK = {"worlds": "house", "runs": 2, "log_s": 90.0, "mapping_s": 30.0}  # --quick: CI, a few minutes
+# --quick: one world, 2 runs, a short log (CI: a few minutes)
+QUICK_WORLDS, QUICK_RUNS, QUICK_LOG_S, QUICK_MAPPING_S = "house", 2, 90.0, 30.0
 
 
 def benchmark(out: Path, command: str, *, quick: bool = False, worlds: str | None = None,
@@ -18,7 +19,7 @@ def benchmark(out: Path, command: str, *, quick: bool = False, worlds: str | Non
               progress: Callable[[str, int], None] | None = None) -> dict[str, Any]:
     """Run the benchmark into ``out`` (``run_bench``), write ``out/report.md`` (``command`` is
     quoted in it) and return the summary with the report's path. Unset choices take the
-    paper's values (all worlds, 10 runs, 600 s logs, 60 s mapping), or ``QUICK``'s with
+    paper's values (all worlds, 10 runs, 600 s logs, 60 s mapping), or the ``QUICK_*`` ones with
     ``quick``. ``on_start(units)`` once the settings are checked; ``progress(what, n)`` per unit."""
     from hiper_cli.bench.configs import parse_configs
     from hiper_cli.bench.report import require_matplotlib, write_report
@@ -27,12 +28,12 @@ def benchmark(out: Path, command: str, *, quick: bool = False, worlds: str | Non
     from hiper_cli.bench.tasks import TaskConfig
 
     require_matplotlib()
-    world_text = worlds or (str(QUICK["worlds"]) if quick else "house,hospital,office")
+    world_text = worlds or (QUICK_WORLDS if quick else "house,hospital,office")
     settings = BenchSettings(
         worlds=tuple(w.strip() for w in world_text.split(",") if w.strip()),
-        configs=parse_configs(configs), runs=runs or (int(QUICK["runs"]) if quick else 10), seed=seed,
-        log_s=log_s or (float(QUICK["log_s"]) if quick else 600.0),
-        mapping_s=mapping_s or (float(QUICK["mapping_s"]) if quick else 60.0),
+        configs=parse_configs(configs), runs=runs or (QUICK_RUNS if quick else 10), seed=seed,
+        log_s=log_s or (QUICK_LOG_S if quick else 600.0),
+        mapping_s=mapping_s or (QUICK_MAPPING_S if quick else 60.0),
         tasks=TaskConfig(time_limit_s=time_limit_s),
     )
     if on_start is not None:

@@ -50,3 +50,7 @@ def sessions_command(kb: Kb = DEFAULT_KB, kb_docs: KbDocs = None, as_json: Json 
 
 def register(app: HiperTyper) -> None:
     app.add_typer(kb_app, name="kb")
+
+
+# hiper kb compact lives in its own module; imported here so --help lists it before kb bench
+from hiper_cli.commands import kb_compact  # noqa: E402, F401

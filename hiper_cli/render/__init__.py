@@ -7,8 +7,8 @@ server and Python users get the same results without a terminal. The modules are
 the package whose results they show (``render.evaluate`` shows ``hiper_cli.evaluate``'s).
 """
 
-from hiper_cli.render.progress import FrameBar, download_bar, frame_progress, unit_progress
+from hiper_cli.render.progress import FrameBar, download_bar, frame_progress, log_bars, unit_progress
 from hiper_cli.render.text import console, emit, print_error, print_json, safe_text
 
-__all__ = ["FrameBar", "console", "download_bar", "emit", "frame_progress", "print_error", "print_json",
-           "safe_text", "unit_progress"]
+__all__ = ["FrameBar", "console", "download_bar", "emit", "frame_progress", "log_bars", "print_error",
+           "print_json", "safe_text", "unit_progress"]

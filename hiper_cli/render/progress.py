@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
 from typing import Any
 
-__all__ = ["FrameBar", "UnitBar", "download_bar", "frame_progress", "unit_progress"]
+from hiper_cli.render.text import console
+
+__all__ = ["FrameBar", "UnitBar", "download_bar", "frame_progress", "log_bars", "unit_progress"]
 
 
 class FrameBar:
@@ -88,3 +91,20 @@ def unit_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[Uni
     with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.description}"), TimeElapsedColumn(), console=out) as bar:
         yield UnitBar(bar)
+
+
+@contextmanager
+def log_bars(n: int, *, enabled: bool = True) -> Iterator[Callable[[int, Path], Any]]:
+    """One frame bar per log of ``n`` (rich shows a single live display: each closes the last);
+    yields ``on_log(i, log)``, which returns that log's ``progress(done, total)`` or None."""
+    bars = ExitStack()
+
+    def on_log(i: int, log: Path) -> Any:
+        bars.close()
+        if not enabled:
+            return None
+        bar = bars.enter_context(frame_progress(f"perceive {i + 1}/{n} {log.name}", console()))
+        return None if bar is None else bar.update
+
+    with bars:
+        yield on_log

@@ -19,8 +19,10 @@ def _err(v: Any) -> str:
     return "inf" if v is None else _fmt(v)
 
 
-def show_qa(out: Any, data: dict[str, Any], title: str, glimpse_s: float) -> None:
-    """One log's benchmark: the table of kinds under ``title``, then the headline."""
+def show_qa(out: Any, data: dict[str, Any], log: Path, kb: str | None, glimpse_s: float) -> None:
+    """One log's benchmark (answered from ``kb``, else perceived): the kinds, then the headline."""
+    title = f"hiper eval qa {log} (detector {data['detector']}"
+    title += f", answers from {kb})" if kb else ")"
     _print_kinds(out, data, title)
     _print_headline(out, data, glimpse_s, f"questions in {data['files']['questions']}")
 
