@@ -95,3 +95,18 @@ def test_the_table_iii_report_is_the_api_s_figures():
                                max_frames=12).evaluation
     for key in ("classification", "tp", "fp", "sum_i", "sum_o", "identity_switches", "truth_instances_seen"):
         assert report.ours[key] == again.figures[key], key
+
+
+def test_the_feedback_check_scores_through_the_api():
+    """``hiper eval feedback`` perceives and scores with ``perceive_and_score``: its C2 row is
+    the API's figures of the same run."""
+    from hiper_cli.analyze.feedback import SWITCHES, evaluate_feedback
+
+    report = evaluate_feedback(FIXTURE, FIXTURE, switches={"without (C2)": SWITCHES["without (C2)"]})
+    row = report["runs"]["without (C2)"]
+    done = perceive_and_score(FIXTURE, detector="truth", background="truth", use_learned_priors=False)
+    ev = done.evaluation
+    assert (row["tp"], row["fp"], row["unknown_instances"]) == (
+        ev.foreground["tp"], ev.foreground["fp"], ev.foreground["unknown_instances"])
+    assert row["person_fp"] == ev.foreground["classification"].get("person", {"fp": 0})["fp"]
+    assert row["moving_people_speed_error_mps"] == ev.speed["moving_people_speed_error_mps"]
