@@ -55,7 +55,7 @@ def test_the_sections_hold_the_figures(scored):
     assert (ev.foreground["tp"], ev.foreground["fp"]) == (2, 2)
     # chair, shelf and walker are observed; the chair and the walker are found
     assert (ev.recall["truth_observed"], ev.recall["truth_found"]) == (3, 2)
-    assert ev.recall["recall"] == pytest.approx(2 / 3)
+    assert ev.recall["recall_observed"] == pytest.approx(2 / 3)
     assert ev.speed["walkers_matched"] == 1
     assert ev.localisation["centre_error_mean_m"] == pytest.approx(0.0707, abs=1e-3)
     assert ev.timing == {"sessions": 0, "frames": 0, "seconds": 0, "frames_per_s": None}

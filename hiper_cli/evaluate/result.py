@@ -98,7 +98,7 @@ class Evaluation:
         parts = _split(fg, _SCENE_FOREGROUND_KEYS)
         found = truth_observed - int(fg["fn_observed"])
         recall = {"truth_observed": truth_observed, "truth_found": found,
-                  "recall": found / truth_observed if truth_observed else None, **parts["recall"]}
+                  "recall_observed": found / truth_observed if truth_observed else None, **parts["recall"]}
         if "detector_ceiling" in figures:
             recall["detector_ceiling"] = figures["detector_ceiling"]
         return cls(log, str(figures["world"]), scored, "scene", figures, figures["background"],
