@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
@@ -23,7 +23,8 @@ from hiper_cli.render.evaluate import show_scene_eval
         "class, classified precision, centre error, "
         "unknown instances on no real object, person instances per person, walker speed). With "
         "--ceiling DETECTOR it also runs that detector (hiper eval detector) and prints hiper's recall "
-        "of the nameable objects seen clearly beside the detector's own.\n\n"
+        "of the nameable objects seen clearly beside the detector's own. --kb may also name a JSON "
+        "export (hiper export --format json).\n\n"
         "Example: hiper perceive ../shared/worlds/bookstore --kb bs.hiper && "
         "hiper eval scene ../shared/worlds/bookstore --kb bs.hiper"
     ),
@@ -36,33 +37,10 @@ def eval_scene(
         None, "--ceiling", help="Also score this detector's own recall (yolox, onnx:PATH, log, truth)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    from hiper_cli.errors import LogError
-    from hiper_cli.evaluate.scene import score_scene
-    from hiper_cli.evaluate.surfaces import load_surfaces
-    from hiper_cli.graph import open_kb_for_reading
-    from hiper_cli.perceive.logs.world_truth import load_world_truth
+    from hiper_cli.evaluate import evaluate_kb
 
-    if not (log / "gt" / "instances.json").exists() and (log / "gt" / "world.json").exists():
-        raise LogError(f"{log / 'gt' / 'instances.json'}: not found; this hiper sim log was made before "
-                       "hiper sim wrote scene truth: make it again with hiper sim, or score it with "
-                       "hiper eval background / hiper eval foreground")
-    truth = load_world_truth(log)
-    surfaces = load_surfaces(log)
-    with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
-        instances = knowledge.instances()
-    data = score_scene(truth, surfaces, instances)
-    if ceiling is not None:
-        data["detector_ceiling"] = _ceiling(log, ceiling, data["foreground"]["matched_truth_ids"])
+    data = evaluate_kb(kb, log, docs_dir=kb_docs, ceiling=ceiling).figures
     emit(data, json_out, show_scene_eval)
-
-
-def _ceiling(log: Path, detector: str, matched_truth_ids: list[int]) -> dict[str, Any]:
-    from hiper_cli.evaluate.detector import detector_ceiling, recall_beside_ceiling
-    from hiper_cli.perceive.detect import make_detector
-    from hiper_cli.perceive.logs import open_log
-
-    result = detector_ceiling(log, open_log(log), make_detector(detector, log_path=log))
-    return {**recall_beside_ceiling(result, matched_truth_ids), "detector": detector}
 
 
 def register(app: typer.Typer) -> None:
