@@ -9,6 +9,7 @@ from hiper_cli.graph.kb import (
     KbConfig,
     KnowledgeBase,
     SyncReport,
+    migrate_kb,
     open_kb,
     open_kb_for_reading,
 )
@@ -19,6 +20,7 @@ __all__ = [
     "KbConfig",
     "KnowledgeBase",
     "SyncReport",
+    "migrate_kb",
     "open_kb",
     "open_kb_for_reading",
 ]
