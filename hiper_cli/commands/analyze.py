@@ -33,10 +33,9 @@ EnvOption = Annotated[str | None, typer.Option("--env", help="Environment (defau
 
 def _window(kb: Any, t_from: str | None, t_to: str | None, last: str | None, daily: str | None) -> Any:
     from hiper_cli.analyze import resolve_window
-    from hiper_cli.graph.columns import newest_stamp_s
 
     return resolve_window(
-        t_from=t_from, t_to=t_to, last=last, daily=daily, newest_stamp_s=newest_stamp_s(kb.docs)
+        t_from=t_from, t_to=t_to, last=last, daily=daily, newest_stamp_s=kb.newest_sighting_s()
     )
 
 

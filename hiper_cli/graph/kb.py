@@ -29,6 +29,7 @@ import numpy as np
 from hiper_cli import DEFAULT_KB
 from hiper_cli.errors import ConfigError, GraphDamagedError, KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
+from hiper_cli.graph.door import DOCUMENTS_FILE, KbDoor, is_knowledge_base
 from hiper_cli.graph.location import kb_location
 from hiper_cli.graph.migrate import GRAPH_REBUILD_KEY, MigrationReport, migrate_documents
 from hiper_cli.graph.ontology import (
@@ -52,12 +53,12 @@ __all__ = [
     "KbConfig",
     "KnowledgeBase",
     "SyncReport",
+    "is_knowledge_base",
     "migrate_kb",
     "open_kb",
     "open_kb_for_reading",
 ]
 
-DOCUMENTS_FILE = "documents.sqlite"
 GRAPH_DIR = "graph"
 
 
@@ -127,9 +128,10 @@ def _value(term: Any) -> Any:
     return str(term)
 
 
-class KnowledgeBase(KbReads):
+class KnowledgeBase(KbReads, KbDoor):
     """Open with ``open_kb``. Not thread-safe; one writer process at a time. The typed reads
-    of the query layer come from ``KbReads`` (``reads.py``)."""
+    of the query layer come from ``KbReads`` (``reads.py``), those of the other packages from
+    ``KbDoor`` (``door.py``)."""
 
     def __init__(
         self,

@@ -21,6 +21,7 @@ from typing import Any
 
 from hiper_cli import DEFAULT_KB
 from hiper_cli.errors import KnowledgeBaseError
+from hiper_cli.graph.door import DOCUMENTS_FILE
 from hiper_cli.graph.location import kb_location
 from hiper_cli.graph.sqlite_guard import GuardedConnection, connect_read_only, inspect_existing, translate
 from hiper_cli.graph.versions import SCHEMA_VERSION, check_version, stored_version
@@ -28,7 +29,6 @@ from hiper_cli.graph.versions import SCHEMA_VERSION, check_version, stored_versi
 __all__ = ["GRAPH_REBUILD_KEY", "STEPS", "MigrationReport", "MigrationStep", "backup_path",
            "migrate_documents"]
 
-DOCUMENTS_FILE = "documents.sqlite"
 GRAPH_REBUILD_KEY = "graph_rebuild"
 
 
