@@ -9,8 +9,7 @@ import re
 import numpy as np
 import pytest
 
-from hiper_cli.graph import open_kb
-from hiper_cli.model import Box3D, FrameResult, Instance, Observation
+from tests.kb_helpers import small_kb
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "hiper_cli"
@@ -62,36 +61,6 @@ def test_the_check_catches_a_planted_reach_around(tmp_path):
     assert len(_offences(planted)) == 5
 
 
-def _small_kb(root: pathlib.Path):
-    """One session of three frames: a chair seen twice, a person walking, a floor."""
-    kb = open_kb(root)
-    env = kb.environment("flat")
-    session = kb.start_session(env, "/logs/flat", ["background", "foreground"])
-    chair = Instance("foreground", "chair", Box3D(np.array([1.0, 2.0, 0.45]), np.array([0.5, 0.5, 0.9])),
-                     0.0, 0.0)
-    person = Instance("foreground", "person", Box3D(np.array([3.0, 1.0, 0.9]), np.array([0.5, 0.4, 1.7])),
-                      0.0, 0.0, state="dynamic")
-    floor = Instance("background", "floor", Box3D(np.array([2.0, 2.0, -0.01]), np.array([6.0, 6.0, 0.02])),
-                     0.0, 0.0)
-    rows = []
-    for k in range(3):
-        stamp_s = float(k)
-        rows.append([stamp_s, 3.0 + 0.5 * k, 1.0, 0.9, 0.5, 0.0, 0.0])
-        seen = Observation("foreground", "chair", 0.9, stamp_s, k, Box3D(np.array([1.0, 2.0, 2.0]),
-                                                                       np.array([0.5, 0.5, 0.9])),
-                           instance_uuid=chair.uuid)
-        chair.observation_uuids.append(seen.uuid)
-        chair.last_seen_s = person.last_seen_s = floor.last_seen_s = stamp_s
-        person.box = Box3D(np.array(rows[-1][1:4]), person.box.extent_m)
-        person.data = {"trajectory": [list(r) for r in rows]}
-        T_map_cam = np.eye(4)
-        kb.write_frame(session, FrameResult(observations=[seen], instances=[chair, person, floor]),
-                       pose_id=k, stamp_s=stamp_s, T_map_cam=T_map_cam)
-    kb.end_session(session)
-    kb.sync_graph()
-    return kb
-
-
 def _api_blocks() -> list[str]:
     text = DOC.read_text()
     api = text[text.index("## The API"):]
@@ -107,7 +76,7 @@ def test_docs_kb_md_shows_the_api():
 def test_the_api_examples_of_docs_kb_md_run(tmp_path, block):
     """Each example runs against the small knowledge base as ``kb``; its ``assert`` lines are
     the documented answers."""
-    kb = _small_kb(tmp_path / "flat.hiper")
+    kb = small_kb(tmp_path / "flat.hiper")
     try:
         exec(compile(_api_blocks()[block], f"docs/kb.md block {block}", "exec"),
              {"kb": kb, "np": np, "tmp_path": tmp_path})
