@@ -69,7 +69,15 @@ class KbDoor:
     graph: Any
     kb_id: str
 
-    # -- instances and their trajectories, as columns ----------------------------------------
+    # -- instances in a window, and their trajectories as columns -----------------------------
+
+    def instances_seen(self, t_start_s: float | None = None, t_end_s: float | None = None, *,
+                       layer: str | None = None, class_name: str | None = None) -> list[Instance]:
+        """The instances seen at some time in [t_start_s, t_end_s] (s; None leaves that end open):
+        first sighting at or before its end, last sighting at or after its start; stamp order."""
+        found = self.docs.find(type="instance", layer=layer, class_name=class_name, t_start_s=t_start_s)
+        return [Instance.from_dict(d) for d in found
+                if t_end_s is None or float(d["first_seen_s"]) <= t_end_s]
 
     def instance_columns(self, class_name: str | None = None, t_start_s: float | None = None,
                          t_end_s: float | None = None, *, layer: str = "foreground") -> InstanceColumns:

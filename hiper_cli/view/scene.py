@@ -188,9 +188,7 @@ def load_scene(kb: KnowledgeBase, window: TimeWindow | None = None, log: Path | 
     that of the sessions that perceived this log (all sessions when none did)."""
     window = window or TimeWindow()
     background, foreground = [], []
-    for inst in kb.instances():
-        if not window.overlaps(float(inst.first_seen_s), float(inst.last_seen_s)):
-            continue
+    for inst in kb.instances_seen(window.start_s, window.end_s):
         if inst.layer == "background":
             background.append(_background(inst))
         elif inst.layer == "foreground" and (track := _track(inst, window)) is not None:
