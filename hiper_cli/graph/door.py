@@ -27,6 +27,7 @@ from hiper_cli.graph.columns import (
     trajectory_columns,
 )
 from hiper_cli.graph.documents import DocumentStore
+from hiper_cli.graph.history import Change
 from hiper_cli.model import Environment, Instance, Observation
 
 __all__ = ["DOCUMENTS_FILE", "KbDoor", "KbSizes", "SessionPoses", "is_knowledge_base"]
@@ -132,6 +133,14 @@ class KbDoor:
             "SUM(json_array_length(json_extract(body, '$.data.trajectory'))) FROM docs "
             "WHERE type = 'instance' AND layer = 'foreground'").fetchone()
         return KbSizes(counts, int(apart or 0) + int(inline or 0))
+
+    def change_events(self, session_id: int | None = None) -> list[Change]:
+        """The change events (moved | removed | added) found when a session was aligned to the
+        place's memory, of every session or of ``session_id``, in stamp order."""
+        return [Change(str(d["kind"]), str(d["class"]), str(d["instance_uuid"]), int(d["session"]),
+                       float(d["stamp_s"]), d.get("from_m"), d.get("to_m"), str(d["uuid"]))
+                for d in self.docs.find(type="change")
+                if session_id is None or int(d["session"]) == session_id]
 
     # -- writes -------------------------------------------------------------------------------
 
