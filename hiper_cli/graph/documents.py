@@ -41,10 +41,10 @@ from hiper_cli.graph.sqlite_guard import (
 )
 from hiper_cli.graph.trajectories import SCHEMA as TRAJECTORIES_SCHEMA
 from hiper_cli.graph.trajectories import TrajectoryStore
+from hiper_cli.graph.versions import SCHEMA_VERSION, check_version, stored_version
 
 __all__ = ["SCHEMA_VERSION", "DocumentStore", "Session", "dumps"]
 
-SCHEMA_VERSION = 1
 PAGE_SIZE = 2048
 # Observations' spatial-index rows and instance links are first appended to two small staging
 # tables (``obs_cells_new``, ``links_new``) and moved into their clustered tables once this many
@@ -213,6 +213,7 @@ class DocumentStore(ChangeFeed, Lookups):
         self.read_only = read_only
         if self.path.is_file() and self.path.stat().st_size > 0:
             inspect_existing(self.path)  # read-only: refuse another program's file before any write
+            check_version(self.path.parent, stored_version(self.path))  # and another schema version
         try:
             if read_only:
                 self._db = GuardedConnection(connect_read_only(self.path), self.path)
@@ -251,12 +252,6 @@ class DocumentStore(ChangeFeed, Lookups):
             if isinstance(err, KnowledgeBaseError):
                 raise
             raise translate(self.path, err) from err
-        version = self.meta("schema_version")
-        if version is not None and int(version) != SCHEMA_VERSION:
-            raise KnowledgeBaseError(
-                f"{self.path}: schema version {version}, this hiper reads {SCHEMA_VERSION}; "
-                "export with the hiper that wrote it and import here"
-            )
         self._seq: int | None = None
         cell = self.meta("grid_cell_m")
         legacy = self._scalar("SELECT name FROM sqlite_master WHERE name = 'obs_grid'") is not None
