@@ -110,3 +110,8 @@ def test_the_feedback_check_scores_through_the_api():
         ev.foreground["tp"], ev.foreground["fp"], ev.foreground["unknown_instances"])
     assert row["person_fp"] == ev.foreground["classification"].get("person", {"fp": 0})["fp"]
     assert row["moving_people_speed_error_mps"] == ev.speed["moving_people_speed_error_mps"]
+
+
+def test_eval_changes_names_a_folder_without_changes_json(tmp_path):
+    result = CliRunner().invoke(app, ["eval", "changes", str(tmp_path), "--kb", str(tmp_path / "kb.hiper")])
+    assert result.exit_code != 0 and "no readable changes.json" in " ".join(result.output.split())

@@ -25,7 +25,7 @@ def changes(
     Example: hiper sim --sessions 3 --changes 6 -o days && for s in 1 2 3; do hiper perceive
     days/session_$s --kb days.hiper --detector truth; done && hiper eval changes days --kb days.hiper
     """
-    from hiper_cli.bench.changes import evaluate_changes
+    from hiper_cli.evaluate import evaluate_changes
 
     emit(evaluate_changes(kb, truth).to_dict(), json_out, show_changes)
 

@@ -8,10 +8,12 @@ background, foreground, speed, localisation, recall and timing figures):
 - ``perceive_and_score(log, ...)``: an in-memory perception run scored per observation
   (``hiper eval foreground``, ``hiper bench``, ``hiper eval feedback``);
 - ``evaluate_foreground`` / ``evaluate_background``: the paper's Table III / Table II reports;
-  ``detector_ceiling``: what the 2D detector alone finds.
+  ``detector_ceiling``: what the 2D detector alone finds; ``evaluate_changes``: a knowledge base
+  of several sessions against the changes ``hiper sim --sessions`` made (``hiper eval changes``).
 """
 
 from hiper_cli.evaluate.background import BackgroundReport, evaluate_background
+from hiper_cli.evaluate.changes import ChangeReport, evaluate_changes
 from hiper_cli.evaluate.detector import DetectorCeiling, detector_ceiling, recall_beside_ceiling
 from hiper_cli.evaluate.foreground import (
     ForegroundReport,
@@ -27,6 +29,7 @@ from hiper_cli.evaluate.result import SECTIONS, Evaluation
 __all__ = [
     "SECTIONS",
     "BackgroundReport",
+    "ChangeReport",
     "DetectorCeiling",
     "Evaluation",
     "ForegroundReport",
@@ -34,6 +37,7 @@ __all__ = [
     "PerceptionScore",
     "detector_ceiling",
     "evaluate_background",
+    "evaluate_changes",
     "evaluate_foreground",
     "evaluate_kb",
     "parse_settings",
