@@ -23,7 +23,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -69,14 +69,21 @@ def replace_block(text: str, block: str) -> str:
 
 # --- running hiper ---
 
+REUSE = False  # --reuse: read a command's saved output in OUT instead of running it again
+
+
 def hiper(*args: str, out: Path | None = None) -> str:
     """Run `python -m hiper_cli ARGS` on this checkout; stdout (also written to `out`)."""
+    if REUSE and out is not None and out.is_file():
+        return out.read_text()
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     env.setdefault("HIPER_MODELS", str(SHARED / "models"))
     done = subprocess.run([sys.executable, "-m", "hiper_cli", *args], capture_output=True, text=True,
                           env=env, check=False)
     if out is not None:
-        out.write_text(done.stdout + done.stderr)
+        out.write_text(done.stdout)
+        if done.stderr:
+            out.with_name(out.name + ".err").write_text(done.stderr)
     if done.returncode:
         tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
         sys.exit(f"readme_figures: hiper {' '.join(args)} failed: {tail[0]}")
@@ -98,8 +105,9 @@ def spread(values: list[float], fmt: str, unit: str = "") -> str:
     return (lo if lo == hi else f"{lo}-{hi}") + unit
 
 
-def each(values: list[float], fmt: str) -> str:
-    return ", ".join(format(v, fmt) for v in values)
+def each(values: Sequence[float | None], fmt: str) -> str:
+    """One value per log, in the logs' order; `-` where a log has none."""
+    return ", ".join("-" if v is None else format(v, fmt) for v in values)
 
 
 def sim_logs(out: Path, args: argparse.Namespace) -> list[Path]:
@@ -149,8 +157,7 @@ def foreground(out: Path, args: argparse.Namespace) -> dict[str, Any]:
     first = args.detectors[0]
     per_log = f"{names(logs)}"
     fps = " / ".join(each([r["frames_per_s"] for r in runs[d]], ".1f") + f" (`{d}`)" for d in args.detectors)
-    speed = " / ".join(each([r["moving_people_speed_error_mps"] for r in runs[d]
-                             if r.get("moving_people_speed_error_mps") is not None], "+.3f") + f" (`{d}`)"
+    speed = " / ".join(each([r.get("moving_people_speed_error_mps") for r in runs[d]], "+.3f") + f" (`{d}`)"
                        for d in args.detectors)
     cmd = "`hiper eval foreground LOG --detector D --no-ablation`"
     return {"rows": [
@@ -253,7 +260,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--kb-size", type=int, default=500_000)
     parser.add_argument("--quick-bench", action="store_true", help="hiper bench --quick (a smoke run)")
     parser.add_argument("--render-only", action="store_true", help="rewrite the README from the JSON only")
+    parser.add_argument("--reuse", action="store_true",
+                        help="use the outputs a run left in OUT (same logs); the section keeps its source")
     args = parser.parse_args(argv)
+    global REUSE
+    REUSE = args.reuse
     figures: dict[str, Any] = json.loads(FIGURES.read_text()) if FIGURES.exists() else {}
     if not args.render_only:
         unknown = set(args.only.split(",")) - set(SECTIONS)
@@ -263,7 +274,10 @@ def main(argv: list[str]) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         for name in args.only.split(","):
             print(f"readme_figures: measuring {name}", file=sys.stderr)
+            old = figures.get(name, {}).get("source")
             figures[name] = SECTIONS[name](args.out, args)
+            if args.reuse and old:
+                figures[name]["source"] = f"{old}; rendered again from its outputs"
             FIGURES.write_text(json.dumps(figures, indent=1, ensure_ascii=False) + "\n")
     README.write_text(replace_block(README.read_text(), render(figures)))
     print(f"readme_figures: README.md rewritten from {FIGURES.relative_to(ROOT)}", file=sys.stderr)

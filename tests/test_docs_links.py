@@ -35,3 +35,14 @@ def test_a_link_that_names_no_single_file_stays_broken(tmp_path):
         (tmp_path / "docs" / folder / "page.md").write_text("x\n")
     (tmp_path / "docs" / "index.md").write_text("[p](page.md) [q](gone.md)\n")
     assert docs_links.check(tmp_path, fix=True) == ["docs/index.md: page.md", "docs/index.md: gone.md"]
+
+
+def test_every_result_page_is_in_the_index():
+    """docs/results/README.md names every page of docs/results/ and of its archive, so a reader
+    finds the current page of a topic and nothing is left unlisted."""
+    results = ROOT / "docs" / "results"
+    index = (results / "README.md").read_text()
+    pages = [p.relative_to(results).as_posix() for p in results.rglob("*.md") if p.name != "README.md"
+             and "bench-" not in p.parent.name]
+    missing = [p for p in pages if f"({p})" not in index and f"`{p}`" not in index]
+    assert not missing, f"docs/results/README.md does not list {missing}: add each under its topic"
