@@ -23,7 +23,7 @@ def convert(log: Log, out: o.Out, to: o.To = None, rgb_format: o.RgbFormat = "ra
     from hiper_cli.sensor.convert import rewrite_log
 
     label = f"writing {safe_text(out)}" if degrade is None else f"degrading to {safe_text(out)}"
-    with frame_progress(label, console(), enabled=not json_out) as bar:
+    with frame_progress(label, console(), enabled=not json_out, late=True) as bar:
         data = rewrite_log(log, out, log_options, to=to, rgb_format=rgb_format, depth_encoding=depth_encoding,
                            pose_as=pose_as, degrade=degrade, seed=seed, pose_drift=pose_drift,
                            overwrite=overwrite, on_start=bar.start if bar else None,

@@ -36,9 +36,9 @@ def fetch_command(name: o.ModelName, directory: o.DirOption = None, from_url: o.
     """
     from hiper_cli.perceive.detect.install import fetch_named_model
 
-    with download_bar(name) as progress:
+    with download_bar() as bar:
         data = fetch_named_model(name, directory, url=from_url, allow_unverified=trust_unverified,
-                                 progress=progress, timeout_s=timeout_s)
+                                 on_start=bar.start, progress=bar.update, timeout_s=timeout_s)
     emit(data, as_json, show_fetched)
 
 

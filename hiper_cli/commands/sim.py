@@ -16,16 +16,18 @@ def sim(out: o.Out, world: o.World = "house", seconds: o.Seconds = 60.0, seed: o
         png_compression: o.PngCompression = 3, sensor: o.Sensor = "structured-light",
         overwrite: o.Overwrite = False, sessions: o.Sessions = 1, changes: o.Changes = 0,
         as_json: Json = False) -> None:
+    from hiper_cli.sim import SimConfig
     from hiper_cli.sim.run import run_sim
 
+    config = SimConfig.from_flat(
+        rate_hz=rate_hz, mapping_s=mapping_s, width_px=width, height_px=height, max_range_m=max_range_m,
+        speed_mps=speed_mps, depth_noise=depth_noise, miss_rate=miss_rate, jitter_frac=jitter,
+        false_positives_per_image=false_positives, confusion_rate=confusion, png_compression=png_compression,
+        sensor=sensor)
     label = f"sim {world} x{sessions}" if sessions > 1 or changes else f"sim {safe_text(world)}"
     with frame_progress(label, console(), enabled=not as_json) as bar:
-        data = run_sim(out, world=world, seconds=seconds, seed=seed, sessions=sessions, changes=changes,
-                       overwrite=overwrite, progress=bar.update if bar else None, rate_hz=rate_hz,
-                       mapping_s=mapping_s, width_px=width, height_px=height, max_range_m=max_range_m,
-                       speed_mps=speed_mps, depth_noise=depth_noise, miss_rate=miss_rate, jitter_frac=jitter,
-                       false_positives_per_image=false_positives, confusion_rate=confusion,
-                       png_compression=png_compression, sensor=sensor)
+        data = run_sim(out, config, world=world, seconds=seconds, seed=seed, sessions=sessions,
+                       changes=changes, overwrite=overwrite, progress=bar.update if bar else None)
     emit(data, as_json, lambda screen, d: show_sim(screen, d, world, seed))
 
 

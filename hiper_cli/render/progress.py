@@ -9,7 +9,8 @@ from typing import Any
 
 from hiper_cli.render.text import console
 
-__all__ = ["FrameBar", "UnitBar", "download_bar", "frame_progress", "log_bars", "unit_progress"]
+__all__ = ["DownloadBar", "FrameBar", "UnitBar", "download_bar", "frame_progress", "log_bars",
+           "unit_progress"]
 
 
 class FrameBar:
@@ -32,48 +33,89 @@ class FrameBar:
         self._bar.update(self._task, completed=done, total=total, rate=done / elapsed if elapsed > 0 else 0.0)
 
 
+def _frame_bar(label: str, out: Any) -> Any:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
+                    TextColumn("{task.fields[rate]:.1f} frames/s"), TimeElapsedColumn(), console=out)
+
+
+class _LateFrameBar(FrameBar):
+    """A ``FrameBar`` that appears only once ``start`` is called: nothing is drawn for a run
+    refused before its first frame."""
+
+    def __init__(self, label: str, out: Any, stack: ExitStack) -> None:
+        super().__init__(None)
+        self._label, self._out, self._stack = label, out, stack
+
+    def start(self, total: int) -> None:
+        self._bar = self._stack.enter_context(_frame_bar(self._label, self._out))
+        super().start(total)
+
+
 @contextmanager
-def frame_progress(label: str, out: Any, *, enabled: bool = True, total: int | None = None
-                   ) -> Iterator[FrameBar | None]:
+def frame_progress(label: str, out: Any, *, enabled: bool = True, total: int | None = None,
+                   late: bool = False) -> Iterator[FrameBar | None]:
     """A ``FrameBar`` labelled ``label`` on console ``out`` (started when ``total`` is given);
-    ``None`` when not ``enabled`` (``--json``)."""
+    ``None`` when not ``enabled`` (``--json``). ``late``: drawn from its ``start`` on."""
     if not enabled:
         yield None
         return
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
-                  TextColumn("{task.fields[rate]:.1f} frames/s"), TimeElapsedColumn(), console=out) as bar:
+    if late:
+        with ExitStack() as stack:
+            yield _LateFrameBar(label, out, stack)
+        return
+    with _frame_bar(label, out) as bar:
         frame_bar = FrameBar(bar)
         if total is not None:
             frame_bar.start(total)
         yield frame_bar
 
 
+class DownloadBar:
+    """A transient download bar on stderr, drawn from ``start(name, total)`` on; then
+    ``update(done, total)`` as ``fetch_model`` reports."""
+
+    def __init__(self, stack: ExitStack) -> None:
+        self._stack = stack
+        self._bar: Any = None
+        self._task: Any = None
+
+    def start(self, name: str, total: int | None) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TransferSpeedColumn
+
+        self._bar = self._stack.enter_context(Progress(
+            TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TransferSpeedColumn(),
+            console=Console(stderr=True), transient=True))
+        self._task = self._bar.add_task(name, total=total)
+
+    def update(self, done: int, total: int | None) -> None:
+        self._bar.update(self._task, completed=done, total=total)
+
+
 @contextmanager
-def download_bar(name: str) -> Iterator[Any]:
-    """A transient download bar on stderr; yields ``progress(done, total)`` for ``fetch_model``."""
-    from rich.console import Console
-    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TransferSpeedColumn
-
-    with Progress(TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TransferSpeedColumn(),
-                  console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task(name, total=None)
-
-        def progress(done: int, size: int | None) -> None:
-            bar.update(task, completed=done, total=size)
-
-        yield progress
+def download_bar() -> Iterator[DownloadBar]:
+    """A ``DownloadBar``, closed on leaving."""
+    with ExitStack() as stack:
+        yield DownloadBar(stack)
 
 
 class UnitBar:
-    """A rich progress bar over units of work: ``start(total)`` once, then ``step(what, n)``."""
+    """A rich progress bar over units of work, drawn from ``start(total)`` on (nothing for a
+    run refused before it starts); then ``step(what, n)``."""
 
-    def __init__(self, bar: Any) -> None:
-        self._bar = bar
+    def __init__(self, label: str, out: Any, stack: ExitStack) -> None:
+        self._label, self._out, self._stack = label, out, stack
+        self._bar: Any = None
         self._task: Any = None
 
     def start(self, total: int) -> None:
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self._bar = self._stack.enter_context(Progress(
+            TextColumn(f"[bold]{self._label}"), BarColumn(), MofNCompleteColumn(),
+            TextColumn("{task.description}"), TimeElapsedColumn(), console=self._out))
         self._task = self._bar.add_task("", total=total)
 
     def step(self, what: str, n: int) -> None:
@@ -86,11 +128,8 @@ def unit_progress(label: str, out: Any, *, enabled: bool = True) -> Iterator[Uni
     if not enabled:
         yield None
         return
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
-                  TextColumn("{task.description}"), TimeElapsedColumn(), console=out) as bar:
-        yield UnitBar(bar)
+    with ExitStack() as stack:
+        yield UnitBar(label, out, stack)
 
 
 @contextmanager

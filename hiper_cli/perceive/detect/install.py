@@ -7,6 +7,7 @@ line, Python users and any other front end get the same answer.
 from __future__ import annotations
 
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -23,11 +24,15 @@ def list_models(directory: Path | None = None) -> dict[str, Any]:
 
 
 def fetch_named_model(name: str, directory: Path | None = None, *, url: str | None = None,
-                      allow_unverified: bool = False, progress: Progress | None = None,
-                      timeout_s: float = 30.0) -> dict[str, Any]:
+                      allow_unverified: bool = False,
+                      on_start: Callable[[str, int | None], None] | None = None,
+                      progress: Progress | None = None, timeout_s: float = 30.0) -> dict[str, Any]:
     """Download the catalog's model ``name`` (or alias) into the models folder (``fetch_model``):
-    where it is and how it came."""
+    where it is and how it came. ``on_start(model name, size in bytes or None)`` once the name
+    is known, before the download."""
     model = entry(name)
+    if on_start is not None:
+        on_start(model.name, model.size_bytes)
     result = fetch_model(model, models_dir(directory), url=url, allow_unverified=allow_unverified,
                          progress=progress, timeout_s=timeout_s)
     return {"name": model.name, "path": str(result.path), "sha256": result.sha256,
