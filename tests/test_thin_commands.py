@@ -13,7 +13,7 @@ MAX_COMMAND_LINES = 42  # a command function, its decorator and its docstring (t
 # being thinned in parallel work (issue 56): query and analyze by the knowledge-base door, eval
 # scene by the one measuring API; _rows (the door's table printer) belongs in hiper_cli.render.
 # Remove a name once its module keeps the rules.
-PENDING = {"query", "analyze", "eval_scene", "_rows"}
+PENDING: set[str] = set()
 
 
 def _modules() -> list[pathlib.Path]:

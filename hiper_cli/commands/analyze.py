@@ -7,8 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import group
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption, group
 
 __all__ = ["analyze_app", "register"]
 
@@ -42,11 +41,11 @@ def features_command(
     Example: hiper analyze features --class person --kb scene.hiper --plot person.png
     """
     from hiper_cli.analyze.requests import WindowText, features_at
-    from hiper_cli.commands._rows import emit
+    from hiper_cli.render.rows import emit_view
 
     run = features_at(kb, class_name, WindowText(t_from, t_to, last, daily), kb_docs=kb_docs, plot=plot,
                       store=not no_store)
-    emit(run.to_dict(), run.view(), as_json)
+    emit_view(run.to_dict(), run.view(), as_json)
 
 
 def register(app: typer.Typer) -> None:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION
+from hiper_cli.cmdline import JSON_OPTION
 from hiper_cli.commands.analyze import analyze_app
 
 __all__ = ["register"]
@@ -27,10 +27,10 @@ def bench_command(
     """
     from hiper_cli.analyze.bench import run_analyze_bench
     from hiper_cli.analyze.views import bench_lines
-    from hiper_cli.commands._rows import emit
+    from hiper_cli.render.rows import emit_view
 
     data = run_analyze_bench(kb, hours=hours)
-    emit(data, bench_lines(data, str(kb)), as_json)
+    emit_view(data, bench_lines(data, str(kb)), as_json)
 
 
 def register(app: typer.Typer) -> None:

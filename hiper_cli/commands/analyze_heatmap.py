@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands.analyze import DailyOption, EnvOption, FromOption, LastOption, ToOption, analyze_app
 
 __all__ = ["register"]
@@ -33,11 +33,11 @@ def heatmap_command(
     Example: hiper analyze heatmap --class person --daily 09:00-10:00 --inverse -o maps
     """
     from hiper_cli.analyze.requests import WindowText, heatmap_at
-    from hiper_cli.commands._rows import emit
+    from hiper_cli.render.rows import emit_view
 
     run = heatmap_at(kb, class_name, WindowText(t_from, t_to, last, daily), out_dir, kb_docs=kb_docs,
                      env_name=env, map_yaml=map_yaml, inverse=inverse)
-    emit(run.to_dict(), run.view(), as_json)
+    emit_view(run.to_dict(), run.view(), as_json)
 
 
 def register(app: typer.Typer) -> None:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands.analyze import EnvOption, analyze_app
 
 __all__ = ["register"]
@@ -30,10 +30,10 @@ def map_command(
     Example: hiper analyze map --kb scene.hiper -o maps/floor.yaml
     """
     from hiper_cli.analyze.requests import map_at
-    from hiper_cli.commands._rows import emit
+    from hiper_cli.render.rows import emit_view
 
     run = map_at(kb, out, kb_docs=kb_docs, env_name=env, map_yaml=map_yaml, resolution_m=resolution_m)
-    emit(run.to_dict(), run.view(), as_json)
+    emit_view(run.to_dict(), run.view(), as_json)
 
 
 def register(app: typer.Typer) -> None:

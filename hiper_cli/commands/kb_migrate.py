@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands.kb import kb_app
+from hiper_cli.render import console, print_json
 
 __all__ = ["register"]
 

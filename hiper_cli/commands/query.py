@@ -7,8 +7,7 @@ from typing import Annotated, Any
 import typer
 from typer.core import TyperGroup
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import HiperTyper
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, HiperTyper, KbDocsOption, KbOption
 
 
 class _AskByDefault(TyperGroup):
@@ -46,13 +45,13 @@ def ask_command(
 
     Example: hiper query "where was the bottle last seen" --kb house.hiper
     """
-    from hiper_cli.commands._rows import emit
     from hiper_cli.query.request import run_query
     from hiper_cli.query.views import query_view
+    from hiper_cli.render.rows import emit_view
 
     answer = run_query(kb, words, sparql=sparql, kb_docs=kb_docs, pose=pose, at=at, now=now, limit=limit,
                        timeout_s=timeout_s)
-    emit(answer.to_dict(), query_view(answer), as_json)
+    emit_view(answer.to_dict(), query_view(answer), as_json)
 
 
 def register(app: typer.Typer) -> None:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION
+from hiper_cli.cmdline import JSON_OPTION
 from hiper_cli.commands.query import query_app
 
 __all__ = ["register"]
@@ -25,13 +25,13 @@ def bench_command(
 
     Example: hiper query bench --instances 10000 --observations 1000000 --kb /tmp/qbench.hiper
     """
-    from hiper_cli.commands._rows import emit
     from hiper_cli.query.bench import QueryBenchConfig, run_query_bench
     from hiper_cli.query.views import bench_view
+    from hiper_cli.render.rows import emit_view
 
     config = QueryBenchConfig(instances=instances, observations=observations, queries=queries)
     report = run_query_bench(config, kb_path=kb)
-    emit(report, bench_view(report), as_json)
+    emit_view(report, bench_view(report), as_json)
 
 
 def register(app: typer.Typer) -> None:

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands.query import query_app
 
 __all__ = ["register"]
@@ -28,12 +28,12 @@ def workspace_command(
 
     Example: hiper query workspace --center 1.7,1.9,0.8 --size 1.0 --kb house.hiper --json
     """
-    from hiper_cli.commands._rows import emit
     from hiper_cli.query.request import workspace_at
     from hiper_cli.query.views import workspace_view
+    from hiper_cli.render.rows import emit_view
 
     ws = workspace_at(kb, center, size, resolution_m=resolution, kb_docs=kb_docs)
-    emit(ws.to_dict(), workspace_view(ws), as_json)
+    emit_view(ws.to_dict(), workspace_view(ws), as_json)
 
 
 def register(app: typer.Typer) -> None:

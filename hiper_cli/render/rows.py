@@ -6,14 +6,14 @@ import sys
 from collections.abc import Iterable
 from typing import Any
 
-from hiper_cli.commands._render import console, print_json, safe_text
+from hiper_cli.render.text import console, print_json, safe_text
 
-__all__ = ["emit", "print_lines", "print_table"]
+__all__ = ["emit_view", "print_lines", "print_table"]
 
 _COMPACT = {"box": None, "pad_edge": False, "padding": (0, 1, 0, 0), "header_style": "bold underline"}
 
 
-def emit(data: Any, view: Any, as_json: bool) -> None:
+def emit_view(data: Any, view: Any, as_json: bool) -> None:
     """``data`` as JSON (``--json``), else ``view``: a ``TextTable``, a list of them or of lines,
     or raw text (a Turtle graph: written as it is, without rich)."""
     if as_json:
