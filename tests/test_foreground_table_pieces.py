@@ -6,6 +6,7 @@ import numpy as np
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces
+from tests.fg_constants import constants
 
 W, H = 640, 480
 
@@ -58,9 +59,9 @@ def test_pieces_apart_in_height_length_or_line_stay_apart():
         assert len(join_hidden_pieces([left, other], _hidden_everywhere, config, W, H)) == 2
     desks = [_piece(0.0, 1.6, 0.0, 0.7), _piece(2.2, 3.8, 0.0, 0.7, u0=300)]  # 3.8 m together
     assert len(join_hidden_pieces(desks, _hidden_everywhere, config, W, H)) == 2
-    off = RefineConfig(table_pieces_max_gap_m=0.0)
     right = _piece(8.6, 9.2, 1.7, 2.2, u0=300)
-    assert len(join_hidden_pieces([left, right], _hidden_everywhere, off, W, H)) == 2
+    with constants(table_pieces_max_gap_m=0.0):
+        assert len(join_hidden_pieces([left, right], _hidden_everywhere, config, W, H)) == 2
 
 
 def _table_tracker(config):

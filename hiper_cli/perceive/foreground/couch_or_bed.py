@@ -16,6 +16,12 @@ from numpy.typing import NDArray
 
 __all__ = ["BED", "COUCH", "couch_or_bed"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+COUCH_OR_BED: bool = True
+"""A blob a detection names ``couch`` or ``bed`` takes the other name when its tall part
+says so (``couch_or_bed.py``): a back along a long side is a couch's, a headboard across a
+short end a bed's (issue 17: YOLOX-Nano named a couch ``bed`` in 26 views of 27)."""
+
 COUCH, BED = "couch", "bed"
 TALL_M = 0.7  # above a seat (0.45), a mattress (0.5-0.6) and a couch's arms (0.6-0.65)
 MIN_TALL_SHARE = 0.05  # of the blob's points: a back or a headboard in view

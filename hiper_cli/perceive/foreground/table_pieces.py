@@ -37,6 +37,16 @@ if TYPE_CHECKING:
 
 __all__ = ["HIDDEN_SHARE", "TOP_HEIGHT_TOLERANCE_M", "join_hidden_pieces", "join_hidden_tracks"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+TABLE_PIECES_MAX_GAP_M: float = 0.8
+"""Two such tables of one frame facing each other across at most this gap, their tops at
+one height and the band between them at that height hidden from the camera by something
+nearer (a chair in front of the table), are one table cut in two (``table_pieces.py``;
+0: off) ..."""
+TABLE_PIECES_MAX_LENGTH_M: float = 3.5
+"""... unless joined they would be longer than this (two desks in a row, a chair before
+the gap between them)."""
+
 FloatArray = NDArray[np.float64]
 Hidden = Callable[[FloatArray], tuple[NDArray[np.bool_], NDArray[np.bool_]]]
 
@@ -65,13 +75,13 @@ def _band(
     gap = np.maximum(lo_b - hi_a, lo_a - hi_b)  # per axis; negative: they overlap along it
     axis = int(np.argmax(gap))
     other = 1 - axis
-    if gap[axis] > config.table_pieces_max_gap_m:
+    if gap[axis] > TABLE_PIECES_MAX_GAP_M:
         return None
     overlap = min(hi_a[other], hi_b[other]) - max(lo_a[other], lo_b[other])
     narrower = min(hi_a[other] - lo_a[other], hi_b[other] - lo_b[other])
     if overlap < 0.5 * narrower:
         return None
-    if max(hi_a[axis], hi_b[axis]) - min(lo_a[axis], lo_b[axis]) > config.table_pieces_max_length_m:
+    if max(hi_a[axis], hi_b[axis]) - min(lo_a[axis], lo_b[axis]) > TABLE_PIECES_MAX_LENGTH_M:
         return None
     if gap[axis] <= 0.0:
         return np.zeros((0, 3))
@@ -111,7 +121,7 @@ def join_hidden_pieces(
     table hidden in its middle joined (see the module docstring). ``hidden(points_map (K, 3))``
     returns (in the camera's view, hidden behind something nearer) per point."""
     pieces = list(tables)
-    if config.table_pieces_max_gap_m <= 0 or len(pieces) < 2:
+    if TABLE_PIECES_MAX_GAP_M <= 0 or len(pieces) < 2:
         return pieces
     joined = True
     while joined:  # three pieces past two chairs join in two rounds
@@ -135,7 +145,7 @@ def join_hidden_tracks(tracker: Tracker, hidden: Hidden, config: RefineConfig) -
     unmoved table track (live or closed) whose boxes (``SeenBox``) have their tops at one
     height, lie in line and have the band between them hidden from the camera now are one
     table. The newer folds into the older (``same_object.fold``). Returns gone uuid -> keeper."""
-    if config.table_pieces_max_gap_m <= 0:
+    if TABLE_PIECES_MAX_GAP_M <= 0:
         return {}
 
     def is_table(track: Track) -> bool:
