@@ -13,17 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import DataError, PerceptionError
-from hiper_cli.learned import (
-    FEATURE_KINDS,
-    KIND_ALTITUDE,
-    KIND_ODS,
-    KIND_SIZE,
-    AltitudeFeature,
-    ObjectDynamics,
-    SizeFeature,
-    feature_from_analysis,
-)
+from hiper_cli.errors import PerceptionError
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, check_class_names, make_detector
 from hiper_cli.perceive.foreground.amodal import (
@@ -53,6 +43,7 @@ from hiper_cli.perceive.foreground.plausible import (
     max_longest_m,
     min_longest_m,
 )
+from hiper_cli.perceive.foreground.priors import LearnedPriors
 from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import (
     REIDENTIFY_MOVED_M,
@@ -68,7 +59,7 @@ from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
-from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
+from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
     TABLE_CLASS,
     TABLE_SCORE,
@@ -105,12 +96,6 @@ WALKER_FROM_FLOOR: bool = True
 """An observation a detection names a walker class spans from the floor to its blob's top
 (the centre halfway): people stand on the floor, and a person behind a shelf or a table
 shows only the upper body (issue 17: person centres 0.5-0.8 m off in height)."""
-PRIOR_TOLERANCE: float = 0.5
-"""Size / altitude priors reject a class when a blob is outside [lo·(1-t), hi·(1+t)]."""
-PRIOR_MIN_INSTANCES: int = 3
-"""A class's learned feature is a prior only when learned from this many instances: the
-range of one TV's altitude is a point, and the views of the next TV, stand in or out, are
-not."""
 SAME_BOX_IOU: float = 0.8
 """Two detections of different classes whose boxes overlap by this IoU are one object the
 detector named twice (``classes.one_name_per_box``: a bottle and a vase, a bench and a
@@ -121,7 +106,6 @@ SUPPORT_CLASSES = ("floor", "table")
 # Named constants (not the paper's): chosen so that they never bind on the simulated worlds.
 HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
-MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this span
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 
@@ -196,76 +180,14 @@ class ForegroundStage:
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
         self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
-        self._priors: dict[tuple[str, str], ObjectDynamics | SizeFeature | AltitudeFeature] = {}
-        self._analyses_seen = -1
+        self._priors = LearnedPriors(cfg)
         self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
         self._floor_mapped = False  # the background found a floor (``complete_base``)
-        self.tracker = Tracker(cfg, self._class_prior)
+        self.tracker = Tracker(cfg, self._priors.class_prior)
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
-
-    # --- learned priors ---------------------------------------------------------------------
-    def _refresh_priors(self, world: World) -> None:
-        if len(world.analyses) == self._analyses_seen:
-            return
-        self._analyses_seen = len(world.analyses)
-        self._priors = {}
-        for a in sorted(world.analyses, key=lambda a: a.created_s):
-            if a.kind in FEATURE_KINDS:
-                try:
-                    self._priors[(a.kind, a.class_name)] = feature_from_analysis(a)
-                except DataError:  # written by an older hiper: no prior rather than no run
-                    continue
-
-    def _prior(self, kind: str, class_name: str) -> ObjectDynamics | SizeFeature | AltitudeFeature | None:
-        """The learned feature of a class, when learned from ``prior_min_instances`` instances."""
-        found = self._priors.get((kind, class_name))
-        return found if found is not None and found.instances >= PRIOR_MIN_INSTANCES else None
-
-    def _class_prior(self, class_name: str) -> ClassPrior:
-        cfg = self.config
-        ods = self._prior(KIND_ODS, class_name)
-        if not isinstance(ods, ObjectDynamics) or not cfg.use_learned_priors:
-            return ClassPrior()
-        return ClassPrior(
-            cu_mps=ods.cu_mps if cfg.learned_gates else None,
-            # a class seen only standing taught no motion: its σ is the drift of its own filter
-            sigma_mps=ods.sigma_mps if cfg.learned_motion_noise and ods.dynamic_rows else None,
-        )
-
-    def _fits_priors(self, class_name: str, blob: Blob, frame: Frame) -> bool:
-        """False when the learned size / altitude of ``class_name`` rule the blob out.
-
-        The priors are learned from instances, each the extent of all its views; one view shows
-        at most the whole object. A blob larger than the class's range, or whose bottom lies
-        below it, is something else. A smaller one is no evidence: a partial view, or samples a
-        pixel step apart (a bottle at 3 m is a column of points). A walker's instance box is a
-        running mean of its views, partial ones included, so its size range bounds no view. A
-        bottom above the range rules the class out only when the blob is seen whole (inside the
-        image, nothing nearer cuts it): a person close by, legs below the image, keeps its class."""
-        cfg = self.config
-        if not cfg.use_learned_priors:
-            return True
-        tol = PRIOR_TOLERANCE
-        size = self._prior(KIND_SIZE, class_name)
-        bounded = cfg.learned_size and class_name not in cfg.walker_classes  # walkers: a mean box
-        volume_m3 = float(np.prod(blob.extent_map_m))
-        if bounded and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
-            return False
-        alt = self._prior(KIND_ALTITUDE, class_name)
-        if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
-            slack = tol * max(alt.hi_m - alt.lo_m, MIN_ALTITUDE_SPAN_M)
-            bottom = float(blob.center_map_m[2] - blob.extent_map_m[2] / 2.0)
-            if bottom < alt.lo_m - slack:
-                return False
-            if bottom > alt.hi_m + slack:  # seen whole, its bottom is the object's
-                step = cfg.pixel_step
-                return not inside_image(blob, step, frame.camera) or occluded(
-                    blob, frame.depth_m, frame.camera, frame.T_map_cam, step
-                )
-        return True
 
     def _couch_or_bed(self, match: Match, blob: Blob) -> Match:
         """``match`` renamed to the other of couch and bed when the blob's tall part says so
@@ -330,7 +252,7 @@ class ForegroundStage:
         and track them (associate, fuse, move); the changed instances and their observations."""
         clock = [time.perf_counter()]
         future = self._detection_of(frame)
-        self._refresh_priors(world)
+        self._priors.refresh(world)
         if self.config.reidentify:
             self._look_for_earlier(frame, world)
         scene = self._read_background(world)
@@ -477,7 +399,7 @@ class ForegroundStage:
             return match, None
         longest = longest_m(blob.points_map, float(blob.extent_map_m[2])) if cfg.class_sizes else None
         if not (
-            self._fits_priors(match.class_name, blob, frame)
+            self._priors.fits(match.class_name, blob, frame)
             and self._stands(match.class_name, blob, flat)
             and (longest is None or longest <= max_longest_m(match.class_name, CLASS_SIZE_TOLERANCE))
             and (match.class_name not in FIXTURE_CLASSES
