@@ -30,7 +30,6 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, COUCH_OR_BED, couch_or_bed
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import has_moved, is_static
@@ -188,17 +187,6 @@ class ForegroundStage:
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
-
-    def _couch_or_bed(self, match: Match, blob: Blob) -> Match:
-        """``match`` renamed to the other of couch and bed when the blob's tall part says so
-        (``couch_or_bed.py``) and that class is one the stage names."""
-        cfg = self.config
-        told = couch_or_bed(blob.points_map, self._floor_z_m)
-        if told is None or told == match.class_name or told in cfg.exclude_classes or (
-            cfg.classes and told not in cfg.classes
-        ):
-            return match
-        return Match(told, match.score, match.detection_index, match.iou)
 
     def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
@@ -389,12 +377,10 @@ class ForegroundStage:
     def _judged(
         self, frame: Frame, scene: _Background, blob: Blob, match: Match, flat: bool
     ) -> tuple[Match, float | None]:
-        """``match`` as the checks of a named class leave it (couch or bed; else ``unknown``
-        when the class's learned priors, standing, size or attachment rule the blob out), and
+        """``match`` as the checks of a named class leave it (``unknown`` when the class's
+        learned priors, standing, size or attachment rule the blob out), and
         the blob's longest side when it tells the class's size (seen whole; else None)."""
         cfg = self.config
-        if COUCH_OR_BED and match.class_name in (COUCH, BED):
-            match = self._couch_or_bed(match, blob)
         if match.detection_index is None:
             return match, None
         longest = longest_m(blob.points_map, float(blob.extent_map_m[2])) if cfg.class_sizes else None
