@@ -56,7 +56,6 @@ from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import DETECTION_NEAREST, WALKER_SOLID, detected_blobs, is_flat
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
-from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
@@ -106,7 +105,6 @@ SUPPORT_CLASSES = ("floor", "table")
 HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
-HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -248,12 +246,11 @@ class ForegroundStage:
         clock.append(time.perf_counter())
         dets, detect_s = self._detections(frame, future)
         clock.append(time.perf_counter())
-        hidden = self._hidden(frame)
-        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets, hidden)
+        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets)
         clock.append(time.perf_counter())
         observations, measurements, surfaces = self._measure(frame, scene, blobs, dets, found_tables)
         clock.append(time.perf_counter())
-        instances, merged = self._track(frame, scene, (observations, measurements, surfaces), hidden)
+        instances, merged = self._track(frame, scene, (observations, measurements, surfaces))
         clock.append(time.perf_counter())
         return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
                            timings_s=_timings(clock, detect_s, seg))
@@ -316,7 +313,7 @@ class ForegroundStage:
         return blobs, seg
 
     def _split_and_refine(
-        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections, hidden: Any
+        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections
     ) -> tuple[list[Blob], list[Blob], Detections]:
         """The blobs split from the tables the background has not mapped (``tables.py``), and
         trimmed and joined with the detections (``refine.py``); those tables' blobs; the
@@ -331,7 +328,6 @@ class ForegroundStage:
             blobs, found_tables, lookalikes = split_unseen_tables(blobs, usable, names, cfg, width, height)
             if lookalikes:
                 dets, ok, usable, names = _without(dets, ok, np.flatnonzero(ok)[lookalikes])
-            found_tables = join_hidden_pieces(found_tables, hidden, cfg, width, height)
             if TABLE_RIM_DEPTH_M > 0:
                 blobs = drop_table_legs(blobs, scene.tables, cfg, cfg.pixel_step, width, height, rims=True)
         if cfg.detection_split or cfg.detection_join:
@@ -436,12 +432,11 @@ class ForegroundStage:
 
     def _track(
         self, frame: Frame, scene: _Background,
-        measured: tuple[list[Observation], list[Measurement], list[FloatArray | None]], hidden: Any,
+        measured: tuple[list[Observation], list[Measurement], list[FloatArray | None]],
     ) -> tuple[list[Instance], list[str]]:
         """Track the frame's measurements; their observations get their instance, the tracks'
         surfaces their points. The instances changed and the uuids of those merged away (a
         track stitched into another, one whose evidence failed, a table the background mapped)."""
-        cfg = self.config
         observations, measurements, surfaces = measured
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
         tables_withdrawn = (
@@ -450,12 +445,6 @@ class ForegroundStage:
         )
         if tables_withdrawn:  # the background layer mapped them: its instance is the table
             changed = [t for t in changed if t.uuid not in tables_withdrawn]
-        pieces = join_hidden_tracks(self.tracker, hidden, cfg) if UNSEEN_TABLE_INSTANCES else {}
-        if pieces:  # two tracks of one table a chair cut in two: the newer folded into the older
-            joined = [pieces[u].uuid if u in pieces else u for u in joined]
-            changed = [t for t in changed if t.uuid not in pieces]
-            listed = {id(t) for t in changed}
-            changed += [t for t in {id(t): t for t in pieces.values()}.values() if id(t) not in listed]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
         for obs, points, track_uuid in zip(observations, surfaces, joined, strict=True):
             if track_uuid in confirmed:
@@ -465,7 +454,7 @@ class ForegroundStage:
         instances = [self._instance(t) for t in changed]
         # a track closed for good has its instance's surface already (tentative ones: none)
         self._surfaces.keep({t.uuid for t in (*self.tracker.tracks, *self.tracker.dormant)})
-        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn, *pieces]
+        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn]
         return instances, [u for u in gone if self._instances.pop(u, None) is not None]
 
     def finish(self, world: World) -> FrameResult:
@@ -630,17 +619,6 @@ class ForegroundStage:
             return ok, z, depth[vi, ui]
 
         return project
-
-    def _hidden(self, frame: Frame) -> Any:
-        """A function telling, per map point, whether it is in the camera's view and whether
-        something measured nearer (``HIDDEN_MARGIN_M``) hides it."""
-        project = self._projector(frame)
-
-        def hidden(points_map: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-            ok, z, measured = project(points_map)
-            return ok, np.asarray(ok & (measured > 0) & (measured < z - HIDDEN_MARGIN_M))
-
-        return hidden
 
     def _visibility(self, frame: Frame) -> Any:
         """A function telling which map points the camera sees now (in image, not occluded)."""
