@@ -80,9 +80,6 @@ class Blob:
     """Top of the floor or table the blob stands on, when the background filter cut its base."""
     fragment: bool = False
     """Fewer points than ``min_cluster_points``: kept only to be joined to an object (refine)."""
-    cut_from_table_m: tuple[FloatArray, FloatArray] | None = None
-    """(lower, upper) corners, map frame, of the table top and legs found in the blob this one
-    was cut from (``tables.split_unseen_tables``; ``split_parts``); None: not cut from one."""
     _bounds: tuple[FloatArray, FloatArray] | None = field(default=None, init=False, repr=False, compare=False)
     _mean: FloatArray | None = field(default=None, init=False, repr=False, compare=False)
 

@@ -427,7 +427,6 @@ class ForegroundStage:
             named_within=named_within(
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),
-            cut_from_table_m=blob.cut_from_table_m,
         )
 
     def _track(

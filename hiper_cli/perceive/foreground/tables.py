@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import Box3D, point_bounds
+from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
 from hiper_cli.perceive.foreground.legs import (
     TABLE_LEG_ABOVE_M,
@@ -199,11 +199,10 @@ def split_unseen_tables(
         on_table = table_points(blob.points_map, top, config)
         if np.count_nonzero(on_table) >= config.min_cluster_points:
             tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
-        table_box = point_bounds(blob.points_map[on_table]) if on_table.any() else None
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
-                out.append(_part(blob, rest[part], top, table_box, config, width, height))
+                out.append(_part(blob, rest[part], top, config, width, height))
     return out, tables, lookalikes
 
 
@@ -224,12 +223,11 @@ def _held(
 
 
 def _part(
-    blob: Blob, sel: NDArray[np.int64], top: Box3D, table_box: tuple[FloatArray, FloatArray] | None,
+    blob: Blob, sel: NDArray[np.int64], top: Box3D,
     config: SegmentConfig, width: int, height: int,
 ) -> Blob:
     """A part of ``blob`` as a blob of its own, standing on the table top, on the floor below the
-    blob (as the segmentation found it), or on nothing known; cut from the table in ``table_box``."""
+    blob (as the segmentation found it), or on nothing known."""
     part = sub_blob(blob, sel, config.pixel_step, width, height)
     part.support_z_m = standing_on(part, [float(top.aabb()[1][2]), blob.support_z_m], config)
-    part.cut_from_table_m = table_box
     return part

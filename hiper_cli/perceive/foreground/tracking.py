@@ -67,7 +67,6 @@ from hiper_cli.perceive.foreground.same_object import (
     static_together,
 )
 from hiper_cli.perceive.foreground.smoother import smooth_trajectory
-from hiper_cli.perceive.foreground.split_parts import held_tables, last_box
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
@@ -542,9 +541,6 @@ class Tracker:
                 # past that, also inside the base gate its filter's uncertainty grew to
                 judged = searched[i] | (stamp_s - t.last_update_s > SEARCH_UNKNOWN_MAX_S)
                 allowed[i] &= ~(judged & (classes != cls) & ~person_sized)
-        cut = [m.cut_from_table_m for m in measurements]
-        if any(box is not None for box in cut):  # not the unnamed track of the blob it was cut from
-            allowed &= ~held_tables([last_box(t) for t in self.tracks], cut)
         return self._assign(cost, allowed)
 
     # --- one step ---------------------------------------------------------------------------
