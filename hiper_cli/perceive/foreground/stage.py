@@ -48,6 +48,7 @@ from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
+from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
@@ -80,6 +81,7 @@ SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far belo
 MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this span
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
+VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -161,6 +163,7 @@ class ForegroundStage:
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
+        self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
 
     # --- learned priors ---------------------------------------------------------------------
     def _refresh_priors(self, world: World) -> None:
@@ -403,6 +406,8 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
+        keyframe = self._solid.due(frame.stamp_s)
+        unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
             flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
             match, longest = self._judged(frame, scene, blob, match, flat)
@@ -410,6 +415,8 @@ class ForegroundStage:
                 continue
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
+            if keyframe and match.detection_index is None and is_solid(blob.points_cam):
+                unnamed.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
             measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -418,6 +425,8 @@ class ForegroundStage:
             surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
+        if keyframe:
+            self._solid.add(frame, unnamed)
         return observations, measurements, surfaces
 
     def _judged(
@@ -532,7 +541,19 @@ class ForegroundStage:
             earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
+        instances += self._geometry_only(world, instances)
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
+
+    def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
+        """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
+        standing on the floor or a support, outside the background and every instance."""
+        background = list(world.background.values())
+        margin = np.full(3, 2.0 * VOXEL_MARGIN_M)
+        taken = [i.box for i in (*world.foreground.values(), *self._instances.values(), *instances)
+                 if i.layer == "foreground"]
+        grown = [Box3D(i.box.center_m, i.box.extent_m + margin, i.box.R) for i in background]
+        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown)
+        return [_solid_instance(p) for p in parts]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
@@ -755,6 +776,15 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
     out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
     out[:, ROW_POSITION] = box.center_m
     return out.tolist()
+
+
+def _solid_instance(part: SolidPart) -> Instance:
+    """The ``unknown`` instance of a geometry-only object: static, at rest at its box's centre."""
+    rows = [[stamp_s, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0] for stamp_s in (part.first_seen_s, part.last_seen_s)]
+    return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
+                    last_seen_s=part.last_seen_s, confidence=part.seen_share,
+                    observation_uuids=part.observation_uuids,
+                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True})
 
 
 def _wall_boxes(world: World) -> list[Box3D]:
