@@ -45,6 +45,7 @@ MIN_VOXELS = 10  # a part with fewer is debris, not an object (0.01 m³ of surfa
 MIN_HEIGHT_M = 0.15  # ... or lower than this
 MIN_THICKNESS_M = 0.05  # the spread of a part's voxels across their thinnest direction: a sheet
 BASE_REACH_M = 0.25  # its lowest voxel this near the floor or a support top: it stands there
+CEILING_REACH_M = 0.3  # its top this near the ceiling: it is the building's, or joined to it
 MAX_EXTENT_M = 4.5  # a longer part is structure or several things run together
 FLAT_M = 0.01  # a blob whose points spread less than this (σ, plus FLAT_PER_M2 · depth²) across
 FLAT_PER_M2 = 0.0015  # ... their thinnest direction is a piece of a surface: it adds no voxels
@@ -161,7 +162,7 @@ class SolidMap:
         self._free[idx[through]] += 1
 
     def parts(self, floor_z_m: float, supports: Sequence[Box3D], taken: Sequence[Box3D],
-              background: Sequence[Box3D]) -> list[SolidPart]:
+              background: Sequence[Box3D], ceiling_z_m: float | None = None) -> list[SolidPart]:
         """The geometry-only objects: evidence voxels outside the ``background`` boxes, grouped
         into connected parts, kept when found there again, solid, standing and not ``taken`` by
         an instance (see the module docstring)."""
@@ -187,7 +188,7 @@ class SolidMap:
             members = np.flatnonzero(labels == label)
             if not frames or np.median(self._seen[members]) < MIN_SEEN_PART:
                 continue
-            part = self._part(members, tops, taken, uuids)
+            part = self._part(members, (tops, ceiling_z_m), taken, uuids)
             if part is not None:
                 out.append(part)
         return out
@@ -210,10 +211,14 @@ class SolidMap:
         return held
 
     def _part(
-        self, members: NDArray[np.int64], tops: Sequence[float], taken: Sequence[Box3D], uuids: list[str]
+        self, members: NDArray[np.int64], levels: tuple[Sequence[float], float | None],
+        taken: Sequence[Box3D], uuids: list[str],
     ) -> SolidPart | None:
         """The object of one connected part (``members``: voxel indices), or None when it is
-        debris, a sheet, afloat, too long or an instance's already."""
+        debris, a sheet, afloat, reaching the ceiling, too long or an instance's already;
+        ``levels``: the tops of the floor and the supports, and the ceiling's height (None:
+        none mapped)."""
+        tops, ceiling_z_m = levels
         if len(members) < MIN_VOXELS:
             return None
         centres = _centres(self._keys[members])
@@ -223,6 +228,8 @@ class SolidMap:
             return None
         if not any(abs(float(lo[2]) - top) <= BASE_REACH_M for top in tops):
             return None
+        if ceiling_z_m is not None and float(hi[2]) >= ceiling_z_m - CEILING_REACH_M:
+            return None  # from the floor to the ceiling: building structure, or run into it
         if _thinnest_spread_m(centres) < MIN_THICKNESS_M:
             return None
         box = Box3D((lo + hi) / 2.0, extent)

@@ -82,6 +82,8 @@ MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
+STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
+STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -548,11 +550,12 @@ class ForegroundStage:
         """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
         standing on the floor or a support, outside the background and every instance."""
         background = list(world.background.values())
-        margin = np.full(3, 2.0 * VOXEL_MARGIN_M)
         taken = [i.box for i in (*world.foreground.values(), *self._instances.values(), *instances)
                  if i.layer == "foreground"]
-        grown = [Box3D(i.box.center_m, i.box.extent_m + margin, i.box.R) for i in background]
-        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown)
+        grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
+        ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
+        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown,
+                                  min(ceilings) if ceilings else None)
         return [_solid_instance(p) for p in parts]
 
     def _stays(self, inst: Instance) -> bool:
@@ -776,6 +779,16 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
     out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
     out[:, ROW_POSITION] = box.center_m
     return out.tolist()
+
+
+def _grown(box: Box3D, tall: bool) -> Box3D:
+    """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
+    its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
+    background saw)."""
+    extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
+    if tall:
+        extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
+    return Box3D(box.center_m, extent, box.R)
 
 
 def _solid_instance(part: SolidPart) -> Instance:
