@@ -137,3 +137,11 @@ def test_keyframes_come_every_half_second() -> None:
     assert solid.due(5.0)
     solid.add(frame, [])
     assert not solid.due(5.0 + KEYFRAME_S / 2) and solid.due(5.0 + KEYFRAME_S)
+
+
+def test_a_part_from_the_floor_to_the_ceiling_is_the_buildings() -> None:
+    column = box_surface([-0.3, -0.3, 0.0], [0.3, 0.3, 2.5])
+    solid = drive_past([column, floor_points()], unnamed=[0])
+    assert len(solid.parts(0.0, [FLOOR], [], [])) == 1  # no ceiling mapped: a tall thing
+    assert solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=2.6) == []
+    assert len(solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=4.0)) == 1
