@@ -54,6 +54,7 @@ from hiper_cli.perceive.foreground.reidentify import (
 )
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import DETECTION_NEAREST, WALKER_SOLID, detected_blobs, is_flat
+from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
@@ -105,6 +106,10 @@ SUPPORT_CLASSES = ("floor", "table")
 HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
+HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
+VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
+STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
+STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -185,6 +190,7 @@ class ForegroundStage:
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
+        self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
 
     def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
@@ -353,6 +359,8 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
+        keyframe = self._solid.due(frame.stamp_s)
+        unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
             flat = WALKER_SOLID and is_flat(blob.points_cam, cfg)
             match, longest = self._judged(frame, scene, blob, match, flat)
@@ -360,6 +368,8 @@ class ForegroundStage:
                 continue
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
+            if keyframe and match.detection_index is None and is_solid(blob.points_cam):
+                unnamed.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
             measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
@@ -368,6 +378,8 @@ class ForegroundStage:
             surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
+        if keyframe:
+            self._solid.add(frame, unnamed)
         return observations, measurements, surfaces
 
     def _judged(
@@ -472,7 +484,20 @@ class ForegroundStage:
             earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
+        instances += self._geometry_only(world, instances)
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
+
+    def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
+        """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
+        standing on the floor or a support, outside the background and every instance."""
+        background = list(world.background.values())
+        taken = [i.box for i in (*world.foreground.values(), *self._instances.values(), *instances)
+                 if i.layer == "foreground"]
+        grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
+        ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
+        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown,
+                                  min(ceilings) if ceilings else None)
+        return [_solid_instance(p) for p in parts]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
@@ -682,6 +707,25 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
     out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
     out[:, ROW_POSITION] = box.center_m
     return out.tolist()
+
+
+def _grown(box: Box3D, tall: bool) -> Box3D:
+    """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
+    its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
+    background saw)."""
+    extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
+    if tall:
+        extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
+    return Box3D(box.center_m, extent, box.R)
+
+
+def _solid_instance(part: SolidPart) -> Instance:
+    """The ``unknown`` instance of a geometry-only object: static, at rest at its box's centre."""
+    rows = [[stamp_s, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0] for stamp_s in (part.first_seen_s, part.last_seen_s)]
+    return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
+                    last_seen_s=part.last_seen_s, confidence=part.seen_share,
+                    observation_uuids=part.observation_uuids,
+                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True})
 
 
 def _wall_boxes(world: World) -> list[Box3D]:
