@@ -7,8 +7,10 @@ instance, the observations that say something:
 - the first of each session;
 - every observation that gives a class none kept gave (class evidence);
 - every observation of a foreground object whose map box centre lies ``MOVE_M`` from every
-  one kept (the object somewhere new; a plane's pieces lie all along it, and its instance has
-  fused their outline);
+  one kept (the object somewhere new);
+- every observation of a plane (background) whose map box reaches ``COVER_M`` beyond each kept
+  one's: the kept pieces cover the fused outline, so ``hiper reanchor`` folds them again into
+  the same plane under new poses;
 
 and summarises the others into the instance's stretches in view (``data.view_spans``: first
 and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
@@ -23,9 +25,8 @@ sightings are their trajectory. Only observations older than ``keep_raw_s`` befo
 touched (``--keep-observations``).
 
 The graph is rebuilt from the documents afterwards (observation batches change); queries over
-instances, events and trajectories answer the same. What is dropped cannot be re-anchored to an
-optimised trajectory later (``hiper reanchor``): keep the raw observations of the window a loop
-closure may still change with ``--keep-observations``.
+instances, events and trajectories answer the same. ``--keep-observations DURATION`` keeps every
+raw observation of the last DURATION (a window a loop closure may still change in detail).
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ __all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps
 
 STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
 MOVE_M = 0.25  # an observation this far from every one kept shows the object somewhere new
+COVER_M = 0.2  # a plane's piece reaching this far beyond every kept one's box shows more of it
 SUMMARISED = "observations_summarised"
 VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
 
@@ -63,7 +65,9 @@ class CompactReport:
         return dict(self.__dict__)
 
 
-Row = tuple[int, str, float, str | None, int | None, float, float]  # id, uuid, stamp, class, session, x, y
+Bounds = tuple[float, float, float, float, float, float]  # map-frame min_x, max_x, min_y, max_y, min_z, max_z
+# id, uuid, stamp, class, session, map x, y of the box centre, map box
+Row = tuple[int, str, float, str | None, int | None, float, float, Bounds]
 
 
 def _keep(rows: list[Row], covered: list[tuple[float, float]], keep_after_s: float,
@@ -75,20 +79,30 @@ def _keep(rows: list[Row], covered: list[tuple[float, float]], keep_after_s: flo
     spans: list[tuple[float, float]] = []
     classes: set[str | None] = set()  # the classes the kept observations give
     places: list[tuple[float, float]] = []  # where the kept observations lie
+    boxes: list[Bounds] = []  # the kept observations' map boxes (a plane's coverage)
     for row in rows:
-        oid, _, stamp, cls, _, x, y = row
+        oid, _, stamp, cls, _, x, y, bounds = row
         if spans and stamp - spans[-1][1] <= STRETCH_GAP_S:
             spans[-1] = (spans[-1][0], stamp)
         else:
             spans.append((stamp, stamp))
-        # a plane's pieces lie all along it: its instance has fused their outline already
-        new_place = not background and all((x - px) ** 2 + (y - py) ** 2 > MOVE_M ** 2 for px, py in places)
+        if background:  # a plane's pieces lie all along it: new where they reach beyond the kept ones
+            new_place = not any(_inside(bounds, box) for box in boxes)
+        else:
+            new_place = all((x - px) ** 2 + (y - py) ** 2 > MOVE_M ** 2 for px, py in places)
         if (stamp >= keep_after_s or cls not in classes
                 or (new_place and not any(a <= stamp <= b for a, b in covered))):
             keep.add(oid)
             classes.add(cls)
             places.append((x, y))
+            boxes.append(bounds)
     return keep, spans
+
+
+def _inside(bounds: Bounds, box: Bounds) -> bool:
+    """Whether ``bounds`` lies within ``box`` grown by ``COVER_M`` on every side."""
+    return all(bounds[k] >= box[k] - COVER_M for k in (0, 2, 4)) and all(
+        bounds[k] <= box[k] + COVER_M for k in (1, 3, 5))
 
 
 def merge_spans(spans: Iterable[Sequence[float]]) -> list[list[float]]:
@@ -135,16 +149,20 @@ def _observation_rows(db: Any) -> dict[str, list[Row]]:
     cursor = db.execute(
         "SELECT d.id, d.uuid, d.stamp_s, d.class, d.session_id, l.instance_uuid, "
         "COALESCE(c.min_x + c.max_x, n.min_x + n.max_x, 0) / 2.0, "
-        "COALESCE(c.min_y + c.max_y, n.min_y + n.max_y, 0) / 2.0 "
+        "COALESCE(c.min_y + c.max_y, n.min_y + n.max_y, 0) / 2.0, "
+        "COALESCE(c.min_x, n.min_x, 0), COALESCE(c.max_x, n.max_x, 0), COALESCE(c.min_y, n.min_y, 0), "
+        "COALESCE(c.max_y, n.max_y, 0), COALESCE(c.min_z, n.min_z, 0), COALESCE(c.max_z, n.max_z, 0) "
         "FROM all_links l JOIN docs d ON d.uuid = l.observation_uuid "
         "LEFT JOIN obs_cells c ON c.id = d.id LEFT JOIN obs_cells_new n ON n.id = d.id "
         "ORDER BY l.instance_uuid, d.stamp_s, d.id")
     out: dict[str, list[Row]] = defaultdict(list)
     seen: set[tuple[str, int]] = set()
-    for oid, uuid, stamp, cls, session, inst, x, y in cursor:
+    for oid, uuid, stamp, cls, session, inst, x, y, *bounds in cursor:
         if (inst, oid) not in seen:  # obs_cells may hold a row per cell
             seen.add((inst, oid))
-            out[inst].append((int(oid), str(uuid), float(stamp or 0.0), cls, session, float(x), float(y)))
+            box = tuple(float(v) for v in bounds)
+            out[inst].append((int(oid), str(uuid), float(stamp or 0.0), cls, session, float(x), float(y),
+                              box))  # type: ignore[arg-type]
     return out
 
 
