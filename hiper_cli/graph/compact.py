@@ -60,6 +60,7 @@ class CompactReport:
     bytes_before: int = 0
     bytes_after: int = 0
     seconds: float = 0.0
+    cpu_seconds: float = 0.0  # this process's CPU time (its threads' too): the cost, whatever the load
 
     def to_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
@@ -167,17 +168,29 @@ def _observation_rows(db: Any) -> dict[str, list[Row]]:
 
 
 def _drop(db: Any, ids: list[int]) -> None:
-    """Delete observation documents by row id, with their index rows and links."""
+    """Delete observation documents by row id, with their index rows and links. When most of
+    the observations go, the rows that stay are copied aside and the tables emptied whole
+    (SQLite frees an unconditioned DELETE's pages at once, indexes included): deleting 10^6 rows
+    one by one through three indexes was most of a compaction."""
     db.execute("CREATE TEMP TABLE IF NOT EXISTS drop_ids (id INTEGER PRIMARY KEY, uuid TEXT)")
     db.execute("DELETE FROM drop_ids")
     db.executemany("INSERT OR IGNORE INTO drop_ids (id) VALUES (?)", [(i,) for i in ids])
     db.execute("UPDATE drop_ids SET uuid = (SELECT uuid FROM docs WHERE docs.id = drop_ids.id)")
     db.execute("CREATE INDEX IF NOT EXISTS temp.drop_ids_uuid ON drop_ids (uuid)")
-    for table in ("obs_cells", "obs_cells_new", "docs_box"):
-        db.execute(f"DELETE FROM {table} WHERE id IN (SELECT id FROM drop_ids)")
-    for table in ("links", "links_new"):
-        db.execute(f"DELETE FROM {table} WHERE observation_uuid IN (SELECT uuid FROM drop_ids)")
-    db.execute("DELETE FROM docs WHERE id IN (SELECT id FROM drop_ids)")
+    db.execute("DELETE FROM docs_box WHERE id IN (SELECT id FROM drop_ids)")
+    total = int(db.execute("SELECT COUNT(*) FROM docs").fetchone()[0])
+    whole = len(ids) > total // 2
+    for table, key, column in (("obs_cells", "id", "id"), ("obs_cells_new", "id", "id"),
+                               ("links", "uuid", "observation_uuid"),
+                               ("links_new", "uuid", "observation_uuid"), ("docs", "id", "id")):
+        where = f"{column} IN (SELECT {key} FROM drop_ids)"
+        if whole:
+            db.execute(f"CREATE TEMP TABLE kept_rows AS SELECT * FROM {table} WHERE NOT {where}")
+            db.execute(f"DELETE FROM {table}")
+            db.execute(f"INSERT INTO {table} SELECT * FROM kept_rows")
+            db.execute("DROP TABLE kept_rows")
+        else:
+            db.execute(f"DELETE FROM {table} WHERE {where}")
 
 
 def _stub(db: Any, ids: list[int]) -> None:
@@ -197,7 +210,7 @@ def _stub(db: Any, ids: list[int]) -> None:
 def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) -> CompactReport:
     """Summarise the observations of ``kb`` (module docstring); one transaction, then the
     graph is rebuilt and (``vacuum``) the file shrunk."""
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     report = CompactReport(bytes_before=_bytes(kb))
     docs = kb.docs
     db = docs._db
@@ -262,6 +275,7 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
     report.observations_after = int(docs._scalar("SELECT COUNT(*) FROM docs WHERE type = 'observation'"))
     report.bytes_after = _bytes(kb)
     report.seconds = time.perf_counter() - started
+    report.cpu_seconds = time.process_time() - cpu_started
     return report
 
 

@@ -123,6 +123,15 @@ CREATE TABLE IF NOT EXISTS poses (
 """
 
 
+def pose_text(T_map_cam: Any) -> str:
+    """A pose row's 4×4 matrix as compact JSON: rotation to 1e-6, translation to 10 µm (a
+    pose row a frame is most of what a session adds once its observations are summarised;
+    this is about half the full-precision text)."""
+    rows = T_map_cam.tolist() if hasattr(T_map_cam, "tolist") else T_map_cam
+    top = [[round(float(v), 6) for v in row[:3]] + [round(float(row[3]), 5)] for row in rows[:3]]
+    return json.dumps([*top, [0, 0, 0, 1]], separators=(",", ":"))
+
+
 @dataclass(frozen=True)
 class Session:
     """One ``perceive`` run: which log, into which environment, how far it got."""
@@ -567,10 +576,9 @@ class DocumentStore(ChangeFeed, Lookups):
     def record_frame(self, session_id: int, pose_id: int, stamp_s: float, T_map_cam: Any) -> None:
         """The pose row of a committed frame and the session's progress."""
         seq = self._current_seq()
-        matrix = T_map_cam.tolist() if hasattr(T_map_cam, "tolist") else T_map_cam
         self._db.execute(
             "INSERT OR REPLACE INTO poses VALUES (?, ?, ?, ?)",
-            (session_id, pose_id, stamp_s, json.dumps(matrix)),
+            (session_id, pose_id, stamp_s, pose_text(T_map_cam)),
         )
         self._db.execute(
             "UPDATE sessions SET frames = frames + 1, last_pose_id = ?, last_stamp_s = ?, seq = ? "
