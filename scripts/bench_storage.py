@@ -4,6 +4,8 @@ the time ``hiper kb compact`` takes on a knowledge base of many observations.
   bench_storage.py size KB...            bytes of each knowledge base folder and what holds them
   bench_storage.py fill KB N             a synthetic KB of N observations of still objects
   bench_storage.py compact KB            time compaction of KB (a copy is compacted: KB.compacted)
+  bench_storage.py prefix LOG SECONDS OUT   the first SECONDS of a TUM log folder as folder OUT
+                                         (links to its images and truth, its lists cut)
 
 ``size`` prints the folder's bytes (documents, graph), per table and per document kind; the
 perceive runs that make the knowledge bases are in docs/results/2026-12-07-bounded-storage.md.
@@ -112,6 +114,27 @@ def compact_timed(kb_path: Path) -> None:
     print(json.dumps({"kb": str(copy), **report.to_dict()}))
 
 
+def prefix(log: Path, seconds: float, out: Path) -> None:
+    """The frames of ``log`` stamped before its first stamp + ``seconds``, as a log folder."""
+    out.mkdir(parents=True, exist_ok=False)
+    first = None
+    for entry in sorted(log.iterdir()):
+        if entry.suffix != ".txt":
+            (out / entry.name).symlink_to(entry.resolve())
+            continue
+        lines = []
+        for line in entry.read_text().splitlines():
+            if not line.strip() or line.startswith("#"):
+                lines.append(line)
+                continue
+            stamp = float(line.split()[0])
+            first = stamp if first is None else min(first, stamp)
+            if stamp < first + seconds:
+                lines.append(line)
+        (out / entry.name).write_text("\n".join(lines) + "\n")
+    print(json.dumps({"prefix": str(out), "seconds": seconds}))
+
+
 def main(argv: list[str]) -> None:
     if len(argv) >= 2 and argv[0] == "size":
         for kb in argv[1:]:
@@ -120,6 +143,8 @@ def main(argv: list[str]) -> None:
         fill(Path(argv[1]), int(float(argv[2])))
     elif len(argv) == 2 and argv[0] == "compact":
         compact_timed(Path(argv[1]))
+    elif len(argv) == 4 and argv[0] == "prefix":
+        prefix(Path(argv[1]), float(argv[2]), Path(argv[3]))
     else:
         sys.exit(__doc__)
 

@@ -21,8 +21,10 @@ and drops the others, counting them in the instance (``data.observations_summari
 a stretch already covered by earlier sessions of a found-again object (the same log perceived
 again) add nothing either. Observations no instance holds (debris that never became an
 object, tracks merged away) are dropped. Movers keep every observation, as a stub: their
-sightings are their trajectory. Only observations older than ``keep_raw_s`` before the newest stamp are
-touched (``--keep-observations``).
+sightings are their trajectory. Only observations older than ``keep_raw_s`` before the newest
+stamp are touched (``--keep-observations``); the geometry of those kept is rounded to 10 µm.
+Pose rows keep their matrix only where the camera's motion is not a straight line between its
+neighbours (``poserows.py``).
 
 The graph is rebuilt from the documents afterwards (observation batches change); queries over
 instances, events and trajectories answer the same. ``--keep-observations DURATION`` keeps every
@@ -38,6 +40,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from hiper_cli.graph.codec import dumps, loads
+from hiper_cli.graph.poserows import thin_session
 
 if TYPE_CHECKING:
     from hiper_cli.graph.kb import KnowledgeBase
@@ -46,6 +49,7 @@ __all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps
 
 STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
 MOVE_M = 0.25  # an observation this far from every one kept shows the object somewhere new
+DECIMALS = 5  # kept observations' coordinates to 10 µm, directions to 1e-5
 COVER_M = 0.2  # a plane's piece reaching this far beyond every kept one's box shows more of it
 SUMMARISED = "observations_summarised"
 VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
@@ -57,6 +61,7 @@ class CompactReport:
     debris_dropped: int = 0
     summarised: int = 0
     observations_after: int = 0
+    pose_matrices_dropped: int = 0  # pose rows whose matrix their neighbours give (``poserows.py``)
     bytes_before: int = 0
     bytes_after: int = 0
     seconds: float = 0.0
@@ -207,6 +212,31 @@ def _stub(db: Any, ids: list[int]) -> None:
         db.executemany("UPDATE docs SET body = ? WHERE id = ?", updates)
 
 
+def _rounded(value: Any) -> Any:
+    """``value`` with every float rounded to ``DECIMALS`` places (lists and dicts through)."""
+    if isinstance(value, float):
+        return round(value, DECIMALS)
+    if isinstance(value, list):
+        return [_rounded(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _rounded(v) for k, v in value.items()}
+    return value
+
+
+def _round_kept(db: Any, before_s: float) -> None:
+    """The geometry of the observations kept (box and data, not stamps) to ``DECIMALS``
+    places: a kept plane's outline at full float precision is twice the bytes."""
+    rows = db.execute("SELECT id, body FROM docs WHERE type = 'observation' AND stamp_s < ?", (before_s,))
+    updates = []
+    for oid, body in rows.fetchall():
+        doc = loads(body)
+        doc["box"], doc["data"] = _rounded(doc.get("box")), _rounded(doc.get("data"))
+        text = dumps(doc)
+        if len(text) < len(body):
+            updates.append((text, oid))
+    db.executemany("UPDATE docs SET body = ? WHERE id = ?", updates)
+
+
 def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) -> CompactReport:
     """Summarise the observations of ``kb`` (module docstring); one transaction, then the
     graph is rebuilt and (``vacuum``) the file shrunk."""
@@ -252,6 +282,9 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
                 summarised[inst] = len(gone)
         _stub(db, stub_ids)
         _drop(db, debris + drop)
+        _round_kept(db, keep_after_s)
+        for (session_id,) in db.execute("SELECT id FROM sessions").fetchall():
+            report.pose_matrices_dropped += thin_session(db, int(session_id), keep_after_s)
         for inst, n in summarised.items():
             doc = instances[inst]
             data = doc.setdefault("data", {})

@@ -32,6 +32,7 @@ from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.grid import GRID_CELL_M, cell_index, cell_key, grid_rows
 from hiper_cli.graph.lookups import Lookups
+from hiper_cli.graph.poserows import pose_at
 from hiper_cli.graph.sqlite_guard import (
     GuardedConnection,
     connect_read_only,
@@ -750,7 +751,7 @@ class DocumentStore(ChangeFeed, Lookups):
         row = self._db.execute(
             "SELECT stamp_s, T_map_cam FROM poses WHERE session_id = ? AND pose_id = ?", (session_id, pose_id)
         ).fetchone()
-        return None if row is None else (float(row[0]), json.loads(row[1]))
+        return None if row is None else (float(row[0]), pose_at(self._db, session_id, float(row[0]), row[1]))
 
     def pose_count(self, session_id: int) -> int:
         return int(self._scalar("SELECT COUNT(*) FROM poses WHERE session_id = ?", (session_id,)))
