@@ -162,10 +162,10 @@ def _observation_rows(db: Any) -> dict[str, list[Row]]:
         "LEFT JOIN obs_cells c ON c.id = d.id LEFT JOIN obs_cells_new n ON n.id = d.id "
         "ORDER BY l.instance_uuid, d.stamp_s, d.id")
     out: dict[str, list[Row]] = defaultdict(list)
-    seen: set[tuple[str, int]] = set()
+    last: tuple[str, int] | None = None
     for oid, uuid, stamp, cls, session, inst, x, y, *bounds in cursor:
-        if (inst, oid) not in seen:  # obs_cells may hold a row per cell
-            seen.add((inst, oid))
+        if (inst, oid) != last:  # obs_cells may hold a row per cell (next to each other: sorted)
+            last = (inst, oid)
             box = tuple(float(v) for v in bounds)
             out[inst].append((int(oid), str(uuid), float(stamp or 0.0), cls, session, float(x), float(y),
                               box))  # type: ignore[arg-type]
