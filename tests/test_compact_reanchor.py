@@ -3,6 +3,7 @@
 every observation does."""
 
 import json
+import shutil
 
 import numpy as np
 import pytest
@@ -39,6 +40,8 @@ def kbs(tmp_path_factory):
         result = CliRunner().invoke(app, args + (["--keep-observations", keep] if keep else []))
         assert result.exit_code == 0, result.output
         out[keep] = kb
+    shutil.copytree(out[None], root / "kb_copy.hiper")  # untouched by the re-anchoring test
+    out["copy"] = root / "kb_copy.hiper"
     return out
 
 
@@ -64,7 +67,7 @@ def test_a_summarised_kb_reanchors_its_walls_as_one_that_kept_everything(kbs, tm
     shifted[:, 0, 3] += 0.5
     traj = tmp_path / "optimised.txt"
     write_tum_trajectory(traj, Trajectory.from_matrices(0.5 * np.arange(N), shifted))
-    for kb in kbs.values():
+    for kb in (kbs["all"], kbs[None]):
         result = CliRunner().invoke(app, ["reanchor", "--kb", str(kb), "--poses", str(traj), "--json"])
         assert result.exit_code == 0, result.output
         assert json.loads(result.output)["merged"] == 0
@@ -76,3 +79,17 @@ def test_a_summarised_kb_reanchors_its_walls_as_one_that_kept_everything(kbs, tm
         assert extent == pytest.approx(extent_all, abs=0.1), cls
     moved = [r for r in after_all if r[1] == 0 and r[0] == "wall"]  # walls across x went with the poses
     assert moved and all(any(abs(r[2] - b[2] - 0.5) < 0.03 for b in before_all) for r in moved)
+
+
+def test_a_plane_seen_again_where_it_was_covered_keeps_little(kbs):
+    """The same log again: its views of each plane lie inside what the first session kept."""
+    kb = kbs["copy"]
+    _, n_first = _planes(kb)
+    log = kbs[None].parent / "log"
+    args = ["perceive", str(log), "--kb", str(kb), "--stages", "background", "--again"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    with open_kb(kb) as knowledge:
+        second = knowledge.docs.count(type="observation", layer="background") - n_first
+        planes = len(knowledge.instances(layer="background"))
+    assert second <= planes + 2  # about the first sighting of each plane in the session (its evidence)

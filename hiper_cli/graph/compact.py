@@ -9,8 +9,8 @@ instance, the observations that say something:
 - every observation of a foreground object whose map box centre lies ``MOVE_M`` from every
   one kept (the object somewhere new);
 - every observation of a plane (background) whose map box reaches ``COVER_M`` beyond each kept
-  one's: the kept pieces cover the fused outline, so ``hiper reanchor`` folds them again into
-  the same plane under new poses;
+  one's, earlier sessions' included: the kept pieces cover the fused outline, so
+  ``hiper reanchor`` folds them again into the same plane under new poses;
 
 and summarises the others into the instance's stretches in view (``data.view_spans``: first
 and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
@@ -77,15 +77,17 @@ Row = tuple[int, str, float, str | None, int | None, float, float, Bounds]
 
 
 def _keep(rows: list[Row], covered: list[tuple[float, float]], keep_after_s: float,
-          background: bool = False) -> tuple[set[int], list[tuple[float, float]]]:
+          background: bool = False, boxes: list[Bounds] | None = None,
+          ) -> tuple[set[int], list[tuple[float, float]]]:
     """Ids of the observations of one static instance (one session) kept, and the stretches in
     view the others are summarised into (module docstring). ``covered``: stretches earlier
-    sessions' observations of the instance span; one inside them adds nothing."""
+    sessions' observations of the instance span; one inside them adds nothing. ``boxes``: the
+    map boxes of a plane's observations kept so far, earlier sessions' included (extended)."""
     keep: set[int] = set()
     spans: list[tuple[float, float]] = []
     classes: set[str | None] = set()  # the classes the kept observations give
     places: list[tuple[float, float]] = []  # where the kept observations lie
-    boxes: list[Bounds] = []  # the kept observations' map boxes (a plane's coverage)
+    boxes = [] if boxes is None else boxes  # the kept observations' map boxes (a plane's coverage)
     for row in rows:
         oid, _, stamp, cls, _, x, y, bounds = row
         if spans and stamp - spans[-1][1] <= STRETCH_GAP_S:
@@ -268,12 +270,13 @@ def compact(kb: KnowledgeBase, *, keep_raw_s: float = 0.0, vacuum: bool = True) 
                     summarised[inst] = len(again)
                 continue
             keep: set[int] = set()
-            for session in {r[4] for r in rows}:
+            boxes: list[Bounds] = []  # a plane's coverage, over the sessions in turn
+            for session in sorted({r[4] for r in rows}, key=lambda s: s or 0):
                 mine = [r for r in rows if r[4] == session]
                 covered = [s for other, spans_ in stretches.items() if other != session
                            and (other or 0) < (session or 0) for s in spans_]
                 kept, session_spans = _keep(mine, covered, keep_after_s,
-                                            instances[inst].get("layer") == "background")
+                                            instances[inst].get("layer") == "background", boxes)
                 keep |= kept
                 spans.setdefault(inst, []).extend(session_spans)
             gone = [r[0] for r in rows if r[0] not in keep]
