@@ -14,7 +14,7 @@ import sys
 import typer
 
 from hiper_cli import __version__, commands
-from hiper_cli.commands._render import HiperTyper
+from hiper_cli.cmdline import HiperTyper
 from hiper_cli.errors import HiperError
 
 app = HiperTyper(
@@ -57,7 +57,8 @@ _register_commands()
 def main() -> None:
     """Entry point of the ``hiper`` script: one red line and a non-zero exit on ``HiperError``;
     a usage error prints the command's usage line and one red line with a hint, exit code 2."""
-    from hiper_cli.commands._render import is_usage_error, print_error, print_usage_error
+    from hiper_cli.cmdline.usage import is_usage_error, print_usage_error
+    from hiper_cli.render import print_error
 
     try:
         # In non-standalone mode click returns the code of a typer.Exit instead of raising it.

@@ -159,7 +159,7 @@ def perceive_live(
         def written(frame: Frame | None, result: FrameResult) -> None:
             if frame is not None:
                 unsynced.append(float(frame.extras.get("sent_s", time.time())))
-                if knowledge.graph.synced_seq(knowledge.kb_id) >= knowledge.docs.seq:
+                if knowledge.graph_in_sync():
                     queryable()
                 _copy_counts(source, report)
                 if progress is not None:

@@ -66,20 +66,15 @@ def reanchor_with_poses(kb: str, poses: Path, *, kb_docs: Path | None = None, ma
     return replace(summary, kb=str(kb), poses=str(poses))
 
 
-def _aabb(lo: Any, hi: Any) -> tuple[list[float], list[float]]:
-    return [float(v) for v in lo], [float(v) for v in hi]
-
-
 def reanchor_kb(kb: KnowledgeBase, trajectory: Trajectory, *, max_dt_s: float = 0.05,
                 write: bool = True) -> ReanchorSummary:
     """Recompute the background layer of ``kb`` with ``trajectory``; return a summary."""
     instances = kb.instances(layer="background")
     observations: dict[str, Observation] = {}
     for inst in instances:
-        docs = kb.docs.observations_of(inst.uuid)
-        inst.observation_uuids = [d["uuid"] for d in docs]
-        for d in docs:
-            observations[d["uuid"]] = Observation.from_dict(d)
+        held = kb.observations_of(inst.uuid)
+        inst.observation_uuids = [o.uuid for o in held]
+        observations.update((o.uuid, o) for o in held)
     stamps = np.array([o.stamp_s for o in observations.values()])
     poses: dict[str, NDArray[np.float64]] = {}
     if len(stamps):
@@ -93,14 +88,8 @@ def reanchor_kb(kb: KnowledgeBase, trajectory: Trajectory, *, max_dt_s: float = 
     result = reanchor(instances, observations.values(), pose_of)
     shifts = [float(np.linalg.norm(i.box.center_m - before[i.uuid])) for i in result.instances]
     if write:
-        obs_items = [(o.to_dict(), _aabb(*o.box.transformed(poses[u]).aabb()))
-                     for u, o in observations.items() if u in poses]
-        inst_items = [(i.to_dict(), _aabb(*i.box.aabb())) for i in result.instances]
-        with kb.docs.transaction():
-            kb.docs.put_many(obs_items)
-            kb.docs.put_many(inst_items)
-            for uuid in result.deleted:
-                kb.docs.delete(uuid)
+        kb.write_reanchored([(o, poses[u]) for u, o in observations.items() if u in poses],
+                            result.instances, result.deleted)
         kb.sync_graph()
     return ReanchorSummary(
         instances=len(result.instances), observations=result.observations, deleted=tuple(result.deleted),

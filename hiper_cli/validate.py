@@ -140,34 +140,40 @@ def _coerce(where: str, value: Any, kind: Any) -> Any:
             return _coerce(where, value, args[0])
         return value
     if kind is bool:
-        if isinstance(value, bool):
-            return value
-        if isinstance(value, int) and value in (0, 1):
-            return bool(value)
-        if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
-            return value.lower() in ("true", "1", "yes")
-        raise ConfigError(f"{where}={value!r}: expected true or false")
+        return _coerce_bool(where, value)
     if kind in (int, float):
-        number = value
-        if isinstance(value, str):
-            try:
-                number = float(value)
-            except ValueError:
-                number = None
-        if isinstance(number, bool) or not isinstance(number, int | float):
-            raise ConfigError(f"{where}={value!r}: expected {'an integer' if kind is int else 'a number'}")
-        if not math.isfinite(float(number)) or abs(float(number)) > MAX_MAGNITUDE:
-            raise ConfigError(f"{where}={value!r}: expected a finite number of at most {MAX_MAGNITUDE:g}")
-        if kind is int:
-            if float(number) != int(number):
-                raise ConfigError(f"{where}={value!r}: expected an integer")
-            return int(number)
-        return float(number)
-    if kind is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"{where}={value!r}: expected a text")
-        return value
+        return _coerce_number(where, value, kind)
+    if kind is str and not isinstance(value, str):
+        raise ConfigError(f"{where}={value!r}: expected a text")
     return value
+
+
+def _coerce_bool(where: str, value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int) and value in (0, 1):
+        return bool(value)
+    if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
+        return value.lower() in ("true", "1", "yes")
+    raise ConfigError(f"{where}={value!r}: expected true or false")
+
+
+def _coerce_number(where: str, value: Any, kind: type) -> int | float:
+    number = value
+    if isinstance(value, str):
+        try:
+            number = float(value)
+        except ValueError:
+            number = None
+    if isinstance(number, bool) or not isinstance(number, int | float):
+        raise ConfigError(f"{where}={value!r}: expected {'an integer' if kind is int else 'a number'}")
+    if not math.isfinite(float(number)) or abs(float(number)) > MAX_MAGNITUDE:
+        raise ConfigError(f"{where}={value!r}: expected a finite number of at most {MAX_MAGNITUDE:g}")
+    if kind is int:
+        if float(number) != int(number):
+            raise ConfigError(f"{where}={value!r}: expected an integer")
+        return int(number)
+    return float(number)
 
 
 def typed_options(cls: type, options: Mapping[str, Any], where: str) -> dict[str, Any]:

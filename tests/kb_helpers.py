@@ -155,3 +155,36 @@ def kb_location(request, tmp_path):
     if request.param == "local":
         return str(tmp_path / "scene.hiper"), None
     return request.getfixturevalue("sparql_url"), tmp_path / "docs.hiper"
+
+
+def small_kb(root: Path) -> Any:
+    """An open knowledge base of one session (log "/logs/flat", place "flat") of three frames at
+    0, 1 and 2 s: a chair seen in each, a person walking along x at 0.5 m/s, a floor."""
+    from hiper_cli.graph import open_kb
+
+    kb = open_kb(root)
+    env = kb.environment("flat")
+    session = kb.start_session(env, "/logs/flat", ["background", "foreground"])
+    chair = Instance("foreground", "chair", Box3D(np.array([1.0, 2.0, 0.45]), np.array([0.5, 0.5, 0.9])),
+                     0.0, 0.0)
+    person = Instance("foreground", "person", Box3D(np.array([3.0, 1.0, 0.9]), np.array([0.5, 0.4, 1.7])),
+                      0.0, 0.0, state="dynamic")
+    floor = Instance("background", "floor", Box3D(np.array([2.0, 2.0, -0.01]), np.array([6.0, 6.0, 0.02])),
+                     0.0, 0.0)
+    rows = []
+    for k in range(3):
+        stamp_s = float(k)
+        rows.append([stamp_s, 3.0 + 0.5 * k, 1.0, 0.9, 0.5, 0.0, 0.0])
+        seen = Observation("foreground", "chair", 0.9, stamp_s, k, Box3D(np.array([1.0, 2.0, 2.0]),
+                                                                       np.array([0.5, 0.5, 0.9])),
+                           instance_uuid=chair.uuid)
+        chair.observation_uuids.append(seen.uuid)
+        chair.last_seen_s = person.last_seen_s = floor.last_seen_s = stamp_s
+        person.box = Box3D(np.array(rows[-1][1:4]), person.box.extent_m)
+        person.data = {"trajectory": [list(r) for r in rows]}
+        T_map_cam = np.eye(4)
+        kb.write_frame(session, FrameResult(observations=[seen], instances=[chair, person, floor]),
+                       pose_id=k, stamp_s=stamp_s, T_map_cam=T_map_cam)
+    kb.end_session(session)
+    kb.sync_graph()
+    return kb

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from hiper_cli.commands._common import LOG_FLAGS, with_log_flags
+from hiper_cli.cmdline import LOG_FLAGS, with_log_flags
 from hiper_cli.errors import ConfigError
 from hiper_cli.perceive.logs import LogOptions
 from hiper_cli.pipeline import PerceiveOptions

@@ -10,9 +10,9 @@ import pytest
 from typer.testing import CliRunner
 
 from hiper_cli.cli import app
-from hiper_cli.commands._render import safe_text
 from hiper_cli.errors import QueryError
 from hiper_cli.graph.sparql_safety import readonly_form, run_with_timeout
+from hiper_cli.render import safe_text
 from hiper_cli.serve.endpoint import allowed_hosts, host_allowed
 
 runner = CliRunner()

@@ -37,6 +37,11 @@ def test_a_truth_kb_answers_every_question_right(tmp_path):
         assert kinds[(kind, "short")] > 0
     yes_no = data["by_kind"]["yes_no"]["all"]
     assert 0 < yes_no["true_yes"] < yes_no["n"]  # both answers occur
+    # what the answers stand on, measured by hiper_cli.evaluate: the truth's own objects
+    perception = data["perception"]
+    assert perception["scored"] == "knowledge base"
+    assert perception["foreground"]["classified_precision"] == 1.0
+    assert perception["recall"]["truth_found"] >= perception["recall"]["truth_observed"] - 1  # not the door
 
 
 def test_questions_are_deterministic_and_written_with_their_answers(tmp_path):

@@ -56,3 +56,6 @@ def test_compaction_keeps_a_matrix_only_where_the_motion_bends(tmp_path):
             turn = np.degrees(np.arccos(np.clip((np.trace(M[:3, :3].T @ T[:3, :3]) - 1) / 2, -1, 1)))
             assert stamp == t and np.linalg.norm(M[:3, 3] - T[:3, 3]) <= 0.0101 and turn <= 0.51, k
         assert np.allclose(kb.docs.pose_before(stamps[40] + 0.01)[3], kb.docs.pose(session.id, 40)[1])
+        recorded = kb.session_poses(session.id)  # the whole session at once, interpolated alike
+        assert np.allclose(recorded.stamps_s, stamps)
+        assert np.abs(recorded.T_map_cam[:, :3, 3] - np.stack(poses)[:, :3, 3]).max() <= 0.0101

@@ -24,7 +24,7 @@ def _numeric_options() -> list[tuple[str, str]]:
         callback = getattr(command, "callback", None)
         if callback is None or hasattr(command, "commands"):
             return
-        for name, p in inspect.signature(callback).parameters.items():
+        for name, p in inspect.signature(callback, eval_str=True).parameters.items():
             hint = str(p.annotation)
             numeric = hint.split(",")[0]  # Annotated[int, typer.Option(help=...)]: the type alone
             numeric_type = any(t in numeric for t in ("int", "float"))

@@ -57,7 +57,6 @@ def fill_bench_kb(root: Path, hours: float = 2.0, seed: int = 0) -> dict[str, An
     rng = np.random.default_rng(seed)
     kb = open_kb(root)
     env = kb.environment("bench")
-    docs = kb.docs
     walls = [
         Instance(
             "background",
@@ -81,7 +80,7 @@ def fill_bench_kb(root: Path, hours: float = 2.0, seed: int = 0) -> dict[str, An
     observations = rows_total = instances = 0
     slots: list[tuple[Instance, np.ndarray, int]] = []  # instance, its rows, next row index
     for start in range(0, frames, 600):  # one transaction per minute of data
-        items: list[tuple[dict[str, Any], Any]] = []
+        items: list[dict[str, Any]] = []
         done: list[Instance] = []
         for f in range(start, min(start + 600, frames)):
             stamp = f / HZ
@@ -110,7 +109,7 @@ def fill_bench_kb(root: Path, hours: float = 2.0, seed: int = 0) -> dict[str, An
                 }
                 observations += 1
                 inst.observation_uuids.append(str(obs["uuid"]))
-                items.append((obs, None))
+                items.append(obs)
                 if k + 1 == len(r):
                     inst.box = Box3D(c, inst.box.extent_m)
                     inst.last_seen_s = float(r[-1, 0])
@@ -120,9 +119,7 @@ def fill_bench_kb(root: Path, hours: float = 2.0, seed: int = 0) -> dict[str, An
                 else:
                     kept.append((inst, r, k + 1))
             slots = kept
-        with docs.transaction():
-            docs.put_many(items, env_uuid=env.uuid)
-            docs.put_many([(i.to_dict(), None) for i in done], env_uuid=env.uuid)
+        kb.put_batch(items, done, env_uuid=env.uuid)
         instances += len(done)
     kb.sync_graph()
     kb.close()
@@ -146,10 +143,8 @@ def _measure(root: str, what: str) -> dict[str, Any]:
 
     t_open = time.perf_counter()
     if what == "cache":
-        from hiper_cli.graph.columns import trajectory_columns
-
         with open_kb(root) as kb:
-            n = len(trajectory_columns(kb.docs).rows)
+            n = len(kb.trajectory_columns().rows)
         return {"seconds": round(time.perf_counter() - t_open, 3), "rows": n}
     with open_kb(root) as kb, tempfile.TemporaryDirectory() as out:
         times = []
@@ -185,26 +180,15 @@ def run_analyze_bench(root: str | Path, hours: float = 2.0) -> dict[str, Any]:
     """Fill ``root`` unless it holds a knowledge base, then time features and a heatmap, each
     in a fresh process; returns the sizes and the measurements."""
     path = Path(root)
-    from hiper_cli.graph.kb import open_kb
+    from hiper_cli.graph.kb import is_knowledge_base, open_kb
 
-    if (path / "documents.sqlite").exists():
+    if is_knowledge_base(path):
         with open_kb(path) as kb:
-            db = kb.docs.connection
-            count = {t: int(n) for t, n in db.execute("SELECT type, COUNT(*) FROM docs GROUP BY type")}
-            rows = 0
-            for (n,) in db.execute(
-                "SELECT json_extract(body, '$.data.trajectory_rows') FROM docs "
-                "WHERE type = 'instance' AND layer = 'foreground'"
-            ):
-                rows += int(n) if n is not None else 0
-            inline = db.execute(
-                "SELECT SUM(json_array_length(json_extract(body, '$.data.trajectory'))) FROM docs "
-                "WHERE type = 'instance' AND layer = 'foreground'"
-            ).fetchone()[0]
+            held = kb.sizes()
         sizes = {
-            "observations": count.get("observation", 0),
-            "instances": count.get("instance", 0),
-            "trajectory_rows": rows + int(inline or 0),
+            "observations": held.documents.get("observation", 0),
+            "instances": held.documents.get("instance", 0),
+            "trajectory_rows": held.trajectory_rows,
             "hours": None,
             "fill_s": 0.0,
         }

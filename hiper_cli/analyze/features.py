@@ -26,12 +26,7 @@ from numpy.typing import NDArray
 from hiper_cli.analyze.stats import bootstrap_mean_ci, folded_normal_sigma
 from hiper_cli.analyze.window import TimeWindow
 from hiper_cli.errors import ConfigError
-from hiper_cli.graph.columns import (
-    TrajectoryColumns,
-    foreground_classes,
-    instance_columns,
-    trajectory_columns,
-)
+from hiper_cli.graph.columns import TrajectoryColumns
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.learned import AltitudeFeature, ObjectDynamics, SizeFeature
 from hiper_cli.model import Analysis
@@ -219,7 +214,7 @@ def features_of_tracks(
 def floor_height_m(kb: KnowledgeBase) -> float:
     """The height of the floor in the map frame: the top of the largest floor instance (0 when
     the knowledge base has none)."""
-    floors = instance_columns(kb.docs, "floor", layer="background")
+    floors = kb.instance_columns("floor", layer="background")
     if not floors.uuids:
         return 0.0
     biggest = int(np.argmax(floors.half_aabb_m[:, 0] * floors.half_aabb_m[:, 1]))
@@ -241,7 +236,7 @@ def compute_features(
     lo_s, hi_s = math.inf, -math.inf
     floor_z = floor_height_m(kb)
     for name in wanted:
-        tracks = trajectory_columns(kb.docs, name, window.t_start_s, window.t_end_s)
+        tracks = kb.trajectory_columns(name, window.t_start_s, window.t_end_s)
         stamps = tracks.rows[:, 0]
         if window.daily_s is not None:
             stamps = stamps[window.mask(stamps)]
@@ -263,7 +258,7 @@ def store_features(kb: KnowledgeBase, report: FeatureReport) -> list[Analysis]:
 
 def check_classes(kb: KnowledgeBase, class_names: Sequence[str]) -> None:
     """A ``ConfigError`` naming the classes the knowledge base knows when one asked is not there."""
-    known = foreground_classes(kb.docs)
+    known = kb.foreground_classes()
     missing = [c for c in class_names if c not in known]
     if missing:
         have = ", ".join(known) if known else "none (run 'hiper perceive LOG' first)"

@@ -15,12 +15,12 @@ from typing import Any
 
 from hiper_cli.analyze.features import FeatureConfig, features_of_tracks
 from hiper_cli.analyze.window import TimeWindow
-from hiper_cli.evaluate.foreground import _run, _score
+from hiper_cli.evaluate import perceive_and_score
 from hiper_cli.graph.columns import columns_of_instances
-from hiper_cli.model import Analysis
+from hiper_cli.model import Analysis, World
 from hiper_cli.perceive.logs.truth import load_truth
 
-__all__ = ["SWITCHES", "evaluate_feedback", "learned_priors"]
+__all__ = ["SWITCHES", "evaluate_feedback", "learn_priors", "learned_priors"]
 
 _OFF = {"use_learned_priors": False}
 _ONLY = {
@@ -38,19 +38,24 @@ SWITCHES: dict[str, dict[str, bool]] = {
 }
 
 
-def learned_priors(
-    log_path: str | Path, background: str = "truth", **options: Any
-) -> tuple[list[Analysis], dict[str, Any]]:
-    """Perceive ``log_path`` without priors and learn the features of its instances."""
-    root = Path(log_path)
-    run = _run(root, load_truth(root), {**options, **_OFF}, None, background)
-    tracks = columns_of_instances(list(run.world.foreground.values()))
+def learn_priors(world: World) -> tuple[list[Analysis], dict[str, Any]]:
+    """The features (ODS, size, altitude) of a perceived world's foreground tracks, as the
+    analyses the foreground stage reads back, and per class as ``--json`` shows them."""
+    tracks = columns_of_instances(list(world.foreground.values()))
     classes = features_of_tracks(tracks, TimeWindow(), 0.0, FeatureConfig())
     now = time.time()
     lo = float(tracks.rows[:, 0].min(initial=0.0))
     hi = float(tracks.rows[:, 0].max(initial=0.0))
     analyses = [a for c in classes for a in c.analyses(lo, hi, now)]
     return analyses, {c.class_name: c.to_dict() for c in classes}
+
+
+def learned_priors(
+    log_path: str | Path, background: str = "truth", **options: Any
+) -> tuple[list[Analysis], dict[str, Any]]:
+    """Perceive ``log_path`` without priors and learn the features of its instances."""
+    done = perceive_and_score(log_path, background=background, **{**options, **_OFF})
+    return learn_priors(done.run.world)
 
 
 def _summary(scored: dict[str, Any]) -> dict[str, Any]:
@@ -82,11 +87,11 @@ def evaluate_feedback(
     priors, learned = learned_priors(learn_log, background, **opts)
     root = Path(log_path)
     truth = load_truth(root)
-    dyn = float(options.get("dynamic_speed_mps", 0.15))
     runs = {}
     for name, flags in (switches or SWITCHES).items():
-        run = _run(root, truth, {**opts, **flags}, None, background, priors)
-        runs[name] = _summary(_score(run, truth, dyn))
+        settings = {**opts, **flags}
+        done = perceive_and_score(root, background=background, priors=priors, truth=truth, **settings)
+        runs[name] = _summary(done.evaluation.figures)
     return {
         "log": str(root),
         "learned_on": str(learn_log),

@@ -16,7 +16,6 @@ from hiper_cli.analyze.heatmap import Heatmap, HeatmapConfig, heatmap_from_rows
 from hiper_cli.analyze.maplayer import MapConfig, environment_of, map_for
 from hiper_cli.analyze.window import TimeWindow
 from hiper_cli.errors import DataError
-from hiper_cli.graph.columns import trajectory_columns
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.learned import KIND_HEATMAP, KIND_ODS, ObjectDynamics
 from hiper_cli.model import Analysis
@@ -36,16 +35,16 @@ class HeatmapResult:
 
 def learned_speed_mps(kb: KnowledgeBase, class_name: str) -> float | None:
     """μ_v of the newest ``ods`` analysis of ``class_name``, if there is one with motion."""
-    found = [d for d in kb.docs.find(type="analysis", class_name=class_name) if d.get("kind") == KIND_ODS]
+    found = kb.analyses(KIND_ODS, class_name)
     if not found:
         return None
-    newest = max(found, key=lambda d: float(d.get("created_s", 0.0)))
-    return ObjectDynamics.from_values(Analysis.from_dict(newest).values).mean_mps
+    newest = max(found, key=lambda a: float(a.created_s))
+    return ObjectDynamics.from_values(newest.values).mean_mps
 
 
 def _nothing_in(kb: KnowledgeBase, class_name: str, window: TimeWindow) -> str:
     """Why a window holds no row of a class, and when the class was seen."""
-    every = trajectory_columns(kb.docs, class_name).rows[:, 0]
+    every = kb.trajectory_columns(class_name).rows[:, 0]
     seen = f"from {every.min():.1f} to {every.max():.1f} s" if every.size else "in no trajectory row"
     return (f"no {class_name} trajectory rows in the window ({window.describe()}); {kb.location} holds "
             f"them {seen}: widen --from/--to, --last or --daily")
@@ -71,7 +70,7 @@ def generate_heatmap(
     window = window or TimeWindow()
     check_classes(kb, [class_name])
     env = environment_of(kb, env_name)
-    tracks = trajectory_columns(kb.docs, class_name, window.t_start_s, window.t_end_s)
+    tracks = kb.trajectory_columns(class_name, window.t_start_s, window.t_end_s)
     keep = window.mask(tracks.rows[:, 0])
     if not np.any(keep):  # before the map is built and stored: bad input changes nothing
         raise DataError(_nothing_in(kb, class_name, window))

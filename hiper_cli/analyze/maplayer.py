@@ -25,7 +25,7 @@ from hiper_cli.analyze.gridmap import (
     write_map_server,
 )
 from hiper_cli.errors import ConfigError
-from hiper_cli.graph.columns import InstanceColumns, instance_columns, trajectory_columns
+from hiper_cli.graph.columns import InstanceColumns
 from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.model import Environment
 
@@ -64,8 +64,8 @@ def _fill(cells: np.ndarray, grid: OccupancyGrid, inst: InstanceColumns, k: int,
 def build_map(kb: KnowledgeBase, config: MapConfig | None = None) -> OccupancyGrid:
     """The occupancy grid of everything the knowledge base holds (see the module doc)."""
     config = config or MapConfig()
-    background = instance_columns(kb.docs, layer="background")
-    tracks = trajectory_columns(kb.docs)
+    background = kb.instance_columns(layer="background")
+    tracks = kb.trajectory_columns()
     xy = [tracks.rows[:, 1:3]]
     for k in range(len(background.uuids)):
         if background.class_names[k] in SKIPPED_CLASSES:
@@ -127,8 +127,7 @@ def store_map(
 ) -> Environment:
     """Keep ``grid`` as the map of ``env`` (its document's ``data["map"]``)."""
     env.data["map"] = grid.to_dict() | {"source": source, "built_from": built_from}
-    with kb.docs.transaction():
-        kb.docs.put(env.to_dict(), env_uuid=env.uuid)
+    kb.store_environment(env)
     return env
 
 
@@ -175,8 +174,7 @@ def map_for(
 def _content_key(kb: KnowledgeBase) -> list[float]:
     """What a built map depends on, cheaply: the instance count and the newest sighting (both
     read from indexes); a new perception run changes it."""
-    db = kb.docs.connection
-    n, newest = db.execute("SELECT COUNT(*), MAX(stamp_s) FROM docs WHERE type = 'instance'").fetchone()
+    n, newest = kb.instance_summary()
     return [float(BUILD_RULES), float(n), float(newest or 0.0)]
 
 

@@ -69,19 +69,6 @@ class PerceptionResult:
     seconds: dict[str, float] = field(default_factory=dict)
 
 
-def _learn(world: Any) -> tuple[list[Any], dict[str, Any]]:
-    from hiper_cli.analyze.features import FeatureConfig, features_of_tracks
-    from hiper_cli.analyze.window import TimeWindow
-    from hiper_cli.graph.columns import columns_of_instances
-
-    tracks = columns_of_instances(list(world.foreground.values()))
-    classes = features_of_tracks(tracks, TimeWindow(), 0.0, FeatureConfig())
-    lo = float(tracks.rows[:, 0].min(initial=0.0))
-    hi = float(tracks.rows[:, 0].max(initial=0.0))
-    analyses = [a for c in classes for a in c.analyses(lo, hi, time.time())]
-    return analyses, {c.class_name: c.to_dict() for c in classes}
-
-
 def _knowledge_of_run(
     cfg: BenchConfig, run: Any, truth: Any, scored: dict[str, Any], learned: dict[str, Any] | None
 ) -> Knowledge:
@@ -219,8 +206,8 @@ def _knowledge_of_baseline(
 
 def perceive_configs(log: str | Path, configs: tuple[BenchConfig, ...]) -> PerceptionResult:
     """Tables II and III and the knowledge of every configuration in ``configs`` on ``log``."""
-    from hiper_cli.evaluate.background import evaluate_background
-    from hiper_cli.evaluate.foreground import _run, _score
+    from hiper_cli.analyze.feedback import learn_priors
+    from hiper_cli.evaluate import evaluate_background, perceive_and_score
     from hiper_cli.perceive.logs.truth import load_truth
 
     root = Path(log)
@@ -231,26 +218,25 @@ def perceive_configs(log: str | Path, configs: tuple[BenchConfig, ...]) -> Perce
     if names & {"C1", "C2", "C3"}:
         out.table2 = evaluate_background(root).to_dict()
         out.seconds["table2"] = time.perf_counter() - clock
-    base = {"detector": "truth"}
-    off = {"use_learned_priors": False}
-    c2_run = None
+    base: dict[str, Any] = {"detector": "truth"}
+    off: dict[str, Any] = {**base, "use_learned_priors": False}
+    c2 = None
     for cfg in configs:
         clock = time.perf_counter()
         learned = None
         if cfg.name in ("C1", "C2", "C3"):
-            if c2_run is None:
-                c2_run = _run(root, truth, {**base, **off}, None, "stage")
-                c2_scored = _score(c2_run, truth, 0.15)
-            run, scored = c2_run, c2_scored
+            if c2 is None:
+                c2 = perceive_and_score(root, background="stage", truth=truth, **off)
+            done = c2
             if cfg.name == "C1":
-                priors, learned = _learn(c2_run.world)
-                run = _run(root, truth, base, None, "stage", priors)
-                scored = _score(run, truth, 0.15)
-            out.knowledge[cfg.name] = _knowledge_of_run(cfg, run, truth, scored, learned)
+                priors, learned = learn_priors(c2.run.world)
+                done = perceive_and_score(root, background="stage", priors=priors, truth=truth, **base)
+            scored = done.evaluation.figures
+            out.knowledge[cfg.name] = _knowledge_of_run(cfg, done.run, truth, scored, learned)
         elif cfg.name == "C4":
-            run = _run(root, truth, {**base, **off, "background_filter": False}, None, "truth")
-            scored = _score(run, truth, 0.15)
-            out.knowledge[cfg.name] = _knowledge_of_run(cfg, run, truth, scored, None)
+            done = perceive_and_score(root, background="truth", truth=truth, background_filter=False, **off)
+            scored = done.evaluation.figures
+            out.knowledge[cfg.name] = _knowledge_of_run(cfg, done.run, truth, scored, None)
         else:
             brun, scored, labels = _baseline(root, truth)
             out.knowledge[cfg.name] = _knowledge_of_baseline(brun, labels, truth, scored)

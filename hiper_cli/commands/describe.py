@@ -6,20 +6,17 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, KbDocsOption, KbOption
-from hiper_cli.commands._render import JSON_OPTION, console, print_json, safe_text
+from hiper_cli.cmdline import DEFAULT_KB, HiperTyper, Json, Kb, KbDocs
+from hiper_cli.render import console, print_json, safe_text
 
 __all__ = ["register"]
 
+RecentS = Annotated[float, typer.Option(
+    "--recent-s", help="Movers seen in this many seconds before the KB's last stamp.")]
 
-def describe_command(
-    kb: KbOption = DEFAULT_KB,
-    kb_docs: KbDocsOption = None,
-    recent_s: Annotated[
-        float, typer.Option("--recent-s", help="Movers seen in this many seconds before the KB's last stamp.")
-    ] = 300.0,
-    as_json: bool = JSON_OPTION,
-) -> None:
+
+def describe_command(kb: Kb = DEFAULT_KB, kb_docs: KbDocs = None, recent_s: RecentS = 300.0,
+                     as_json: Json = False) -> None:
     """Summarise a scene: layers, counts per class, recent movers, learned features, time span.
 
     Example: hiper describe --kb house.hiper
@@ -35,5 +32,5 @@ def describe_command(
     console().print(safe_text(summary.text))
 
 
-def register(app: typer.Typer) -> None:
+def register(app: HiperTyper) -> None:
     app.command(name="describe")(describe_command)

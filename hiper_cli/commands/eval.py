@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from hiper_cli.commands._render import group
+from hiper_cli.cmdline import group
 
 eval_app = group(
     "eval",

@@ -8,9 +8,10 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.cmdline import JSON_OPTION
 from hiper_cli.commands.eval import eval_app
+from hiper_cli.render import emit
+from hiper_cli.render.evaluate import show_background_eval
 
 
 @eval_app.command(
@@ -42,13 +43,7 @@ def eval_background(
         log, method=method, phase=None if all_phases else "mapping", max_frames=max_frames,
         keyframe_hz=keyframe_hz,
     )
-    data = report.to_dict()
-    if json_out:
-        print_json(data)
-        return
-    from hiper_cli.commands._tables import show_background_eval
-
-    show_background_eval(console(), data)
+    emit(report.to_dict(), json_out, show_background_eval)
 
 
 def register(app: typer.Typer) -> None:

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION
-from hiper_cli.commands._render import console, frame_progress, print_json, safe_text
+from hiper_cli.cmdline import JSON_OPTION
 from hiper_cli.commands.eval import eval_app
+from hiper_cli.render import console, emit, frame_progress, safe_text
+from hiper_cli.render.evaluate import show_detector_ceiling
 
 
 @eval_app.command(
@@ -39,27 +40,7 @@ def eval_detector(
     with frame_progress(f"{safe_text(detector)} on {safe_text(log)}", screen, enabled=not json_out) as bar:
         result = detector_ceiling(log, reader, model, max_frames=max_frames,
                                   progress=bar.update if bar else None)
-    data = {**result.to_dict(), "detector": detector}
-    if json_out:
-        print_json(data)
-        return
-    show_detector_ceiling(data)
-
-
-def show_detector_ceiling(data: dict[str, Any]) -> None:
-    """The per-class table and the total."""
-    from rich.table import Table
-
-    out = console()
-    table = Table("class", "seen clearly", "found", "share of frames", title=(
-        f"{safe_text(data['detector'])} on {safe_text(data['log'])}: {data['frames']} labelled frames"))
-    for name, row in data["per_class"].items():
-        share = "-" if row["frame_share"] is None else f"{row['frame_share']:.2f}"
-        table.add_row(safe_text(name), str(row["seen_clearly"]), str(row["found"]), share)
-    total = data["total"]
-    share = "-" if total["frame_share"] is None else f"{total['frame_share']:.2f}"
-    table.add_row("[bold]total", str(total["seen_clearly"]), f"[bold]{total['found']}", share)
-    out.print(table)
+    emit({**result.to_dict(), "detector": detector}, json_out, show_detector_ceiling)
 
 
 def register(app: typer.Typer) -> None:

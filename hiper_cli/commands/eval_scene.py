@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import console, print_json, safe_text
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
 from hiper_cli.commands.eval import eval_app
+from hiper_cli.render import emit
+from hiper_cli.render.evaluate import show_scene_eval
 
 
 @eval_app.command(
@@ -22,7 +23,8 @@ from hiper_cli.commands.eval import eval_app
         "class, classified precision, centre error, "
         "unknown instances on no real object, person instances per person, walker speed). With "
         "--ceiling DETECTOR it also runs that detector (hiper eval detector) and prints hiper's recall "
-        "of the nameable objects seen clearly beside the detector's own.\n\n"
+        "of the nameable objects seen clearly beside the detector's own. --kb may also name a JSON "
+        "export (hiper export --format json).\n\n"
         "Example: hiper perceive ../shared/worlds/bookstore --kb bs.hiper && "
         "hiper eval scene ../shared/worlds/bookstore --kb bs.hiper"
     ),
@@ -35,73 +37,10 @@ def eval_scene(
         None, "--ceiling", help="Also score this detector's own recall (yolox, onnx:PATH, log, truth)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    from hiper_cli.errors import LogError
-    from hiper_cli.evaluate.scene import score_scene
-    from hiper_cli.evaluate.surfaces import load_surfaces
-    from hiper_cli.graph import open_kb_for_reading
-    from hiper_cli.perceive.logs.world_truth import load_world_truth
+    from hiper_cli.evaluate import evaluate_kb
 
-    if not (log / "gt" / "instances.json").exists() and (log / "gt" / "world.json").exists():
-        raise LogError(f"{log / 'gt' / 'instances.json'}: not found; this hiper sim log was made before "
-                       "hiper sim wrote scene truth: make it again with hiper sim, or score it with "
-                       "hiper eval background / hiper eval foreground")
-    truth = load_world_truth(log)
-    surfaces = load_surfaces(log)
-    with open_kb_for_reading(kb, docs_dir=kb_docs) as knowledge:
-        instances = knowledge.instances()
-    data = score_scene(truth, surfaces, instances)
-    if ceiling is not None:
-        data["detector_ceiling"] = _ceiling(log, ceiling, data["foreground"]["matched_truth_ids"])
-    if json_out:
-        print_json(data)
-        return
-    show_scene_eval(data)
-
-
-def _ceiling(log: Path, detector: str, matched_truth_ids: list[int]) -> dict[str, Any]:
-    from hiper_cli.evaluate.detector import detector_ceiling, recall_beside_ceiling
-    from hiper_cli.perceive.detect import make_detector
-    from hiper_cli.perceive.logs import open_log
-
-    result = detector_ceiling(log, open_log(log), make_detector(detector, log_path=log))
-    return {**recall_beside_ceiling(result, matched_truth_ids), "detector": detector}
-
-
-def _f(value: Any) -> str:
-    return "-" if value is None else f"{value:.3f}" if isinstance(value, float) else str(value)
-
-
-def show_scene_eval(data: dict[str, Any]) -> None:
-    """The two tables as text."""
-    out = console()
-    b, f = data["background"], data["foreground"]
-    out.print(f"Table II, background ({safe_text(data['world'])}): {b['instances']} instances "
-              f"({b['on_unlabelled']} on unlabelled geometry, {b['off_surface']} on no surface)")
-    out.print(f"  semantic precision {_f(b['semantic_precision'])}   static/dynamic precision "
-              f"{_f(b['static_precision'])}   centre distance mean/median {_f(b['distance_centre_mean_m'])}"
-              f" / {_f(b['distance_centre_median_m'])} m")
-    out.print(f"  coverage {_f(b['coverage'])} ({b['pieces_covered']} of {b['pieces']} observed pieces "
-              f">= 1 m^2); uncovered: {safe_text(', '.join(b['uncovered']) or '-')}")
-    out.print(f"  class->truth {safe_text(b['confusion'])}")
-    out.print(f"Table III, foreground: {f['instances']} instances, TP {f['tp']} FP {f['fp']} FN(observed) "
-              f"{f['fn_observed']}, precision {_f(f['precision'])}")
-    out.print(f"  classified ('unknown' left out): TP {f['classified_tp']} FP {f['classified_fp']} precision "
-              f"{_f(f['classified_precision'])} ({f['unknown']} unknown, "
-              f"{_f(f['unknown_on_nothing'])} of them on no real object); person instances per person "
-              f"{_f(f['persons_per_person'])}")
-    out.print(f"  static/dynamic: {f['dynamic_instances']} dynamic instances; state of the matched ones "
-              f"right {_f(f['state_accuracy'])}")
-    for name, c in f["per_class"].items():
-        out.print(f"  {safe_text(name):<14} TP {c['tp']:>3}  FP {c['fp']:>3}  FN {c['fn']:>3}")
-    out.print(f"  unmatched, by what they lie on: {safe_text(f['unmatched'])}")
-    c = data.get("detector_ceiling")
-    if c is not None:
-        out.print(f"  nameable objects seen clearly: hiper {c['hiper_found']} of {c['seen_clearly']}, the "
-                  f"detector ({c['detector']}) alone {c['detector_found']} (its ceiling); hiper keeps "
-                  f"{c['hiper_found_of_detector_found']} of the detector's {c['detector_found']}")
-    out.print(f"  centre error (static, matched) mean/median {_f(f['centre_error_mean_m'])} / "
-              f"{_f(f['centre_error_median_m'])} m; walkers matched {f['walkers_matched']}, speed mean "
-              f"{_f(f['walker_speed_mean_mps'])} m/s, error {_f(f['walker_speed_error_mps'])} m/s")
+    data = evaluate_kb(kb, log, docs_dir=kb_docs, ceiling=ceiling).figures
+    emit(data, json_out, show_scene_eval)
 
 
 def register(app: typer.Typer) -> None:

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION, LOG_ARGUMENT, with_log_flags
-from hiper_cli.commands._render import console, print_json
+from hiper_cli.cmdline import HiperTyper, Json, Log, with_log_flags
+from hiper_cli.render import emit
+from hiper_cli.render.perceive import show_log_info
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.logs import LogOptions
@@ -18,28 +18,17 @@ HELP = (
     "detections and stamp gaps.\n\n"
     "Example: hiper info rgbd_dataset_freiburg1_xyz --poses slam.txt --json"
 )
+Frames = Annotated[bool, typer.Option("--frames", help="Also list every frame's stamp and pose.")]
+Check = Annotated[bool, typer.Option(
+    "--check", help="Decode every image and report the frames that cannot be read.")]
 
 
-def info(
-    log: Path = LOG_ARGUMENT,
-    json_out: bool = JSON_OPTION,
-    frames: bool = typer.Option(False, "--frames", help="Also list every frame's stamp and pose."),
-    check: bool = typer.Option(
-        False, "--check", help="Decode every image and report the frames that cannot be read."
-    ),
-    *,
-    log_options: LogOptions,
-) -> None:
+def info(log: Log, json_out: Json = False, frames: Frames = False, check: Check = False, *,
+         log_options: LogOptions) -> None:
     from hiper_cli.perceive.logs import describe_log
 
-    data = describe_log(log, log_options, frames=frames, check=check)
-    if json_out:
-        print_json(data)
-        return
-    from hiper_cli.commands._tables import show_log_info
-
-    show_log_info(console(), data)
+    emit(describe_log(log, log_options, frames=frames, check=check), json_out, show_log_info)
 
 
-def register(app: typer.Typer) -> None:
+def register(app: HiperTyper) -> None:
     app.command(name="info", help=HELP)(with_log_flags(info))

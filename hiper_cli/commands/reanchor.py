@@ -11,8 +11,8 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbDocsOption, KbOption
-from hiper_cli.commands._render import HiperTyper, console, print_json, safe_text
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, HiperTyper, KbDocsOption, KbOption
+from hiper_cli.render import console, print_json, safe_text
 
 HELP = (
     "Recompute every background instance (walls, floors, ceilings, tables) of a knowledge base from its "

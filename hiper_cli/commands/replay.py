@@ -7,8 +7,9 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from hiper_cli.commands._common import JSON_OPTION, with_log_flags
-from hiper_cli.commands._render import console, print_json, safe_text
+from hiper_cli.cmdline import HiperTyper, Json, with_log_flags
+from hiper_cli.render import console, emit
+from hiper_cli.render.perceive import show_replay_start, show_replayed
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.logs import LogOptions
@@ -27,7 +28,7 @@ Depth = Annotated[str, typer.Option("--depth-encoding", help="Depth images as 32
 
 
 def replay_command(log: Log, url: Url, rate: Rate = 1.0, hz: Hz = None, wait: Wait = 30.0,
-                   depth_encoding: Depth = "32FC1", as_json: bool = JSON_OPTION, *,
+                   depth_encoding: Depth = "32FC1", as_json: Json = False, *,
                    log_options: LogOptions) -> None:
     """Publish a log's frames on Zenoh as a ROS 2 robot running rmw_zenoh would, at the log's rate.
 
@@ -37,29 +38,13 @@ def replay_command(log: Log, url: Url, rate: Rate = 1.0, hz: Hz = None, wait: Wa
 
     Example: hiper replay fixtures/house_small zenoh://tcp/127.0.0.1:7447 --hz 30
     """
-    from dataclasses import replace
+    from hiper_cli.perceive.live.replay_log import replay_log
 
-    from hiper_cli.errors import ConfigError
-    from hiper_cli.perceive.live.replay import REPLAY_LAYOUT, replay_frames
-    from hiper_cli.perceive.live.rmw import parse_endpoint
-    from hiper_cli.perceive.logs import open_log
-
-    if depth_encoding not in ("32FC1", "16UC1"):
-        raise ConfigError(f"--depth-encoding {depth_encoding}: expected 32FC1 or 16UC1")
-    endpoint = parse_endpoint(url)
-    reader = open_log(log, log_options)
-    layout = replace(REPLAY_LAYOUT, depth_encoding="16UC1" if depth_encoding == "16UC1" else "32FC1")
-    out = console()
-    if not as_json:
-        out.print(f"replaying {safe_text(log)} ({len(reader)} frames) on zenoh://{safe_text(endpoint)}")
-    summary = replay_frames(reader, reader.info().camera, endpoint, rate=rate, hz=hz, layout=layout,
-                            wait_s=wait)
-    if as_json:
-        print_json(summary.to_dict())
-    else:
-        out.print(f"published {summary.frames} frames in {summary.seconds:.1f} s ({summary.how}); "
-                  f"{summary.late_frames} late")
+    start = None if as_json else lambda frames, endpoint: show_replay_start(console(), log, frames, endpoint)
+    data = replay_log(log, url, log_options, rate=rate, hz=hz, wait_s=wait, depth_encoding=depth_encoding,
+                      on_start=start)
+    emit(data, as_json, show_replayed)
 
 
-def register(app: typer.Typer) -> None:
+def register(app: HiperTyper) -> None:
     app.command("replay")(with_log_flags(replay_command))

@@ -6,15 +6,16 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._render import JSON_OPTION, console, print_json
+from hiper_cli.cmdline import HiperTyper, Json
+from hiper_cli.render import emit
+from hiper_cli.render.agent import show_tools
 
 __all__ = ["register"]
 
+Format = Annotated[str, typer.Option("--format", help="openai, anthropic or mcp.")]
 
-def tools_command(
-    fmt: Annotated[str, typer.Option("--format", help="openai, anthropic or mcp.")] = "openai",
-    as_json: bool = JSON_OPTION,
-) -> None:
+
+def tools_command(fmt: Format = "openai", as_json: Json = False) -> None:
     """Print the tools of hiper mcp as function-calling schemas for agent frameworks that do not
     speak MCP (docs/agents.md has an agent loop against a local OpenAI-compatible server).
 
@@ -22,20 +23,8 @@ def tools_command(
     """
     from hiper_cli.agent import tool_schemas
 
-    schemas = tool_schemas(fmt)
-    if as_json:
-        print_json(schemas)
-        return
-    from rich.table import Table
-
-    from hiper_cli.agent import TOOLS
-
-    title = f"{len(TOOLS)} tools ({fmt}; --json for the schemas)"
-    table = Table("tool", "inputs", "description", title=title)
-    for t in TOOLS:
-        table.add_row(t.name, ", ".join(t.input_schema["properties"]), t.description)
-    console().print(table)
+    emit(tool_schemas(fmt), as_json, lambda out, _: show_tools(out, fmt))
 
 
-def register(app: typer.Typer) -> None:
+def register(app: HiperTyper) -> None:
     app.command(name="tools")(tools_command)

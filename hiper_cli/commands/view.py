@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from hiper_cli.commands._common import DEFAULT_KB, JSON_OPTION, KbOption
-from hiper_cli.commands._render import console, print_json, safe_text
+from hiper_cli.cmdline import DEFAULT_KB, JSON_OPTION, KbOption
+from hiper_cli.render import console, print_json, safe_text
 
 __all__ = ["register"]
 

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.evaluate.result import Evaluation
 from hiper_cli.evaluate.scene import FOUND_BOTH_WAYS
 from hiper_cli.model import Analysis, Instance, Observation, TrackTrajectory
 from hiper_cli.perceive.foreground.config import ForegroundConfig
@@ -57,9 +58,13 @@ __all__ = [
     "TRUE_PEOPLE_SPEED_MPS",
     "ForegroundReport",
     "ForegroundRun",
+    "PerceptionScore",
     "evaluate_foreground",
     "parse_settings",
+    "perceive_and_score",
     "prefetch",
+    "run_foreground",
+    "score_run",
 ]
 
 # House, hospital, office columns of the paper's Table III (and the C4 ablation of section VI).
@@ -184,10 +189,13 @@ def _frame_truth(
     return ids, errors, errors_xy
 
 
-def _run(
+def run_foreground(
     log_path: Path, truth: Truth, options: dict[str, Any], max_frames: int | None, background: str,
     priors: Sequence[Analysis] = (),
 ) -> ForegroundRun:
+    """The background (``background``: see ``evaluate_foreground``) and foreground stages over
+    the log in memory, with ``priors`` (learned features) in the world; then every observation
+    is given its truth id and visible-centre error in a second pass, off the clock."""
     from hiper_cli.perceive.logs import open_log
 
     stages, world, source = _background(truth, background)
@@ -334,7 +342,9 @@ def _identity_switches(run: ForegroundRun, instances: list[Instance]) -> tuple[i
     return switches, len(by_truth)
 
 
-def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[str, Any]:
+def score_run(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[str, Any]:
+    """Table III figures of a run (see the module docstring); a person faster than
+    ``dynamic_speed_mps`` counts as moving."""
     instances = list(run.world.foreground.values())
     inst_truth = _instance_truth(run, instances)
     per_class, unknown = _classification(instances, inst_truth, truth)
@@ -389,7 +399,7 @@ def _score(run: ForegroundRun, truth: Truth, dynamic_speed_mps: float) -> dict[s
 class ForegroundReport:
     """Our Table III on one log (``to_dict`` is the ``--json`` form, with the paper's table).
 
-    ``ours``: the scores (``_score``: counts, times, localisation, people's speeds, identity
+    ``ours``: the scores (``score_run``: counts, times, localisation, people's speeds, identity
     switches); ``ablation``: the same run without background filtering (C4), when it ran.
     """
 
@@ -435,6 +445,36 @@ def parse_settings(settings: Sequence[str], *, classes: str | None = None,
     return out
 
 
+@dataclass(frozen=True)
+class PerceptionScore:
+    """A perception run kept for what a caller reads from it (its world, each observation's
+    truth id) and its ``Evaluation``."""
+
+    run: ForegroundRun
+    evaluation: Evaluation
+
+
+def perceive_and_score(
+    log_path: str | Path,
+    *,
+    background: str = "auto",
+    max_frames: int | None = None,
+    priors: Sequence[Analysis] = (),
+    truth: Truth | None = None,
+    **options: Any,
+) -> PerceptionScore:
+    """Perceive ``log_path`` (a log with ``gt/``) in memory and score the run per observation
+    against its truth (Table III). ``options`` go to the foreground stage (``detector`` and the
+    fields of ``ForegroundConfig``); ``priors``: learned features fed back; ``truth``: the
+    log's, when the caller has read it already."""
+    root = Path(log_path)
+    truth = load_truth(root) if truth is None else truth
+    dynamic_speed_mps = ForegroundConfig.from_options(**options).dynamic_speed_mps
+    run = run_foreground(root, truth, options, max_frames, background, priors)
+    figures = score_run(run, truth, dynamic_speed_mps)
+    return PerceptionScore(run, Evaluation.of_perception(str(root), truth.world, figures))
+
+
 def evaluate_foreground(
     log_path: str | Path,
     *,
@@ -455,13 +495,13 @@ def evaluate_foreground(
     truth = load_truth(root)
     opts = {"detector": detector, "background_filter": background_filter, **options}
     fg_config = ForegroundConfig.from_options(**opts)
-    dyn = fg_config.dynamic_speed_mps
-    main = _run(root, truth, opts, max_frames, background)
-    ours = _score(main, truth, dyn)
+    main = perceive_and_score(root, background=background, max_frames=max_frames, truth=truth, **opts)
+    ours = main.evaluation.figures
     c4: dict[str, Any] | None = None
     if ablation and background_filter:
-        off = _run(root, truth, {**opts, "background_filter": False}, max_frames, background)
-        scored = _score(off, truth, dyn)
+        off = {**opts, "background_filter": False}
+        scored = perceive_and_score(root, background=background, max_frames=max_frames, truth=truth,
+                                    **off).evaluation.figures
         base = ours["detect_time_s"][0]
         slow = scored["detect_time_s"][0]
         c4 = {
@@ -474,7 +514,7 @@ def evaluate_foreground(
         }
     return ForegroundReport(
         log=str(root), world=truth.world, seed=truth.seed, detector=detector,
-        background_filter=background_filter, background_source=main.background_source,
+        background_filter=background_filter, background_source=main.run.background_source,
         classes=tuple(fg_config.classes), exclude_classes=tuple(fg_config.exclude_classes), ours=ours,
         ablation=c4,
     )

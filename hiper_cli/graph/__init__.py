@@ -9,6 +9,8 @@ from hiper_cli.graph.kb import (
     KbConfig,
     KnowledgeBase,
     SyncReport,
+    is_knowledge_base,
+    migrate_kb,
     open_kb,
     open_kb_for_reading,
 )
@@ -19,6 +21,8 @@ __all__ = [
     "KbConfig",
     "KnowledgeBase",
     "SyncReport",
+    "is_knowledge_base",
+    "migrate_kb",
     "open_kb",
     "open_kb_for_reading",
 ]

@@ -14,7 +14,7 @@ instance, the observations that say something:
 
 and summarises the others into the instance's stretches in view (``data.view_spans``: first
 and last stamp of each run of observations closer than ``STRETCH_GAP_S``; "time in view" reads
-them, ``span_stamps``);
+them, ``spans.span_stamps``);
 
 and drops the others, counting them in the instance (``data.observations_summarised``: its
 ``observation_count`` stays what was seen). Observations of a session whose stamps fall inside
@@ -41,18 +41,18 @@ from typing import TYPE_CHECKING, Any
 
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.poserows import thin_session
+from hiper_cli.graph.spans import VIEW_SPANS
 
 if TYPE_CHECKING:
     from hiper_cli.graph.kb import KnowledgeBase
 
-__all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans", "span_stamps"]
+__all__ = ["VIEW_SPANS", "CompactReport", "compact", "merge_spans"]
 
 STRETCH_GAP_S = 1.0  # observations further apart start a new stretch (the query layer's view_gap_s)
 MOVE_M = 0.25  # an observation this far from every one kept shows the object somewhere new
 DECIMALS = 5  # kept observations' coordinates to 10 µm, directions to 1e-5
 COVER_M = 0.2  # a plane's piece reaching this far beyond every kept one's box shows more of it
 SUMMARISED = "observations_summarised"
-VIEW_SPANS = "view_spans"  # [[first, last], ...] stamps of the stretches in view, summarised
 
 
 @dataclass
@@ -320,17 +320,6 @@ def _bytes(kb: KnowledgeBase) -> int:
     path = kb.docs.path
     wal = path.with_name(path.name + "-wal")
     return path.stat().st_size + (wal.stat().st_size if wal.exists() else 0)
-
-
-def span_stamps(doc: dict[str, Any], step_s: float = 0.5) -> list[float]:
-    """Stamps standing for an instance's summarised stretches in view (``VIEW_SPANS``): each
-    stretch from its first to its last stamp in ``step_s`` steps, so "time in view" over them
-    is what it was over the observations they summarise."""
-    out: list[float] = []
-    for a, b in (doc.get("data") or {}).get(VIEW_SPANS, []):
-        n = max(1, int((b - a) / step_s))
-        out += [a + (b - a) * k / n for k in range(n + 1)]
-    return out
 
 
 def summarised_count(doc: dict[str, Any]) -> int:

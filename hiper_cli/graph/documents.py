@@ -23,7 +23,7 @@ import sqlite3
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -42,10 +42,10 @@ from hiper_cli.graph.sqlite_guard import (
 )
 from hiper_cli.graph.trajectories import SCHEMA as TRAJECTORIES_SCHEMA
 from hiper_cli.graph.trajectories import TrajectoryStore
+from hiper_cli.graph.versions import SCHEMA_VERSION, check_version, stored_version
 
 __all__ = ["SCHEMA_VERSION", "DocumentStore", "Session", "dumps"]
 
-SCHEMA_VERSION = 1
 PAGE_SIZE = 2048
 # Observations' spatial-index rows and instance links are first appended to two small staging
 # tables (``obs_cells_new``, ``links_new``) and moved into their clustered tables once this many
@@ -165,6 +165,19 @@ class Session:
         }
 
 
+@dataclass
+class _Batch:
+    """The rows one ``put_many`` writes: documents, instance boxes, observation grid cells (and
+    the largest half-extent among them), observation -> instance links, long trajectories."""
+
+    rows: list[tuple[Any, ...]] = field(default_factory=list)
+    boxes: list[tuple[Any, ...]] = field(default_factory=list)
+    grid: list[tuple[Any, ...]] = field(default_factory=list)
+    margin_m: float = 0.0
+    obs_links: list[tuple[str, str, int]] = field(default_factory=list)
+    trajectories: list[tuple[str, list[Any] | None]] = field(default_factory=list)
+
+
 _SESSION_COLUMNS = "id, env_uuid, log_path, stages, started_s, ended_s, frames, last_pose_id, last_stamp_s"
 
 
@@ -210,6 +223,7 @@ class DocumentStore(ChangeFeed, Lookups):
         self.read_only = read_only
         if self.path.is_file() and self.path.stat().st_size > 0:
             inspect_existing(self.path)  # read-only: refuse another program's file before any write
+            check_version(self.path.parent, stored_version(self.path))  # and another schema version
         try:
             if read_only:
                 self._db = GuardedConnection(connect_read_only(self.path), self.path)
@@ -218,8 +232,8 @@ class DocumentStore(ChangeFeed, Lookups):
                                                              timeout=30.0), self.path)
                 # 2 KiB pages (only takes effect on a new file): a frame dirties a few dozen
                 # index pages spread over the file and COMMIT copies each into the WAL, so
-                # smaller pages mean fewer bytes per commit (measured: 4 KiB -> 2 KiB +20 %
-                # ingest at 100 k observations; 1 KiB was slower: deeper trees)
+                # smaller pages mean fewer bytes per commit (2 KiB ingests ~20 % faster than
+                # 4 KiB at 100 k observations; 1 KiB is slower: deeper trees)
                 self._db.execute(f"PRAGMA page_size={PAGE_SIZE}")
                 self._db.execute("PRAGMA journal_mode=WAL")
                 # NORMAL in WAL mode: a killed process never loses a committed transaction;
@@ -227,8 +241,8 @@ class DocumentStore(ChangeFeed, Lookups):
                 self._db.execute("PRAGMA synchronous=NORMAL")
                 # A bounded page cache (32 MiB) and fewer, larger checkpoints (a WAL of up to
                 # 40,000 pages = 80 MiB on disk: pages rewritten by many frames are copied back
-                # once per checkpoint): measured ~+30 % ingest at 500 k documents for 10,000
-                # 4 KiB pages, another ~+6 % for 40,000 2 KiB pages at 100 k; memory stays bounded.
+                # once per checkpoint) ingest ~1/3 faster at 500 k documents than SQLite's
+                # defaults; memory stays bounded.
                 self._db.execute("PRAGMA cache_size=-32768")
                 self._db.execute("PRAGMA wal_autocheckpoint=40000")
                 # the tables and the schema version in one transaction: a process killed while
@@ -248,12 +262,6 @@ class DocumentStore(ChangeFeed, Lookups):
             if isinstance(err, KnowledgeBaseError):
                 raise
             raise translate(self.path, err) from err
-        version = self.meta("schema_version")
-        if version is not None and int(version) != SCHEMA_VERSION:
-            raise KnowledgeBaseError(
-                f"{self.path}: schema version {version}, this hiper reads {SCHEMA_VERSION}; "
-                "export with the hiper that wrote it and import here"
-            )
         self._seq: int | None = None
         cell = self.meta("grid_cell_m")
         legacy = self._scalar("SELECT name FROM sqlite_master WHERE name = 'obs_grid'") is not None
@@ -401,13 +409,30 @@ class DocumentStore(ChangeFeed, Lookups):
         if not items:
             return
         seq = self._current_seq()
-        rows = []
-        boxes = []
-        grid = []
-        margin = 0.0
+        batch = self._batch(items, session_id, env_uuid, seq)
+        existing = self._write_rows(batch.rows)
+        index_rows = [r for r in map(self._index_box, batch.boxes) if r is not None]
+        if index_rows:
+            self._db.executemany(
+                "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?",
+                index_rows,
+            )
+        if batch.grid:
+            self._write_cells(batch.grid, batch.margin_m, existing)
+        if batch.obs_links:
+            self._write_obs_links(batch.obs_links, existing)
+        for doc, _ in items:
+            if doc["type"] == "instance":
+                self._link_instance(doc["uuid"], doc.get("observation_uuids", []), seq)
+        for uuid, apart in batch.trajectories:
+            self._traj.write(uuid, apart)
+        self._revive([r[0] for r in batch.rows])
+
+    def _batch(self, items: Sequence[tuple[dict[str, Any], Box | None]], session_id: int | None,
+               env_uuid: str | None, seq: int) -> _Batch:
+        """The rows of ``put_many``: documents, instance boxes, observation cells and links."""
+        batch = _Batch()
         cell_m = self._grid_cell_m
-        obs_links = []
-        trajectories: list[tuple[str, list[Any] | None]] = []
         for doc, box_map in items:
             stamp = doc.get("stamp_s", doc.get("last_seen_s", doc.get("t_end_s")))
             stored = doc
@@ -416,20 +441,24 @@ class DocumentStore(ChangeFeed, Lookups):
                 stored["observation_count"] = len(doc.get("observation_uuids", [])) + int(
                     (doc.get("data") or {}).get("observations_summarised", 0))  # see compact.py
                 stored, apart = self._traj.split(stored)  # long trajectories: see trajectories.py
-                trajectories.append((doc["uuid"], apart))
-            rows.append((doc["uuid"], doc["type"], doc.get("layer"), doc.get("class"), stamp,
-                         doc.get("instance_uuid"), session_id, env_uuid, seq, dumps(stored)))
+                batch.trajectories.append((doc["uuid"], apart))
+            batch.rows.append((doc["uuid"], doc["type"], doc.get("layer"), doc.get("class"), stamp,
+                               doc.get("instance_uuid"), session_id, env_uuid, seq, dumps(stored)))
             if box_map is not None:
                 lo, hi = box_map
                 if doc["type"] == "observation":
                     c = [(lo[k] + hi[k]) / 2.0 for k in range(3)]
-                    margin = max(margin, *(hi[k] - c[k] for k in range(3)))
-                    grid.append((cell_key(*(cell_index(v, cell_m) for v in c)),
-                                 lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
+                    batch.margin_m = max(batch.margin_m, *(hi[k] - c[k] for k in range(3)))
+                    batch.grid.append((cell_key(*(cell_index(v, cell_m) for v in c)),
+                                       lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
                 else:
-                    boxes.append((lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
+                    batch.boxes.append((lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], doc["uuid"]))
             if doc["type"] == "observation" and doc.get("instance_uuid"):
-                obs_links.append((doc["instance_uuid"], doc["uuid"], seq))
+                batch.obs_links.append((doc["instance_uuid"], doc["uuid"], seq))
+        return batch
+
+    def _write_rows(self, rows: list[tuple[Any, ...]]) -> set[str]:
+        """Insert or replace the document rows; the uuids of observations that were there already."""
         db = self._db
         obs_rows = [r for r in rows if r[1] == "observation"]
         existing: set[str] = set()
@@ -445,53 +474,48 @@ class DocumentStore(ChangeFeed, Lookups):
         other = [r for r in rows if r[1] != "observation"] if obs_rows else rows
         if other:
             db.executemany(self._UPSERT, other)
-        index_rows = [r for r in map(self._index_box, boxes) if r is not None]
-        if index_rows:
-            db.executemany(
-                "INSERT OR REPLACE INTO docs_box SELECT id, ?, ?, ?, ?, ?, ? FROM docs WHERE uuid = ?",
-                index_rows,
-            )
-        if grid:
-            # a re-written observation may move to another cell: drop its old entry first
-            if existing:
-                db.executemany("DELETE FROM obs_cells WHERE id = (SELECT id FROM docs WHERE uuid = ?)",
-                               [(u,) for u in existing])
-            db.executemany(
-                "INSERT OR REPLACE INTO obs_cells_new SELECT id, ?, ?, ?, ?, ?, ?, ? FROM docs "
-                "WHERE uuid = ?",
-                grid,
-            )
-            self._staged += len(grid) if self._staged >= 0 else 0
-            if margin > self._grid_margin():
-                self.set_meta("grid_margin_m", repr(margin))
-        if obs_links:
-            db.executemany("INSERT INTO links_new VALUES (?, ?, ?)", obs_links)
-            self._staged += len(obs_links) if self._staged >= 0 else 0
-            for instance_uuid, observation_uuid, _ in obs_links:
-                known = self._known_links(instance_uuid)
-                new = known >= 0 and observation_uuid not in existing
-                self._pending_link_counts[instance_uuid] = known + 1 if new else -1
-        for doc, _ in items:
-            if doc["type"] == "instance":
-                self._link_instance(doc["uuid"], doc.get("observation_uuids", []), seq)
-        for uuid, apart in trajectories:
-            self._traj.write(uuid, apart)
-        if self._scalar("SELECT EXISTS (SELECT 1 FROM tombstones)"):
-            # a document written again after its deletion: no tombstone any more, and its
-            # creation is unknown (the graph may still hold the node of its earlier life)
-            uuids = [r[0] for r in rows]
-            marks = ",".join("?" * len(uuids))
-            found = db.execute(f"SELECT uuid FROM tombstones WHERE uuid IN ({marks})", uuids)
-            revived = [(u,) for (u,) in found]
-            if revived:
-                db.executemany("DELETE FROM tombstones WHERE uuid = ?", revived)
-                db.executemany("UPDATE docs SET created_seq = NULL WHERE uuid = ?", revived)
+        return existing
+
+    def _write_cells(self, grid: list[tuple[Any, ...]], margin_m: float, existing: set[str]) -> None:
+        """The observations' grid cells; a re-written observation may move to another cell."""
+        if existing:
+            self._db.executemany("DELETE FROM obs_cells WHERE id = (SELECT id FROM docs WHERE uuid = ?)",
+                                 [(u,) for u in existing])
+        self._db.executemany(
+            "INSERT OR REPLACE INTO obs_cells_new SELECT id, ?, ?, ?, ?, ?, ?, ? FROM docs "
+            "WHERE uuid = ?",
+            grid,
+        )
+        self._staged += len(grid) if self._staged >= 0 else 0
+        if margin_m > self._grid_margin():
+            self.set_meta("grid_margin_m", repr(margin_m))
+
+    def _write_obs_links(self, obs_links: list[tuple[str, str, int]], existing: set[str]) -> None:
+        """The links of new observations to their instances, and the instances' pending counts."""
+        self._db.executemany("INSERT INTO links_new VALUES (?, ?, ?)", obs_links)
+        self._staged += len(obs_links) if self._staged >= 0 else 0
+        for instance_uuid, observation_uuid, _ in obs_links:
+            known = self._known_links(instance_uuid)
+            new = known >= 0 and observation_uuid not in existing
+            self._pending_link_counts[instance_uuid] = known + 1 if new else -1
+
+    def _revive(self, uuids: list[str]) -> None:
+        """A document written again after its deletion: no tombstone any more, and its
+        creation is unknown (the graph may still hold the node of its earlier life)."""
+        if not self._scalar("SELECT EXISTS (SELECT 1 FROM tombstones)"):
+            return
+        marks = ",".join("?" * len(uuids))
+        found = self._db.execute(f"SELECT uuid FROM tombstones WHERE uuid IN ({marks})", uuids)
+        revived = [(u,) for (u,) in found]
+        if revived:
+            self._db.executemany("DELETE FROM tombstones WHERE uuid = ?", revived)
+            self._db.executemany("UPDATE docs SET created_seq = NULL WHERE uuid = ?", revived)
 
     def _index_box(self, bounds: tuple[Any, ...]) -> tuple[Any, ...] | None:
         """The R*Tree row for a document's box (min_x, max_x, ..., max_z, uuid), or None while
         the box stays inside the row the index holds: rows are the box grown by
         ``BOX_SLACK_M`` on every side. A tracked instance moves a little every frame, and
-        re-inserting it into the R*Tree each time was ~20 % of the ingest (measured); queries
+        re-inserting it into the R*Tree each time would be ~20 % of the ingest; queries
         test each document's own box after the index."""
         uuid = bounds[6]
         held = self._pending_boxes.get(uuid, self._boxes.get(uuid))

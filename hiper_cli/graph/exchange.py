@@ -36,7 +36,7 @@ from hiper_cli.graph.kb import KnowledgeBase
 from hiper_cli.graph.ontology import HIPER, PROV, RDF_TYPE, doc_quads, h, layer_graph, link_quad, speed_mps
 from hiper_cli.model import LAYERS, Instance
 
-__all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_export"]
+__all__ = ["EXPORT_FORMATS", "export_kb", "guess_format", "import_kb", "json_export", "read_export_instances"]
 
 EXPORT_FORMATS = ("turtle", "nquads", "jsonld", "graphml", "json")
 _SUFFIX = {".ttl": "turtle", ".nq": "nquads", ".jsonld": "jsonld", ".graphml": "graphml", ".json": "json"}
@@ -281,6 +281,20 @@ def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]
             o = {**o, "instance_uuid": None}
         out.append((f"observations[{k}]", o))
     return out
+
+
+def read_export_instances(path: Path) -> tuple[list[Instance], list[dict[str, Any]]]:
+    """The instances and sessions of a JSON export, read as its knowledge base returns them
+    (a background piece's exported ``plane`` back in its ``data["plane_map"]``), for scoring."""
+    data = read_json_export(path)
+    planes = {i.get("uuid"): i.get("plane") for i in data.get("instances", [])}
+    instances = []
+    for _, doc in _docs_from_json(data, path):
+        if doc["type"] == "instance":
+            if planes.get(doc["uuid"]) is not None:
+                doc["data"].setdefault("plane_map", planes[doc["uuid"]])
+            instances.append(Instance.from_dict(doc))
+    return instances, list(data.get("sessions", []))
 
 
 def _vec(text: str | None) -> list[float]:

@@ -14,7 +14,7 @@ from hiper_cli.graph.sqlite_guard import GuardedConnection
 
 __all__ = ["GRID_CELL_M", "cell_index", "cell_key", "grid_rows"]
 
-GRID_CELL_M = 2.0  # new stores; one written before this value was chosen keeps 1 m (meta)
+GRID_CELL_M = 2.0  # for new stores; a store keeps the cell size it was created with (meta, else 1 m)
 MAX_COLUMNS = 4096
 _GRID_OFFSET = 1 << 19
 _GRID_SPAN = 1 << 20

@@ -166,42 +166,59 @@ def _check(doc: dict[str, Any]) -> None:
     if kind == "environment":
         _text(doc, "name")
     elif kind in ("instance", "observation"):
-        if doc.get("layer") not in PERCEIVED_LAYERS:
-            raise _Bad("layer", f"is {doc.get('layer')!r}, expected one of {', '.join(PERCEIVED_LAYERS)}")
-        _text(doc, "class")
-        _box(doc.get("box"))
-        _number(doc, "confidence", 0.0, 1.0)
-        if kind == "instance":
-            _number(doc, "first_seen_s")
-            _number(doc, "last_seen_s")
-            if doc.get("state", "static") not in STATES:
-                raise _Bad("state", f"is {doc.get('state')!r}, expected one of {', '.join(STATES)}")
-            links = doc.get("observation_uuids", [])
-            if not isinstance(links, list):
-                raise _Bad("observation_uuids", "is not a list of uuids")
-            for k, link in enumerate(links):
-                if not isinstance(link, str) or not UUID_RE.match(link):
-                    raise _Bad(f"observation_uuids[{k}]", f"is {link!r}, not a uuid")
-        else:
-            _number(doc, "stamp_s")
-            if not isinstance(doc.get("pose_id", -1), int) or isinstance(doc.get("pose_id"), bool):
-                raise _Bad("pose_id", f"is {doc.get('pose_id')!r}, expected an integer")
-            if doc.get("instance_uuid") is not None:
-                _uuid(doc, "instance_uuid")
-        if not isinstance(doc.get("data", {}), dict):
-            raise _Bad("data", "is not an object")
+        _perceived(doc, kind)
     elif kind == "analysis":
-        _text(doc, "kind")
-        if doc.get("class") is not None:
-            _text(doc, "class")
-        for key in ("t_start_s", "t_end_s", "created_s"):
-            _number(doc, key)
-        if not isinstance(doc.get("values"), dict):
-            raise _Bad("values", "is not an object")
+        _analysis(doc)
     elif kind == "change":
         _change(doc)
     else:
         raise _Bad("type", f"is {kind!r}, expected environment, instance, observation, analysis or change")
+
+
+def _perceived(doc: dict[str, Any], kind: str) -> None:
+    """An instance or an observation: layer, class, box, confidence, then its own fields."""
+    if doc.get("layer") not in PERCEIVED_LAYERS:
+        raise _Bad("layer", f"is {doc.get('layer')!r}, expected one of {', '.join(PERCEIVED_LAYERS)}")
+    _text(doc, "class")
+    _box(doc.get("box"))
+    _number(doc, "confidence", 0.0, 1.0)
+    if kind == "instance":
+        _instance(doc)
+    else:
+        _observation(doc)
+    if not isinstance(doc.get("data", {}), dict):
+        raise _Bad("data", "is not an object")
+
+
+def _instance(doc: dict[str, Any]) -> None:
+    _number(doc, "first_seen_s")
+    _number(doc, "last_seen_s")
+    if doc.get("state", "static") not in STATES:
+        raise _Bad("state", f"is {doc.get('state')!r}, expected one of {', '.join(STATES)}")
+    links = doc.get("observation_uuids", [])
+    if not isinstance(links, list):
+        raise _Bad("observation_uuids", "is not a list of uuids")
+    for k, link in enumerate(links):
+        if not isinstance(link, str) or not UUID_RE.match(link):
+            raise _Bad(f"observation_uuids[{k}]", f"is {link!r}, not a uuid")
+
+
+def _observation(doc: dict[str, Any]) -> None:
+    _number(doc, "stamp_s")
+    if not isinstance(doc.get("pose_id", -1), int) or isinstance(doc.get("pose_id"), bool):
+        raise _Bad("pose_id", f"is {doc.get('pose_id')!r}, expected an integer")
+    if doc.get("instance_uuid") is not None:
+        _uuid(doc, "instance_uuid")
+
+
+def _analysis(doc: dict[str, Any]) -> None:
+    _text(doc, "kind")
+    if doc.get("class") is not None:
+        _text(doc, "class")
+    for key in ("t_start_s", "t_end_s", "created_s"):
+        _number(doc, key)
+    if not isinstance(doc.get("values"), dict):
+        raise _Bad("values", "is not an object")
 
 
 def _change(doc: dict[str, Any]) -> None:

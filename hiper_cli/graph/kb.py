@@ -29,7 +29,9 @@ import numpy as np
 from hiper_cli import DEFAULT_KB
 from hiper_cli.errors import ConfigError, GraphDamagedError, KnowledgeBaseError
 from hiper_cli.graph.documents import DocumentStore, Session
+from hiper_cli.graph.door import DOCUMENTS_FILE, KbDoor, is_knowledge_base
 from hiper_cli.graph.location import kb_location
+from hiper_cli.graph.migrate import GRAPH_REBUILD_KEY, MigrationReport, migrate_documents
 from hiper_cli.graph.ontology import (
     OBSERVATION_BATCH_S,
     OBSERVATION_DETAIL,
@@ -51,11 +53,12 @@ __all__ = [
     "KbConfig",
     "KnowledgeBase",
     "SyncReport",
+    "is_knowledge_base",
+    "migrate_kb",
     "open_kb",
     "open_kb_for_reading",
 ]
 
-DOCUMENTS_FILE = "documents.sqlite"
 GRAPH_DIR = "graph"
 
 
@@ -125,9 +128,10 @@ def _value(term: Any) -> Any:
     return str(term)
 
 
-class KnowledgeBase(KbReads):
+class KnowledgeBase(KbReads, KbDoor):
     """Open with ``open_kb``. Not thread-safe; one writer process at a time. The typed reads
-    of the query layer come from ``KbReads`` (``reads.py``)."""
+    of the query layer come from ``KbReads`` (``reads.py``), those of the other packages from
+    ``KbDoor`` (``door.py``)."""
 
     def __init__(
         self,
@@ -640,9 +644,10 @@ def open_kb(
         docs.close()
         raise
     kb = KnowledgeBase(root, graph, docs, config or KbConfig(), read_only=read_only)
-    if rebuilt:
-        kb.sync_graph(rebuild=True)
-        kb.graph_rebuilt = True
+    if rebuilt or (not read_only and docs.meta(GRAPH_REBUILD_KEY) is not None):
+        kb.sync_graph(rebuild=True)  # a damaged graph, or one a migration changed (migrate.py)
+        docs.connection.execute("DELETE FROM meta WHERE key = ?", (GRAPH_REBUILD_KEY,))
+        kb.graph_rebuilt = rebuilt
     elif sync and not read_only:
         try:
             kb.sync_graph()
@@ -650,6 +655,16 @@ def open_kb(
             kb.close(sync=False)
             raise
     return kb
+
+
+def migrate_kb(location: str | Path = DEFAULT_KB, *, docs_dir: str | Path | None = None) -> MigrationReport:
+    """Carry the knowledge base at ``location`` forward to this hiper's schema version, after a
+    backup copy beside it (``migrate.py``), and rebuild its graph when the migration asks for it."""
+    report = migrate_documents(location, docs_dir=docs_dir)
+    if report.migrated:
+        with open_kb(location, docs_dir=docs_dir, create=False):
+            pass  # the open rebuilds the graph the migration marked
+    return report
 
 
 def _fresh_graph(path: Path) -> LocalGraph:

@@ -54,8 +54,7 @@ _INTEGER = ox.NamedNode(XSD + "integer")
 #   of observations and their first and last stamps (the paper's "links to a batch of
 #   time-continuous child observations"); the observations themselves stay in the documents.
 #   The graph then grows with instances, not observations: the on-disk store's memory grows
-#   with the quads it holds (62 -> 96 MB over 400 k quads, 129 MB with lookups mixed in:
-#   scripts/bench_graph_store.py).
+#   with the quads it holds (about 100 MB at 400 k quads: scripts/bench_graph_store.py).
 # "summary": a node per observation (its type) and the provenance link from its instance
 #   (bulk-loaded: ~70 k observations/s with 2 quads each, ~45 k/s with 4);
 # "full": also class, stamp, pose id, frame, confidence and the camera-frame box.

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["POSE_TOL_DEG", "POSE_TOL_M", "pose_at", "thin_session"]
+__all__ = ["POSE_TOL_DEG", "POSE_TOL_M", "matrices", "pose_at", "thin_session"]
 
 POSE_TOL_M = 0.01  # an interpolated pose lies this close to the one recorded ...
 POSE_TOL_DEG = 0.5  # ... and turned this little from it
@@ -113,3 +113,17 @@ def pose_at(db: Any, session_id: int, stamp_s: float, text: str) -> list[list[fl
     a = (stamp_s - float(before[0])) / (float(after[0]) - float(before[0]))
     T = interpolate(np.asarray(json.loads(before[1])), np.asarray(json.loads(after[1])), a)
     return [[round(float(v), 6) for v in row] for row in T.tolist()]
+
+
+def matrices(stamps_s: list[float], texts: list[str]) -> F64:
+    """(N, 4, 4) matrices of a session's pose rows (stamps and matrix texts, in stamp order),
+    the empty ones interpolated between the nearest rows that keep one."""
+    out = np.zeros((len(texts), 4, 4))
+    known = [k for k, text in enumerate(texts) if text]
+    for k in known:
+        out[k] = np.asarray(json.loads(texts[k]), dtype=np.float64)
+    for lo, hi in pairwise(known):
+        for k in range(lo + 1, hi):
+            a = (stamps_s[k] - stamps_s[lo]) / (stamps_s[hi] - stamps_s[lo])
+            out[k] = interpolate(out[lo], out[hi], a)
+    return out

@@ -83,7 +83,7 @@ class KbReads:
     def observation_stamps_of(self, instance_uuid: str) -> list[float]:
         """The stamps of an instance's observations, with those its summarised stretches in
         view stand for (``compact.py``)."""
-        from hiper_cli.graph.compact import VIEW_SPANS, span_stamps
+        from hiper_cli.graph.spans import VIEW_SPANS, span_stamps
 
         stamps = self.docs.observation_stamps(instance_uuid)
         doc = self.docs.get(instance_uuid)

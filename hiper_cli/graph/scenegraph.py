@@ -278,7 +278,7 @@ class LocalGraph:
 
     @_guarded
     def begin_sync(self, kb_id: str) -> None:
-        # not flushed here: a flush costs ~70 ms whatever its size (measured), and only a bulk
+        # not flushed here: a flush costs ~70 ms whatever its size, and only a bulk
         # load needs the mark on disk first (``append_nquads`` flushes before one)
         self._store.add(ox.Quad(_kb_node(kb_id), _DIRTY, _TRUE, meta_graph(kb_id)))
 

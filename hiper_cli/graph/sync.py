@@ -118,10 +118,10 @@ def sync_graph(
     report.sessions = len(sessions)
     graph.set_synced_seq(kb_id, upto)
     # RocksDB keeps one write buffer per index in memory until flushed: flushing after large
-    # catch-ups bounds the writer's memory (measured 355 -> 187 MB at 60 k observations). A
-    # flush costs ~70 ms however little it writes (measured), 97 % of a sync after every live
-    # frame: small syncs leave their quads buffered (in the write-ahead log, which readers see
-    # too) until FLUSH_MIN_QUADS have gathered.
+    # catch-ups bounds the writer's memory (it halves it at 60 k observations). A flush costs
+    # ~70 ms however little it writes, most of a sync after every live frame: small syncs
+    # leave their quads buffered (in the write-ahead log, which readers see too) until
+    # FLUSH_MIN_QUADS have gathered.
     if graph.buffered_quads() >= FLUSH_MIN_QUADS:
         graph.flush()
     report.seconds = time.perf_counter() - start

@@ -12,12 +12,13 @@ from pathlib import Path
 from typing import Any
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.evaluate import Evaluation, evaluate_kb
 from hiper_cli.perceive.logs.truth import load_truth
 from hiper_cli.qa.questions import generate_questions
 from hiper_cli.qa.scene import load_scene_truth
 from hiper_cli.qa.score import Scored, answer_question, summarise
 
-__all__ = ["QaReport", "QaSet", "evaluate_qa", "evaluate_qa_set", "pick_detector"]
+__all__ = ["QaReport", "QaSet", "evaluate_qa", "evaluate_qa_set", "has_scene_truth", "pick_detector"]
 
 # DAAAM (OC-NaVQA, real data, a cloud LLM): binary accuracy, position error (m), time error (s).
 PUBLISHED = {"system": "DAAAM on OC-NaVQA", "binary_accuracy": 0.711, "position_error_m": 41.75,
@@ -35,11 +36,15 @@ class QaReport:
     scored: list[Scored] = field(default_factory=list)
     files: dict[str, str] = field(default_factory=dict)
     seconds: dict[str, float] = field(default_factory=dict)
+    # the knowledge base scored against the log's scene truth (``hiper_cli.evaluate``), where
+    # the log has one: what the answers stand on
+    perception: Evaluation | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"format": "hiper-eval-qa", "version": 1, "log": self.log, "kb": self.kb,
                 "detector": self.detector, "short_s": self.short_s, "seed": self.seed,
-                **self.figures, "published": PUBLISHED, "files": self.files, "seconds": self.seconds}
+                **self.figures, "published": PUBLISHED, "files": self.files, "seconds": self.seconds,
+                "perception": None if self.perception is None else self.perception.to_dict()}
 
 
 def pick_detector(log: Path, detector: str) -> str:
@@ -129,8 +134,16 @@ def evaluate_qa(
     Path(files["questions"]).write_text("".join(json.dumps(q.to_dict()) + "\n" for q in questions))
     Path(files["answers"]).write_text("".join(json.dumps(s.to_dict()) + "\n" for s in scored))
     figures = summarise(scored) | {"seen_min_pixels": scene.min_pixels, "glimpse_s": glimpse_s}
+    t0 = time.perf_counter()
+    perception = evaluate_kb(kb, log) if has_scene_truth(log) else None
+    seconds["perception"] = time.perf_counter() - t0
     return QaReport(str(log), kb, used, short_s, seed, figures, scored, files,
-                    {k: round(v, 2) for k, v in seconds.items()})
+                    {k: round(v, 2) for k, v in seconds.items()}, perception)
+
+
+def has_scene_truth(log: Path) -> bool:
+    """The log's truth can score a knowledge base's instances (``evaluate_kb``)."""
+    return (log / "gt" / "instances.json").is_file() and (log / "gt" / "surface_points.npz").is_file()
 
 
 @dataclass

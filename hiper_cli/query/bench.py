@@ -190,7 +190,7 @@ def run_query_bench(
     """Build (or reuse, when ``kb_path`` holds one) the synthetic KB and time every form."""
     import tempfile
 
-    from hiper_cli.graph.kb import open_kb
+    from hiper_cli.graph.kb import is_knowledge_base, open_kb
     from hiper_cli.query import ask, trajectory, when
     from hiper_cli.query.describe import describe
     from hiper_cli.query.workspace import workspace
@@ -200,7 +200,7 @@ def run_query_bench(
         tmp = tempfile.TemporaryDirectory(prefix="hiper-query-bench-")
         kb_path = Path(tmp.name) / "bench.hiper"
     build_s = 0.0
-    if not (kb_path / "documents.sqlite").exists():
+    if not is_knowledge_base(kb_path):
         t0 = time.perf_counter()
         build_bench_kb(kb_path, config, progress)
         build_s = time.perf_counter() - t0

@@ -38,26 +38,19 @@ from hiper_cli.query.phrases import (
     SEEN_WORDS,
     SIGHTING_VERBS,
     STATIC_WORDS,
+    UNDERSTOOD,
     VERTICAL_CLASSES,
+    keywords,
     tokens,
 )
 from hiper_cli.query.results import ANSWER_KINDS
 from hiper_cli.query.spec import Near, On, QueryConfig, QuerySpec
 from hiper_cli.query.suggest import refusal
-from hiper_cli.query.timewords import TIME_UNITS_S, TimeAnchor, TimeWindow, clock_stamp, read_time_phrase
+from hiper_cli.query.timewords import TimeAnchor, TimeWindow, clock_stamp, read_time_phrase
 from hiper_cli.query.vocabulary import ANY_FOREGROUND, PLACE_WORDS, plural, resolve_class, singular
 
 __all__ = ["FILLER", "UNDERSTOOD", "ParsedQuery", "keywords", "parse", "parse_time", "tokens", "with_limit"]
 
-UNDERSTOOD = (
-    "classes (cup, chair, person, table, bottle, ... singular or plural; synonyms such as mug, sofa, "
-    "fridge, desk, people, someone; 'objects'/'anything' for all); space: in FOV, closest/nearest, "
-    "within R m of X|me, near X, on the (closest) X, here; time: now, recently, in the last N "
-    "seconds|minutes|hours, N minutes ago, since|before|after HH:MM or an event ('after the person "
-    "left'), between A and B, today, yesterday, last seen, first seen; change: new, gone, moved; "
-    "passing: pass|enter|leave X|here; state: moving, static; questions: how many/count/number of, "
-    "where, when/last time, how long, is there/any/did, go to"
-)
 @dataclass(frozen=True)
 class ParsedQuery:
     """A plain-words query as data: the answer kind, the selection and, for time answers,
@@ -439,16 +432,6 @@ class _Parser:
                          until_s=window.until_s, change=change, **f)
         assert answer in ANSWER_KINDS
         return ParsedQuery(self.text, answer, spec, time_of, window.since_event, window.until_event)
-
-
-def keywords() -> set[str]:
-    """Every word the grammar reads besides class words (for suggestions)."""
-    words = set(FILLER) | set(LENGTH_UNITS) | MOVING_WORDS | STATIC_WORDS | ME_WORDS | FOV_WORDS
-    words |= set(tokens(UNDERSTOOD))
-    for table in (QUESTION_PHRASES, CHANGE_WORDS, PASS_VERBS, ARRIVE_LEAVE_VERBS):
-        for phrase, _kind in table:
-            words.update(phrase)
-    return words | set(TIME_UNITS_S) | {"closest", "nearest", "within", "beside", "nearby", "confidence"}
 
 
 def _parses(text: str, now_s: float, cfg: QueryConfig) -> bool:

@@ -99,7 +99,7 @@ class InstanceIndex:
 def instance_index(kb: KnowledgeBase) -> InstanceIndex:
     """The index of ``kb``'s instances at its current graph version (cached per process)."""
     key = (kb.location, kb.kb_id)
-    version = kb.graph.synced_seq(kb.kb_id)
+    version = kb.graph_synced_seq()
     with _LOCK:
         held = _CACHE.get(key)
         if held is not None and held[0] == version:

@@ -1,11 +1,14 @@
 """The words and phrases of the plain-words grammar (``grammar.py``), as data: filler words,
 question phrases and the answer each asks for, change words, passing verbs, words of
-nearness, order and confidence, chat shorthand; and ``tokens``, which normalises a query's
-words before the grammar reads them."""
+nearness, order and confidence, chat shorthand; ``UNDERSTOOD``, what the grammar reads in one
+line; ``tokens``, which normalises a query's words before the grammar reads them; and
+``keywords``, every word the grammar reads (what a refusal's suggestions are drawn from)."""
 
 from __future__ import annotations
 
 import re
+
+from hiper_cli.query.timewords import TIME_UNITS_S
 
 __all__ = [
     "ARRIVE_LEAVE_VERBS",
@@ -28,7 +31,9 @@ __all__ = [
     "SHORTHAND",
     "SIGHTING_VERBS",
     "STATIC_WORDS",
+    "UNDERSTOOD",
     "VERTICAL_CLASSES",
+    "keywords",
     "tokens",
 ]
 
@@ -202,3 +207,24 @@ def tokens(text: str) -> list[str]:
     words = re.split(r"[\s,;!?\"'()\[\]{}<>*]+", text)
     words = [w.rstrip(".") if re.fullmatch(r"[\d.:]+", w) else w.rstrip(".:") for w in words if w.strip(".:")]
     return [part for w in words for part in SHORTHAND.get(w, w).split()]
+
+
+UNDERSTOOD = (
+    "classes (cup, chair, person, table, bottle, ... singular or plural; synonyms such as mug, sofa, "
+    "fridge, desk, people, someone; 'objects'/'anything' for all); space: in FOV, closest/nearest, "
+    "within R m of X|me, near X, on the (closest) X, here; time: now, recently, in the last N "
+    "seconds|minutes|hours, N minutes ago, since|before|after HH:MM or an event ('after the person "
+    "left'), between A and B, today, yesterday, last seen, first seen; change: new, gone, moved; "
+    "passing: pass|enter|leave X|here; state: moving, static; questions: how many/count/number of, "
+    "where, when/last time, how long, is there/any/did, go to"
+)
+
+
+def keywords() -> set[str]:
+    """Every word the grammar reads besides class words (for suggestions)."""
+    words = set(FILLER) | set(LENGTH_UNITS) | MOVING_WORDS | STATIC_WORDS | ME_WORDS | FOV_WORDS
+    words |= set(tokens(UNDERSTOOD))
+    for table in (QUESTION_PHRASES, CHANGE_WORDS, PASS_VERBS, ARRIVE_LEAVE_VERBS):
+        for phrase, _kind in table:
+            words.update(phrase)
+    return words | set(TIME_UNITS_S) | {"closest", "nearest", "within", "beside", "nearby", "confidence"}

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from functools import cache
 
+from hiper_cli.query.phrases import keywords
 from hiper_cli.query.vocabulary import PLACE_WORDS, class_words
 
 __all__ = ["edit_distance", "max_edits", "nearest_word", "refusal"]
@@ -58,9 +59,7 @@ def _near_enough(word: str, known: str, d: int) -> bool:
 
 @cache
 def _vocabulary() -> tuple[str, ...]:
-    from hiper_cli.query import grammar
-
-    words = grammar.keywords()
+    words = keywords()
     for phrase in class_words():
         words.update(phrase.split())
     return tuple(sorted(w for w in words if w.isalpha() and w not in PLACE_WORDS))

@@ -178,114 +178,121 @@ def _status(err: HiperError) -> int:
     return 403 if "refused" in text else 400
 
 
-def _handler(endpoint: SparqlEndpoint) -> type[BaseHTTPRequestHandler]:
-    class Handler(BaseHTTPRequestHandler):
-        server_version = "hiper-sparql/1"
-        timeout = READ_TIMEOUT_S  # socket timeout: a stalled client does not hold a thread
+class _Handler(BaseHTTPRequestHandler):
+    """One request to the endpoint: a read-only SPARQL query by GET or POST, CORS preflight;
+    every error one plain-text line with its HTTP status."""
 
-        def log_message(self, format: str, *args: Any) -> None:  # quiet: no per-request lines
-            pass
+    endpoint: SparqlEndpoint  # set by ``_handler``
+    server_version = "hiper-sparql/1"
+    timeout = READ_TIMEOUT_S  # socket timeout: a stalled client does not hold a thread
 
-        def _send(self, code: int, body: bytes, media: str) -> None:
-            self.send_response(code)
-            self.send_header("Content-Type", f"{media}; charset=utf-8")
-            self.send_header("Content-Length", str(len(body)))
-            self._cors_headers()
-            self.end_headers()
-            self.wfile.write(body)
+    def log_message(self, format: str, *args: Any) -> None:  # quiet: no per-request lines
+        pass
 
-        def _cors_headers(self) -> None:
-            if endpoint.cors is not None:
-                self.send_header("Access-Control-Allow-Origin", endpoint.cors)
-                self.send_header("Vary", "Origin")
+    def _send(self, code: int, body: bytes, media: str) -> None:
+        self.send_response(code)
+        self.send_header("Content-Type", f"{media}; charset=utf-8")
+        self.send_header("Content-Length", str(len(body)))
+        self._cors_headers()
+        self.end_headers()
+        self.wfile.write(body)
 
-        def _error(self, code: int, message: str) -> None:
-            self._send(code, message.encode("utf-8"), "text/plain")
+    def _cors_headers(self) -> None:
+        if self.endpoint.cors is not None:
+            self.send_header("Access-Control-Allow-Origin", self.endpoint.cors)
+            self.send_header("Vary", "Origin")
 
-        def _run(self, params: dict[str, list[str]], body_query: str | None) -> None:
-            path = urllib.parse.urlsplit(self.path).path.rstrip("/")
-            if path.endswith("/update") or "update" in params:
-                self._error(403, "this endpoint is read-only: SPARQL updates are refused")
-                return
-            if path not in ("/query", "/sparql", ""):
-                self._error(404, f"no such resource {path}; send queries to /query")
-                return
-            query = body_query if body_query is not None else next(iter(params.get("query") or []), None)
-            if not query:
-                self._error(
-                    400, "missing query: GET /query?query=... or POST a application/sparql-query body"
-                )
-                return
-            media = choose_media_type(
-                self.headers.get("Accept"), next(iter(params.get("format") or []), None)
+    def _error(self, code: int, message: str) -> None:
+        self._send(code, message.encode("utf-8"), "text/plain")
+
+    def _run(self, params: dict[str, list[str]], body_query: str | None) -> None:
+        path = urllib.parse.urlsplit(self.path).path.rstrip("/")
+        if path.endswith("/update") or "update" in params:
+            self._error(403, "this endpoint is read-only: SPARQL updates are refused")
+            return
+        if path not in ("/query", "/sparql", ""):
+            self._error(404, f"no such resource {path}; send queries to /query")
+            return
+        query = body_query if body_query is not None else next(iter(params.get("query") or []), None)
+        if not query:
+            self._error(
+                400, "missing query: GET /query?query=... or POST a application/sparql-query body"
             )
-            try:
-                body, media = endpoint.answer(query, media)
-            except HiperError as err:
-                self._error(_status(err), str(err))
-                return
-            self._send(200, body, media)
+            return
+        media = choose_media_type(
+            self.headers.get("Accept"), next(iter(params.get("format") or []), None)
+        )
+        try:
+            body, media = self.endpoint.answer(query, media)
+        except HiperError as err:
+            self._error(_status(err), str(err))
+            return
+        self._send(200, body, media)
 
-        def _host_ok(self) -> bool:
-            if host_allowed(self.headers.get("Host"), endpoint.hosts):
-                return True
-            self._error(421, f"Host {self.headers.get('Host')!r} is not this endpoint's; use "
-                             "http://127.0.0.1:PORT/query (or serve --allow-host NAME)")
-            return False
+    def _host_ok(self) -> bool:
+        if host_allowed(self.headers.get("Host"), self.endpoint.hosts):
+            return True
+        self._error(421, f"Host {self.headers.get('Host')!r} is not this endpoint's; use "
+                         "http://127.0.0.1:PORT/query (or serve --allow-host NAME)")
+        return False
 
-        def _body(self) -> bytes | None:
-            """The request body, or None after answering 4xx for a bad or missing length."""
-            declared = self.headers.get("Content-Length")
-            if declared is None:
-                self._error(411, "a POST needs a Content-Length header")
-                return None
-            if not declared.strip().isdigit():
-                self._error(400, f"Content-Length {declared!r}: expected a non-negative integer")
-                return None
-            length = int(declared)
-            if length > MAX_BODY_BYTES:
-                self._error(413, f"Content-Length {length}: a query body may be at most {MAX_BODY_BYTES} "
-                                 "bytes")
-                return None
-            try:
-                raw = self.rfile.read(length)
-            except TimeoutError:
-                raw = b""
-            if len(raw) != length:
-                self.close_connection = True
-                self._error(400, f"the body ended after {len(raw)} of {length} declared bytes")
-                return None
-            return raw
+    def _body(self) -> bytes | None:
+        """The request body, or None after answering 4xx for a bad or missing length."""
+        declared = self.headers.get("Content-Length")
+        if declared is None:
+            self._error(411, "a POST needs a Content-Length header")
+            return None
+        if not declared.strip().isdigit():
+            self._error(400, f"Content-Length {declared!r}: expected a non-negative integer")
+            return None
+        length = int(declared)
+        if length > MAX_BODY_BYTES:
+            self._error(413, f"Content-Length {length}: a query body may be at most {MAX_BODY_BYTES} "
+                             "bytes")
+            return None
+        try:
+            raw = self.rfile.read(length)
+        except TimeoutError:
+            raw = b""
+        if len(raw) != length:
+            self.close_connection = True
+            self._error(400, f"the body ended after {len(raw)} of {length} declared bytes")
+            return None
+        return raw
 
-        def do_GET(self) -> None:
-            if self._host_ok():
-                self._run(urllib.parse.parse_qs(urllib.parse.urlsplit(self.path).query), None)
+    def do_GET(self) -> None:
+        if self._host_ok():
+            self._run(urllib.parse.parse_qs(urllib.parse.urlsplit(self.path).query), None)
 
-        def do_POST(self) -> None:
-            if not self._host_ok():
-                return
-            body = self._body()
-            if body is None:
-                return
-            raw = body.decode("utf-8", "replace")
-            ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
-            params = urllib.parse.parse_qs(urllib.parse.urlsplit(self.path).query)
-            if ctype == "application/sparql-query":
-                self._run(params, raw)
-            elif ctype == "application/sparql-update":
-                self._error(403, "this endpoint is read-only: SPARQL updates are refused")
-            else:
-                self._run({**params, **urllib.parse.parse_qs(raw)}, None)
+    def do_POST(self) -> None:
+        if not self._host_ok():
+            return
+        body = self._body()
+        if body is None:
+            return
+        raw = body.decode("utf-8", "replace")
+        ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
+        params = urllib.parse.parse_qs(urllib.parse.urlsplit(self.path).query)
+        if ctype == "application/sparql-query":
+            self._run(params, raw)
+        elif ctype == "application/sparql-update":
+            self._error(403, "this endpoint is read-only: SPARQL updates are refused")
+        else:
+            self._run({**params, **urllib.parse.parse_qs(raw)}, None)
 
-        def do_OPTIONS(self) -> None:
-            if not self._host_ok():
-                return
-            self.send_response(204)
-            if endpoint.cors is not None:
-                self._cors_headers()
-                self.send_header("Access-Control-Allow-Methods", "GET, POST, OPTIONS")
-                self.send_header("Access-Control-Allow-Headers", "Content-Type, Accept")
-            self.send_header("Content-Length", "0")
-            self.end_headers()
+    def do_OPTIONS(self) -> None:
+        if not self._host_ok():
+            return
+        self.send_response(204)
+        if self.endpoint.cors is not None:
+            self._cors_headers()
+            self.send_header("Access-Control-Allow-Methods", "GET, POST, OPTIONS")
+            self.send_header("Access-Control-Allow-Headers", "Content-Type, Accept")
+        self.send_header("Content-Length", "0")
+        self.end_headers()
 
-    return Handler
+
+
+def _handler(endpoint: SparqlEndpoint) -> type[BaseHTTPRequestHandler]:
+    """The request handler class of ``endpoint`` (``http.server`` builds one per request)."""
+    return type("Handler", (_Handler,), {"endpoint": endpoint})

@@ -130,6 +130,71 @@ def _person_box(height_m: float, radius_m: float, x: float, y: float) -> Box3D:
     return Box3D(np.array([x, y, height_m / 2.0]), np.array([2 * radius_m, 2 * radius_m, height_m]))
 
 
+def _advance(route: Route, route_t: float, waited_s: float, dt: float, people_xy: np.ndarray,
+             max_wait_s: float) -> tuple[float, float]:
+    """The robot's (route time, time waited) after ``dt``: it waits while someone is in its way,
+    up to ``max_wait_s``, then goes on."""
+    in_way = _blocked(route, route_t, people_xy)
+    if in_way and waited_s < max_wait_s:
+        return route_t, waited_s + dt
+    return route_t + dt, 0.0 if not in_way else waited_s
+
+
+@dataclass
+class _MoverTruth:
+    """What the moving bodies (people, carts) leave in ``gt/``: each one's first box, its
+    centre over time and the rows of tracks.csv."""
+
+    first_box: dict[int, Box3D] = field(default_factory=dict)
+    centres: dict[int, list[list[float]]] = field(default_factory=dict)  # id: [t, x, y, z] rows
+    tracks_rows: list[list[Any]] = field(default_factory=list)
+
+    def add(self, body_id: int, t: float, box: Box3D, vx: float, vy: float) -> None:
+        self.first_box.setdefault(body_id, box)
+        self.centres.setdefault(body_id, []).append([float(t), *box.center_m])
+        self.tracks_rows.append([f"{t:.6f}", body_id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))])
+
+
+def _people_meshes(crowd: Crowd) -> tuple[list[list[Mesh]], list[float]]:
+    """Each person's mesh in ``_STRIDES`` leg poses, and their horizontal radius in metres."""
+    people_meshes: list[list[Mesh]] = []
+    radius: list[float] = []
+    for spec in crowd.specs:
+        poses = [
+            human(spec.height_m, spec.skin, spec.shirt, spec.trousers, spec.hair, s)
+            for s in np.linspace(-1.0, 1.0, _STRIDES)
+        ]
+        people_meshes.append(poses)
+        radius.append(max(float(np.hypot(m.vertices[:, 0], m.vertices[:, 1]).max()) for m in poses))
+    return people_meshes, radius
+
+
+def _people_at(t: float, crowd: Crowd, people_meshes: list[list[Mesh]], radius: list[float],
+               movers: _MoverTruth) -> list[tuple[int, Mesh]]:
+    """The people's meshes where they are at ``t``, their truth recorded in ``movers``."""
+    dynamic: list[tuple[int, Mesh]] = []
+    for i, spec in enumerate(crowd.specs):
+        px, py = crowd.pos[i]
+        s = round((crowd.stride(i) + 1.0) / 2.0 * (_STRIDES - 1))
+        dynamic.append((spec.id, people_meshes[i][s].transformed(rot_z(crowd.heading[i], (px, py, 0.0)))))
+        vx, vy = crowd.vel[i]
+        movers.add(spec.id, t, _person_box(spec.height_m, radius[i], float(px), float(py)), vx, vy)
+    return dynamic
+
+
+def _carts_at(t: float, carts: Carts, movers: _MoverTruth) -> list[tuple[int, Mesh]]:
+    """The carts' meshes where they are at ``t``, their truth recorded in ``movers``."""
+    dynamic: list[tuple[int, Mesh]] = []
+    for i, cspec in enumerate(carts.specs):
+        cx, cy = carts.pos[i]
+        mesh = cspec.mesh.transformed(rot_z(cspec.yaw_rad, (cx, cy, 0.0)))
+        dynamic.append((cspec.id, mesh))
+        lo, hi = mesh.bounds()
+        vx, vy = carts.vel[i]
+        movers.add(cspec.id, t, Box3D((lo + hi) / 2.0, hi - lo), vx, vy)
+    return dynamic
+
+
 def simulate(
     world: str | World,
     seconds: float,
@@ -168,15 +233,7 @@ def simulate(
     crowd = Crowd(w, seed, cfg.people)
     carts = Carts(w.carts, seed)
 
-    people_meshes: list[list[Mesh]] = []
-    radius: list[float] = []
-    for spec in crowd.specs:
-        poses = [
-            human(spec.height_m, spec.skin, spec.shirt, spec.trousers, spec.hair, s)
-            for s in np.linspace(-1.0, 1.0, _STRIDES)
-        ]
-        people_meshes.append(poses)
-        radius.append(max(float(np.hypot(m.vertices[:, 0], m.vertices[:, 1]).max()) for m in poses))
+    people_meshes, radius = _people_meshes(crowd)
     classes = {o.id: o.class_name for o in w.objects}
     classes.update({s.id: "person" for s in crowd.specs})
     classes.update({c.id: "cart" for c in carts.specs})
@@ -189,9 +246,7 @@ def simulate(
     for folder in ("rgb", "depth", "gt/instance_ids"):  # with overwrite: drop images of an older log
         for stale in (root / folder).glob("*.png"):
             stale.unlink(missing_ok=True)  # another run may have removed it
-    first_box: dict[int, Box3D] = {}
-    tracks_rows: list[list[Any]] = []
-    centres: dict[int, list[list[float]]] = {}  # id: [t, x, y, z] rows of the moving instances
+    movers = _MoverTruth()
     all_ids = [o.id for o in w.objects] + [s.id for s in crowd.specs] + [c.id for c in carts.specs]
     scene_truth = SceneTruthRecorder(renderer.camera, cfg.render.max_range_m, max(all_ids, default=0) + 1)
     png = [cv2.IMWRITE_PNG_COMPRESSION, int(cfg.png_compression)]
@@ -213,43 +268,16 @@ def simulate(
             dt = float(t - prev_t)
             prev_t = float(t)
             if k > 0:
-                in_way = _blocked(route, route_t, crowd.pos if operating else np.zeros((0, 2)))
-                if in_way and waited_s < cfg.route.max_wait_s:
-                    waited_s += dt
-                else:
-                    route_t += dt
-                    waited_s = 0.0 if not in_way else waited_s
+                people_xy = crowd.pos if operating else np.zeros((0, 2))
+                route_t, waited_s = _advance(route, route_t, waited_s, dt, people_xy, cfg.route.max_wait_s)
             x, y, _ = route.state_at(route_t)
             if operating and k > op_start:
                 crowd.step(dt, (x, y), carts.footprints())
             carts.step(dt, operating and k > op_start)
             dynamic: list[tuple[int, Mesh]] = []
             if operating:
-                for i, spec in enumerate(crowd.specs):
-                    px, py = crowd.pos[i]
-                    s = round((crowd.stride(i) + 1.0) / 2.0 * (_STRIDES - 1))
-                    dynamic.append(
-                        (spec.id, people_meshes[i][s].transformed(rot_z(crowd.heading[i], (px, py, 0.0))))
-                    )
-                    box = _person_box(spec.height_m, radius[i], float(px), float(py))
-                    first_box.setdefault(spec.id, box)
-                    centres.setdefault(spec.id, []).append([float(t), *box.center_m])
-                    vx, vy = crowd.vel[i]
-                    tracks_rows.append(
-                        [f"{t:.6f}", spec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
-                    )
-            for i, cspec in enumerate(carts.specs):
-                cx, cy = carts.pos[i]
-                mesh = cspec.mesh.transformed(rot_z(cspec.yaw_rad, (cx, cy, 0.0)))
-                dynamic.append((cspec.id, mesh))
-                lo, hi = mesh.bounds()
-                box = Box3D((lo + hi) / 2.0, hi - lo)
-                first_box.setdefault(cspec.id, box)
-                centres.setdefault(cspec.id, []).append([float(t), *box.center_m])
-                vx, vy = carts.vel[i]
-                tracks_rows.append(
-                    [f"{t:.6f}", cspec.id, *(f"{v:.5f}" for v in (*box.center_m, vx, vy, 0.0))]
-                )
+                dynamic += _people_at(float(t), crowd, people_meshes, radius, movers)
+            dynamic += _carts_at(float(t), carts, movers)
             T = route.pose_at(route_t)
             rng = np.random.default_rng([seed, k])
             image = renderer.render(T, dynamic, rng)
@@ -278,19 +306,19 @@ def simulate(
     with (gt / "tracks.csv").open("w", newline="") as fh:
         out_csv = csv.writer(fh)
         out_csv.writerow(["stamp_s", "id", "x", "y", "z", "vx", "vy", "vz"])
-        out_csv.writerows(tracks_rows)
+        out_csv.writerows(movers.tracks_rows)
     (gt / "noise.json").write_text(json.dumps(cfg.noise.to_dict(), indent=2) + "\n")
     sensor.write_truth(gt)
     (gt / "world.json").write_text(
-        json.dumps(_world_doc(w, crowd, carts, first_box, cfg, stamps, op_start), indent=1) + "\n"
+        json.dumps(_world_doc(w, crowd, carts, movers.first_box, cfg, stamps, op_start), indent=1) + "\n"
     )
-    movers = [(s.id, s.name, "person", s.speed_mps) for s in crowd.specs]
-    movers += [(c.id, c.name, "cart", c.speed_mps) for c in carts.specs]
+    moving = [(s.id, s.name, "person", s.speed_mps) for s in crowd.specs]
+    moving += [(c.id, c.name, "cart", c.speed_mps) for c in carts.specs]
     scene_truth.write(
         gt, w.name, seed, cfg.rate_hz,
         [StaticTruth(o.id, o.name, o.class_name, o.mesh, o.plane) for o in w.objects],
-        [DynamicTruth(i, name, cls, np.asarray(centres[i]), first_box[i].extent_m, float(speed))
-         for i, name, cls, speed in movers if i in centres],
+        [DynamicTruth(i, name, cls, np.asarray(movers.centres[i]), movers.first_box[i].extent_m, float(speed))
+         for i, name, cls, speed in moving if i in movers.centres],
     )
     return SimResult(
         root,

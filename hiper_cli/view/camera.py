@@ -11,6 +11,7 @@ log stays quick to write and to open.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -18,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.graph import KnowledgeBase
+from hiper_cli.model import Observation
 from hiper_cli.perceive.logs import LogReader
 from hiper_cli.types import Frame
 from hiper_cli.view.scene import TimeWindow
@@ -55,17 +57,17 @@ def pick_frames(stamps_s: NDArray[np.float64], window: TimeWindow, image_hz: flo
     return picked
 
 
-def overlay_of(docs: list[dict[str, Any]]) -> FrameOverlay:
-    """The overlay of a frame from its observation documents."""
+def overlay_of(observations: Sequence[Observation]) -> FrameOverlay:
+    """The overlay of a frame from its observations."""
     boxes, labels, box_cls = [], [], []
     blobs: list[NDArray[np.float64]] = []
     blob_cls: list[str] = []
     planes: list[NDArray[np.float64]] = []
     plane_cls: list[str] = []
-    for doc in docs:
-        data, cls = doc.get("data", {}), str(doc["class"])
+    for obs in observations:
+        data, cls = obs.data, obs.class_name
         uv = np.asarray(data.get("pixels_uv") or [], dtype=np.float64).reshape(-1, 2)
-        if doc.get("layer") == "background":
+        if obs.layer == "background":
             planes.append(uv)
             plane_cls += [cls] * len(uv)
             continue
@@ -116,8 +118,7 @@ def log_frames(rec: Any, set_time: Any, reader: LogReader, kb: KnowledgeBase, wi
     picked = pick_frames(info.stamps_s, window, image_hz)
     for k in picked:
         frame = reader.read_frame(k)
-        docs = kb.docs.find(type="observation", t_start_s=frame.stamp_s - _STAMP_TOL_S,
-                            t_end_s=frame.stamp_s + _STAMP_TOL_S)
+        seen = kb.observations_between(frame.stamp_s - _STAMP_TOL_S, frame.stamp_s + _STAMP_TOL_S)
         set_time(frame.stamp_s)
-        log_frame_images(rr, rec, frame, overlay_of(docs), jpeg_quality)
+        log_frame_images(rr, rec, frame, overlay_of(seen), jpeg_quality)
     return len(picked)

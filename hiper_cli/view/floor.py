@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
-    from hiper_cli.view.scene import TimeWindow
+    from hiper_cli.view.window import TimeWindow
 
 __all__ = ["FLOOR_KINDS", "GRID_KEYS", "FloorImage", "floor_images"]
 

@@ -90,7 +90,7 @@ class LiveView:
         if self.image_hz > 0 and frame.stamp_s - self._last_image_s < 1.0 / self.image_hz:
             return
         self._last_image_s = frame.stamp_s
-        log_frame_images(self.rr, self.rec, frame, overlay_of([o.to_dict() for o in result.observations]))
+        log_frame_images(self.rr, self.rec, frame, overlay_of(result.observations))
         if len(self._path_m) >= 2:
             path = self._path_m[:: max(1, len(self._path_m) // _PATH_VERTICES)]
             self.rec.log(ROBOT_PATH, self.rr.LineStrips3D([path], colors=[(60, 60, 60)], radii=0.01))

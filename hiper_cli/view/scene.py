@@ -10,41 +10,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import ConfigError
 from hiper_cli.graph import KnowledgeBase
-from hiper_cli.model import Box3D
+from hiper_cli.model import Box3D, Instance
 from hiper_cli.view.floor import FloorImage, floor_images
+from hiper_cli.view.window import TimeWindow
 
 __all__ = ["BackgroundItem", "RobotPath", "TimeWindow", "TrackItem", "ViewScene", "load_scene"]
-
-
-@dataclass(frozen=True)
-class TimeWindow:
-    """A closed interval of log stamps in seconds; None leaves that end open."""
-
-    start_s: float | None = None
-    end_s: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.start_s is not None and self.end_s is not None and self.end_s < self.start_s:
-            raise ConfigError(f"--from {self.start_s:g} is after --to {self.end_s:g}; swap them")
-
-    def overlaps(self, first_s: float, last_s: float) -> bool:
-        after_start = self.start_s is None or last_s >= self.start_s
-        return after_start and (self.end_s is None or first_s <= self.end_s)
-
-    def mask(self, stamps_s: NDArray[np.float64]) -> NDArray[np.bool_]:
-        keep = np.ones(len(stamps_s), dtype=bool)
-        if self.start_s is not None:
-            keep &= stamps_s >= self.start_s
-        if self.end_s is not None:
-            keep &= stamps_s <= self.end_s
-        return keep
 
 
 @dataclass(frozen=True)
@@ -147,45 +122,40 @@ class ViewScene:
         return float(min(floors)) if floors else 0.0
 
 
-def _background(doc: dict[str, Any]) -> BackgroundItem:
-    contour = np.asarray(doc.get("data", {}).get("contour_map", []), dtype=np.float64).reshape(-1, 3)
-    return BackgroundItem(doc["uuid"], doc["class"], Box3D.from_dict(doc["box"]), contour,
-                          float(doc["first_seen_s"]), float(doc["last_seen_s"]))
+def _background(inst: Instance) -> BackgroundItem:
+    contour = np.asarray(inst.data.get("contour_map", []), dtype=np.float64).reshape(-1, 3)
+    return BackgroundItem(inst.uuid, inst.class_name, inst.box, contour,
+                          float(inst.first_seen_s), float(inst.last_seen_s))
 
 
-def _track(doc: dict[str, Any], window: TimeWindow) -> TrackItem | None:
+def _track(inst: Instance, window: TimeWindow) -> TrackItem | None:
     """The instance's trajectory rows [t, x, y, z, vx, vy, vz] inside the window; an instance
     without rows is seen at its box centre at its first and last sighting."""
-    box = Box3D.from_dict(doc["box"])
-    rows = np.asarray(doc.get("data", {}).get("trajectory") or [], dtype=np.float64)
+    box = inst.box
+    rows = np.asarray(inst.data.get("trajectory") or [], dtype=np.float64)
     if rows.ndim != 2 or rows.shape[1] < 4 or len(rows) == 0:
-        stamps = np.array(sorted({float(doc["first_seen_s"]), float(doc["last_seen_s"])}))
+        stamps = np.array(sorted({float(inst.first_seen_s), float(inst.last_seen_s)}))
         rows = np.column_stack([stamps, np.tile(box.center_m, (len(stamps), 1)), np.zeros((len(stamps), 3))])
     rows = rows[np.argsort(rows[:, 0], kind="stable")]
     rows = rows[window.mask(rows[:, 0])]
     if len(rows) == 0:
         return None
     speed = np.linalg.norm(rows[:, 4:7], axis=1) if rows.shape[1] >= 7 else np.zeros(len(rows))
-    return TrackItem(doc["uuid"], doc["class"], str(doc.get("state", "static")), box,
+    return TrackItem(inst.uuid, inst.class_name, str(inst.state), box,
                      rows[:, 0].copy(), rows[:, 1:4].copy(), np.nan_to_num(speed))
 
 
 def _robot(kb: KnowledgeBase, log: Path | None, window: TimeWindow) -> tuple[RobotPath, ...]:
     paths = []
     wanted = str(log.resolve()) if log is not None else None
-    sessions = kb.docs.sessions()
+    sessions = kb.sessions()
     if wanted is not None and any(s.log_path == wanted for s in sessions):
         sessions = [s for s in sessions if s.log_path == wanted]
     for session in sessions:
-        poses = [kb.docs.pose(session.id, k) for k in range((session.last_pose_id or -1) + 1)]
-        held = [p for p in poses if p is not None]
-        if not held:
-            continue
-        stamps = np.array([p[0] for p in held], dtype=np.float64)
-        T = np.array([p[1] for p in held], dtype=np.float64).reshape(-1, 4, 4)
-        keep = window.mask(stamps)
+        poses = kb.session_poses(session.id)
+        keep = window.mask(poses.stamps_s)
         if keep.any():
-            paths.append(RobotPath(session.id, session.log_path, stamps[keep], T[keep]))
+            paths.append(RobotPath(session.id, session.log_path, poses.stamps_s[keep], poses.T_map_cam[keep]))
     return tuple(paths)
 
 
@@ -194,13 +164,11 @@ def load_scene(kb: KnowledgeBase, window: TimeWindow | None = None, log: Path | 
     that of the sessions that perceived this log (all sessions when none did)."""
     window = window or TimeWindow()
     background, foreground = [], []
-    for doc in kb.docs.find(type="instance"):
-        if not window.overlaps(float(doc["first_seen_s"]), float(doc["last_seen_s"])):
-            continue
-        if doc["layer"] == "background":
-            background.append(_background(doc))
-        elif doc["layer"] == "foreground" and (track := _track(doc, window)) is not None:
+    for inst in kb.instances_seen(window.start_s, window.end_s):
+        if inst.layer == "background":
+            background.append(_background(inst))
+        elif inst.layer == "foreground" and (track := _track(inst, window)) is not None:
             foreground.append(track)
-    floor = floor_images(kb.docs.find(type="analysis"), [e.data for e in kb.environments()], window)
+    floor = floor_images([a.to_dict() for a in kb.analyses()], [e.data for e in kb.environments()], window)
     return ViewScene(kb.location, window, tuple(background), tuple(foreground),
                      _robot(kb, log, window), floor)

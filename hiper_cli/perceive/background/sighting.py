@@ -1,9 +1,9 @@
 """Seeing a known surface again: a background instance's ``last_seen`` follows the camera.
 
-An instance's ``last_seen_s`` moved only when a keyframe's plane observation merged into it
-(Algorithm 2). A table seen again at 4.6 m, across a room at a grazing angle, or a wall piece
-half hidden by furniture forms no plane segment, so "was there a table in the last 15
-seconds" answered no while the table was in view. Each keyframe, the depth samples (every
+Plane observations alone (Algorithm 2) move an instance's ``last_seen_s`` only when one merges
+into it. A table seen again at 4.6 m, across a room at a grazing angle, or a wall piece half
+hidden by furniture forms no plane segment, so "was there a table in the last 15 seconds"
+would answer no while the table is in view. Each keyframe, the depth samples (every
 ``sighting_stride_px``-th pixel, map frame) that lie on a known instance, inside its box grown by
 the inlier distance (``inlier_m`` times the depth, as the plane segmentation uses), are counted;
 an instance with samples for ``sighting_min_pixels`` pixels of the image (the truth detector's

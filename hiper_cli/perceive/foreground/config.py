@@ -308,7 +308,7 @@ class MatchConfig(_Part):
     couch_or_bed: bool = True
     """A blob a detection names ``couch`` or ``bed`` takes the other name when its tall part
     says so (``couch_or_bed.py``): a back along a long side is a couch's, a headboard across a
-    short end a bed's (issue 17: YOLOX-Nano named a couch ``bed`` in 26 views of 27)."""
+    short end a bed's (YOLOX-Nano names a couch ``bed`` in most of its views)."""
     unknown_max_extent_m: float = 1.0
     """An unmatched blob is seen *whole* (``whole.py``: evidence for an ``unknown`` instance)
     only when inside the image (not within one ``pixel_step`` of its edge: a shelf, a wall or a
@@ -491,18 +491,18 @@ class TrackerConfig(_Part):
     walker_from_floor: bool = True
     """An observation a detection names a walker class spans from the floor to its blob's top
     (the centre halfway): people stand on the floor, and a person behind a shelf or a table
-    shows only the upper body (issue 17: person centres 0.5-0.8 m off in height)."""
+    shows only the upper body, whose blob alone puts the centre 0.5-0.8 m too high."""
     walker_level: bool = True
     """Tracks of a walker class (or, before a track has a class, observations of one) have no
     vertical velocity: people walk on the floor, so their centre is half their height up (a high
-    quantile of their blobs' tops) and is never extrapolated (issue 17: person boxes below the
-    floor, and 0.7 m low from the mean of partial blobs)."""
+    quantile of their blobs' tops) and is never extrapolated (a vertical velocity drives boxes
+    below the floor, and the mean of partial blobs puts a person 0.7 m low)."""
     complete_footprints: bool = True
     """A static bed, couch or refrigerator seen in part has its box extended behind the faces
     the camera saw, to its class's least footprint width, and a chair, couch or refrigerator
-    whose top no view showed is raised to its class's least height (``amodal.py``; issue 17: a
-    bed seen through a doorway as a strip of its side, its centre 0.54 m off; chairs behind a
-    desk kept up to the seat)."""
+    whose top no view showed is raised to its class's least height (``amodal.py``): a bed seen
+    through a doorway as a strip of its side is otherwise centred half a metre off, and a chair
+    behind a desk ends at its seat."""
     reidentify: bool = True
     """At the end of a session, a static object of a class that stays put whose box overlaps an
     earlier session's instance of its class (``stitch_min_overlap``, ``stitch_overlap_m``) joins

@@ -23,7 +23,7 @@ Two kinds of blobs became people, and their tracks then lived on after the perso
   person split by a table lie at the same depth and both keep the name. For the other
   classes the blob that fits the box best is what the detection saw, and blobs in front of it
   are not either: the end of a desk before a chair fills part of the chair's box, and the
-  nearest rule gave the desk the name (docs/foreground.md has the measurement).
+  nearest rule would give the desk the chair's name.
 """
 
 from __future__ import annotations

@@ -14,9 +14,9 @@ at table height (``unseen_table_lookalikes``: a bench's seat is lower) whose blo
 top named the table, not what remains of the blob. Once the background layer maps the
 table, its filter removes the top and ``legs.py`` the legs before this step.
 
-Each frame decides anew. Remembering a table found once and removing it from every blob that
-reached it later was tried: on the tuning logs it cut chair backs that cross the top's height
-and doubled the identity switches.
+Each frame decides anew: a table remembered once and removed from every blob that reaches it
+later would cut the chair backs that cross the top's height (twice the identity switches on the
+tuning logs).
 """
 
 from __future__ import annotations

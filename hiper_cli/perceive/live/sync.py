@@ -105,10 +105,10 @@ class FrameSync:
     def add_camera_info(self, raw: bytes) -> None:
         if self.camera is not None:
             return
-        from hiper_cli.perceive.logs.rosbag import _camera_from_info
+        from hiper_cli.perceive.logs.rosbag import camera_from_info
 
         msg = typestore(False).deserialize_cdr(raw, "sensor_msgs/msg/CameraInfo")
-        camera = _camera_from_info(msg, self.depth_scale, "live CameraInfo")
+        camera = camera_from_info(msg, self.depth_scale, "live CameraInfo")
         with self._cond:
             self.camera = camera
             self._advance()

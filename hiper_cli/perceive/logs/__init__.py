@@ -23,6 +23,7 @@ from typing import Any, Protocol, runtime_checkable
 from hiper_cli.errors import ConfigError, LogError
 from hiper_cli.perceive.logs.bag_writer import BAG_KINDS, BagLayout, BagWriter
 from hiper_cli.perceive.logs.base import LogInfo, StampGap
+from hiper_cli.perceive.logs.formats import detect_format
 from hiper_cli.perceive.logs.options import DEFAULT_MAX_DT_S, LogOptions
 from hiper_cli.perceive.logs.topics import BagTopics
 from hiper_cli.perceive.logs.trajectory import Trajectory, read_tum_trajectory, write_tum_trajectory
@@ -64,31 +65,6 @@ class LogReader(Protocol):
     def info(self) -> LogInfo: ...
 
     def read_frame(self, pose_id: int) -> Frame: ...
-
-
-def detect_format(path: Path) -> str:
-    """``tum``, ``rosbag1``, ``rosbag2`` or ``mcap``; ``LogError`` when it is none of them."""
-    from hiper_cli.perceive.logs.tum import is_tum_folder
-
-    if not path.exists():
-        raise LogError(f"{path}: no such file or folder; pass a TUM folder, a .bag, a rosbag2 folder "
-                       "or an .mcap file")
-    if path.is_dir():
-        if is_tum_folder(path):
-            return "tum"
-        if (path / "metadata.yaml").is_file():
-            return "rosbag2"
-        raise LogError(f"{path}: not a log folder (no rgb.txt or associations.txt, no metadata.yaml); "
-                       "expected a TUM RGB-D folder or a rosbag2 folder")
-    suffix = path.suffix.lower()
-    if suffix == ".bag":
-        return "rosbag1"
-    if suffix == ".mcap":
-        return "mcap"
-    if suffix == ".db3" and (path.parent / "metadata.yaml").is_file():
-        return "rosbag2"
-    raise LogError(f"{path}: unknown log type '{suffix or path.name}'; expected a TUM folder, .bag, "
-                   "a rosbag2 folder or .mcap")
 
 
 def open_log(

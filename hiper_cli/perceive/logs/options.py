@@ -85,7 +85,7 @@ class LogOptions:
                 width=int(self.width_px or 0), height=int(self.height_px or 0), fx=float(self.fx_px),
                 fy=float(self.fy_px or 0), cx=float(self.cx_px or 0), cy=float(self.cy_px or 0))
         if intrinsics is None and self.depth_scale is not None:
-            from hiper_cli.perceive.logs import detect_format
+            from hiper_cli.perceive.logs.formats import detect_format
 
             if detect_format(log) == "tum":
                 from hiper_cli.perceive.logs.tum import tum_camera

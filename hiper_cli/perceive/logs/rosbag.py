@@ -33,7 +33,7 @@ from hiper_cli.perceive.logs.trajectory import Trajectory
 from hiper_cli.perceive.logs.tum import associate
 from hiper_cli.types import CameraIntrinsics, Detections
 
-__all__ = ["BagReader", "open_bag"]
+__all__ = ["BagReader", "camera_from_info", "open_bag"]
 
 IMAGE = "sensor_msgs/msg/Image"
 COMPRESSED = "sensor_msgs/msg/CompressedImage"
@@ -141,7 +141,9 @@ def _near(reference: str, options: list[str]) -> list[str]:
     return sorted(options, key=lambda name: (-shared(name), name))
 
 
-def _camera_from_info(msg: Any, depth_scale: float, source: str) -> CameraIntrinsics:
+def camera_from_info(msg: Any, depth_scale: float, source: str) -> CameraIntrinsics:
+    """A ``sensor_msgs/CameraInfo`` (ROS 1 ``K``/``D`` or ROS 2 ``k``/``d``) as intrinsics, from a
+    bag or a live topic; ``source`` names it in the error when its K is not a camera's."""
     K = np.asarray(getattr(msg, "K", None) if hasattr(msg, "K") else msg.k, dtype=np.float64).reshape(-1)
     D = np.asarray(getattr(msg, "D", None) if hasattr(msg, "D") else msg.d, dtype=np.float64).reshape(-1)
     if len(K) != 9 or K[0] <= 0 or K[4] <= 0:
@@ -326,7 +328,7 @@ def _intrinsics(path: Path, found: dict[str, Any], reader: Any, topics: BagTopic
         if info_topic is None:
             raise LogError(f"{path}: missing camera intrinsics (no sensor_msgs/CameraInfo topic); pass "
                            "--info-topic, --camera camera.json or --fx/--fy/--cx/--cy/--width/--height")
-        camera = _camera_from_info(_first(reader, info_topic), topics.depth_scale, f"{path} {info_topic}")
+        camera = camera_from_info(_first(reader, info_topic), topics.depth_scale, f"{path} {info_topic}")
         sources["camera"] = f"{path} {info_topic}"
     else:
         sources["camera"] = "flags"

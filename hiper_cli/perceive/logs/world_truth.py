@@ -28,8 +28,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.errors import LogError
 from hiper_cli.model import Box3D
-
-from .truth import Phase, Truth, TruthInstance
+from hiper_cli.perceive.logs.truth_types import Phase, Truth, TruthInstance
 
 __all__ = ["WORLD_TRUTH_FILE", "load_world_truth"]
 
