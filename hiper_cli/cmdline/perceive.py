@@ -43,8 +43,8 @@ Align = Annotated[str, typer.Option("--align", help=(
     "first session defines the frame), none (its poses are map poses) or FILE (a 4x4 T_map_log)."))]
 Keep = Annotated[str, typer.Option("--keep-observations", help=(
     "Keep raw observations this long before the newest stamp ('10 minutes', '2 h'); older ones that add "
-    "nothing are summarised at the end of the session; 0 summarises all. 'all' (default) keeps every "
-    "observation, which hiper reanchor needs; hiper kb compact summarises later."))]
+    "nothing are summarised at the end of the session. 0 (default) summarises all (what hiper reanchor "
+    "needs stays); 'all' keeps every observation."))]
 View = Annotated[bool, typer.Option(
     "--view", help="Watch the run in a new Rerun viewer (pip install 'hiper\\[view]').")]
 Timings = Annotated[bool, typer.Option(

@@ -19,7 +19,7 @@ def perceive_command(
     detector: o.Detector = None, no_background_filter: o.NoFilter = False, classes: o.Classes = None,
     exclude_classes: o.Exclude = None, mapping_hz: o.MappingHz = None, option: o.Options = None,
     resume: o.Resume = False, replace: o.Replace = False, again: o.Again = False, env: o.Env = None,
-    align: o.Align = "auto", keep_observations: o.Keep = "all", view: o.View = False,
+    align: o.Align = "auto", keep_observations: o.Keep = "0", view: o.View = False,
     timings: o.Timings = False, idle_timeout: o.IdleTimeout = None, queue: o.Queue = 1,
     look_ahead: o.LookAhead = False, stats: o.Stats = False, as_json: Json = False, *,
     log_options: LogOptions) -> None:

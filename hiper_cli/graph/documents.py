@@ -32,6 +32,7 @@ from hiper_cli.graph.changes import ChangeFeed
 from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.grid import GRID_CELL_M, cell_index, cell_key, grid_rows
 from hiper_cli.graph.lookups import Lookups
+from hiper_cli.graph.poserows import pose_at
 from hiper_cli.graph.sqlite_guard import (
     GuardedConnection,
     connect_read_only,
@@ -121,6 +122,15 @@ CREATE TABLE IF NOT EXISTS poses (
     PRIMARY KEY (session_id, pose_id)
 ) WITHOUT ROWID;
 """
+
+
+def pose_text(T_map_cam: Any) -> str:
+    """A pose row's 4×4 matrix as compact JSON: rotation to 1e-6, translation to 10 µm (a
+    pose row a frame is most of what a session adds once its observations are summarised;
+    this is about half the full-precision text)."""
+    rows = T_map_cam.tolist() if hasattr(T_map_cam, "tolist") else T_map_cam
+    top = [[round(float(v), 6) for v in row[:3]] + [round(float(row[3]), 5)] for row in rows[:3]]
+    return json.dumps([*top, [0, 0, 0, 1]], separators=(",", ":"))
 
 
 @dataclass(frozen=True)
@@ -591,10 +601,9 @@ class DocumentStore(ChangeFeed, Lookups):
     def record_frame(self, session_id: int, pose_id: int, stamp_s: float, T_map_cam: Any) -> None:
         """The pose row of a committed frame and the session's progress."""
         seq = self._current_seq()
-        matrix = T_map_cam.tolist() if hasattr(T_map_cam, "tolist") else T_map_cam
         self._db.execute(
             "INSERT OR REPLACE INTO poses VALUES (?, ?, ?, ?)",
-            (session_id, pose_id, stamp_s, json.dumps(matrix)),
+            (session_id, pose_id, stamp_s, pose_text(T_map_cam)),
         )
         self._db.execute(
             "UPDATE sessions SET frames = frames + 1, last_pose_id = ?, last_stamp_s = ?, seq = ? "
@@ -766,7 +775,7 @@ class DocumentStore(ChangeFeed, Lookups):
         row = self._db.execute(
             "SELECT stamp_s, T_map_cam FROM poses WHERE session_id = ? AND pose_id = ?", (session_id, pose_id)
         ).fetchone()
-        return None if row is None else (float(row[0]), json.loads(row[1]))
+        return None if row is None else (float(row[0]), pose_at(self._db, session_id, float(row[0]), row[1]))
 
     def pose_count(self, session_id: int) -> int:
         return int(self._scalar("SELECT COUNT(*) FROM poses WHERE session_id = ?", (session_id,)))

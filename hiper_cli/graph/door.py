@@ -9,7 +9,6 @@ around the door.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ from hiper_cli.graph.columns import (
 )
 from hiper_cli.graph.documents import DocumentStore
 from hiper_cli.graph.history import Change
+from hiper_cli.graph.poserows import matrices
 from hiper_cli.model import Environment, Instance, Observation
 
 __all__ = ["DOCUMENTS_FILE", "KbDoor", "KbSizes", "SessionPoses", "is_knowledge_base"]
@@ -119,8 +119,9 @@ class KbDoor:
         rows = self.docs.connection.execute(
             "SELECT stamp_s, T_map_cam FROM poses WHERE session_id = ? ORDER BY pose_id", (session_id,)
         ).fetchall()
-        return SessionPoses(session_id, log_path, np.array([r[0] for r in rows], dtype=np.float64),
-                            np.array([json.loads(r[1]) for r in rows], dtype=np.float64).reshape(-1, 4, 4))
+        stamps = [float(r[0]) for r in rows]
+        return SessionPoses(session_id, log_path, np.array(stamps, dtype=np.float64),
+                            matrices(stamps, [r[1] for r in rows]).reshape(-1, 4, 4))
 
     def sizes(self) -> KbSizes:
         """Documents per type and the foreground trajectory rows."""

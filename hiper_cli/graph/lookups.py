@@ -4,11 +4,11 @@ blob). A mixin of ``DocumentStore``."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from typing import Any
 
 from hiper_cli.graph.grid import grid_rows
+from hiper_cli.graph.poserows import pose_at
 from hiper_cli.graph.sqlite_guard import GuardedConnection
 
 __all__ = ["Lookups"]
@@ -79,7 +79,9 @@ class Lookups:
                 "ORDER BY stamp_s DESC, session_id DESC LIMIT 1",
                 (float(stamp_s),),
             ).fetchone()
-        return None if row is None else (int(row[0]), int(row[1]), float(row[2]), json.loads(row[3]))
+        if row is None:
+            return None
+        return int(row[0]), int(row[1]), float(row[2]), pose_at(self._db, int(row[0]), float(row[2]), row[3])
 
     def stamp_span(self) -> tuple[float, float] | None:
         """(first, last) stamp of the poses and documents, None for an empty store."""
