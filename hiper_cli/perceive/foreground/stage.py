@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
@@ -160,6 +160,9 @@ class ForegroundStage:
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
+        # whether the earlier sessions saw something inside a box (set by the caller, who has
+        # the place's cloud): an object found there was not moved there (``_reidentify``)
+        self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
 
     # --- learned priors ---------------------------------------------------------------------
@@ -561,7 +564,9 @@ class ForegroundStage:
         vacated = self._empty.vacated() if self._empty is not None else {}
         # seen empty now, or by an earlier session: gone from where it was
         gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
-        moved = moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
+        occupied = self.occupied_before or (lambda _: False)
+        movers = [n for n in new if n.uuid not in paired and not occupied(n)]
+        moved = moved_pairs(movers, gone, max_m=cfg.reidentify_moved_m)
         found += moved
         for old, absorbed in found:
             fold(old, absorbed)
