@@ -13,7 +13,14 @@ import pytest
 
 from hiper_cli.graph import open_kb
 from hiper_cli.model import Box3D, Instance
-from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
+from hiper_cli.perceive.foreground.reidentify import (
+    cosighted_pairs,
+    fold,
+    fold_mover,
+    moved_pairs,
+    pairs,
+    still_seen,
+)
 from hiper_cli.perceive.foreground.stage import ForegroundStage
 from hiper_cli.perceive.foreground.stitch import footprint_share
 from hiper_cli.perceive.logs import open_log
@@ -102,6 +109,18 @@ def test_a_move_goes_to_the_object_of_its_shape_and_support():
     in_reach = _inst("cup", [3.6, 0.0, 0.0], [3.7, 0.1, 0.1])  # 2.1 m
     assert _moved([in_reach], [on_floor]) == [(on_floor.uuid, in_reach.uuid)]
     assert _moved([_inst("cup", [4.7, 0.0, 0.0], [4.8, 0.1, 0.1])], [on_floor]) == []  # beyond 3 m
+
+
+def test_a_place_seen_empty_with_its_object_seen_there_all_the_same_is_not_vacated():
+    """A cup 6 cm off (drift) or a second instance of it: rays to its old points pass, the cup
+    stands there; a chair 0.8 m from one taken away, or a cup of another class, does not."""
+    duplicate = _inst("cup", [1.77, 1.85, 0.72], [1.87, 1.98, 0.81])
+    chair_gone = _inst("chair", [2.0, 2.4, 0.0], [2.44, 2.84, 0.92])
+    cup_gone = _inst("cup", [3.0, 0.0, 0.72], [3.08, 0.08, 0.8])
+    seen = [_inst("cup", [1.75, 1.92, 0.72], [1.89, 2.02, 0.83]),  # the cup this session
+            _inst("chair", [2.8, 2.4, 0.0], [3.24, 2.84, 0.92]),  # the chair beside the one taken away
+            _inst("bottle", [3.0, 0.0, 0.72], [3.08, 0.08, 1.0])]  # a bottle where the cup stood
+    assert still_seen([duplicate, chair_gone, cup_gone], seen) == {duplicate.uuid}
 
 
 def test_fold_keeps_the_earlier_uuid_and_the_box_seen_last():

@@ -18,7 +18,11 @@ distance, shape and support, ``move_cost``), not the nearest pair first: two cha
 and one set down between them go to the one whose size, height and support fit, and a nearest
 first choice cannot take back a pair that leaves another object without its only partner.
 Pairs are one to one; the earlier instance absorbs the new one (``fold``) and keeps its uuid.
-An earlier instance seen empty and left unpaired is marked vacated by the stage.
+An earlier instance seen empty and left unpaired is marked vacated by the stage, unless this
+session saw an object of its class at its place all the same (``still_seen``): a small object
+(a cup) a few centimetres off where it was, through pose drift, or a second instance an
+earlier session made of one object, is seen empty by rays aimed at its old points, yet the
+object is there.
 
 A walker is not where it was, so it is never joined by place; but one seen at the same times
 at the same place is the same walker (``cosighted_pairs``): the same log perceived again
@@ -35,7 +39,7 @@ import numpy as np
 from hiper_cli.model import ROW_STAMP, Instance
 from hiper_cli.perceive.foreground.stitch import STAMP_MATCH_S, common_distance_m, footprint_share
 
-__all__ = ["cosighted_pairs", "fold", "fold_mover", "move_cost", "moved_pairs", "pairs"]
+__all__ = ["cosighted_pairs", "fold", "fold_mover", "move_cost", "moved_pairs", "pairs", "still_seen"]
 
 UNKNOWN = "unknown"
 SAME_ROW_M = 0.25  # a row at a stamp the earlier trajectory has, this near its row there, is it
@@ -45,6 +49,7 @@ SAME_ROW_M = 0.25  # a row at a stamp the earlier trajectory has, this near its 
 SHAPE_LOG = 0.7  # a box half or twice as tall costs about as much as the whole reach
 SUPPORT_M = 0.4
 FORBIDDEN = 1e6  # no pair (far above any sum of allowed costs)
+POSE_SLACK_M = 0.1  # how far two sessions' views of one object may lie apart (drift, alignment)
 
 
 def pairs(
@@ -90,6 +95,27 @@ def move_cost(earlier: Instance, new: Instance, *, max_m: float) -> float | None
     shape = (abs(float(np.log(size_e[2] / size_n[2]))) + float(sides)) / SHAPE_LOG
     support = abs(float(earlier.box.aabb()[0][2] - new.box.aabb()[0][2])) / SUPPORT_M
     return d / max(max_m, 1e-9) + shape + support
+
+
+def still_seen(
+    gone: Iterable[Instance], seen: Iterable[Instance], *, slack_m: float = POSE_SLACK_M
+) -> set[str]:
+    """The uuids of the ``gone`` instances (their place seen empty) that an instance of their
+    class this session ``seen`` stands at all the same: their footprints, each grown by
+    ``slack_m``, meet (and they are less than ``slack_m`` apart vertically, per box gap)."""
+    seen = list(seen)
+    out = set()
+    for g in gone:
+        lo_g, hi_g = g.box.aabb()
+        for n in seen:
+            if n.class_name != g.class_name or n.uuid == g.uuid:
+                continue
+            lo_n, hi_n = n.box.aabb()
+            gap = np.maximum(lo_g - hi_n, lo_n - hi_g)  # per axis, > 0 where the boxes lie apart
+            if gap[0] <= 2 * slack_m and gap[1] <= 2 * slack_m and gap[2] <= slack_m:
+                out.add(g.uuid)
+                break
+    return out
 
 
 def cosighted_pairs(

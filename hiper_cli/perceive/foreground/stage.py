@@ -45,7 +45,14 @@ from hiper_cli.perceive.foreground.match import Match, assign_classes, named_wit
 from hiper_cli.perceive.foreground.moving import has_moved, is_static
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
+from hiper_cli.perceive.foreground.reidentify import (
+    cosighted_pairs,
+    fold,
+    fold_mover,
+    moved_pairs,
+    pairs,
+    still_seen,
+)
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
@@ -583,7 +590,9 @@ class ForegroundStage:
             del self._instances[absorbed.uuid]
         found += cosighted
         joined = {old.uuid for old, _ in found}
-        marked = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
+        left = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
+        there = still_seen(left, new)  # seen empty by its old points, yet seen at its place
+        marked = [i for i in left if i.uuid not in there]
         for inst in marked:
             # never before it was last seen (logs whose stamps all start at 0 overlap in time)
             inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
