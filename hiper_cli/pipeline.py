@@ -372,6 +372,9 @@ def perceive(
                            on_existing="resume" if resume else options.on_existing)
     kb.record_alignment(session, alignment)
     grower = MapCloudGrower(kb, env)
+    for stage in stage_list:  # an object found where the place held something did not move there
+        if hasattr(stage, "occupied_before"):
+            stage.occupied_before = FreeBefore(grower.before).occupied
     world = kb.load_world(env)
     before = snapshot(world.foreground.values())
     total = len(reader)

@@ -13,7 +13,14 @@ import pytest
 
 from hiper_cli.graph import open_kb
 from hiper_cli.model import Box3D, Instance
-from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, pairs
+from hiper_cli.perceive.foreground.reidentify import (
+    cosighted_pairs,
+    fold,
+    fold_mover,
+    moved_pairs,
+    pairs,
+    still_seen,
+)
 from hiper_cli.perceive.foreground.stage import ForegroundStage
 from hiper_cli.perceive.foreground.stitch import footprint_share
 from hiper_cli.perceive.logs import open_log
@@ -72,6 +79,48 @@ def test_an_unknown_pairs_only_when_it_fills_the_larger_footprint():
     assert _pairs([box], [pile]) == []
     again = _inst("unknown", [0.1, 0.0, 0.0], [2.0, 1.9, 0.5])
     assert _pairs([again], [pile]) == [(pile.uuid, again.uuid)]
+
+
+def _moved(new, gone):
+    return sorted((e.uuid, n.uuid) for e, n in moved_pairs(new, gone, max_m=3.0))
+
+
+def test_moves_are_one_assignment_over_the_class_not_nearest_first():
+    """Two chairs taken away, two set down: nearest first pairs the middle one with the right
+    chair and leaves the far one unexplained (an addition and a removal); the assignment finds
+    both moves."""
+    left = _inst("chair", [-0.25, -0.25, 0.0], [0.25, 0.25, 0.9])
+    right = _inst("chair", [1.75, -0.25, 0.0], [2.25, 0.25, 0.9])
+    middle = _inst("chair", [0.95, -0.25, 0.0], [1.45, 0.25, 0.9])  # 1.2 m from left, 0.8 from right
+    far = _inst("chair", [3.05, -0.25, 0.0], [3.55, 0.25, 0.9])  # 3.3 m from left, 1.3 from right
+    assert _moved([middle, far], [left, right]) == sorted([(left.uuid, middle.uuid), (right.uuid, far.uuid)])
+    assert _moved([middle], [left, right]) == [(right.uuid, middle.uuid)]  # one set down: the nearest
+
+
+def test_a_move_goes_to_the_object_of_its_shape_and_support():
+    tall = _inst("potted plant", [-0.2, -0.2, 0.0], [0.2, 0.2, 1.2])
+    small = _inst("potted plant", [1.8, -0.2, 0.0], [2.2, 0.2, 0.5])
+    seen = _inst("potted plant", [0.6, -0.2, 0.0], [1.0, 0.2, 0.5])  # 0.8 m from tall, 1.2 from small
+    assert _moved([seen], [tall, small]) == [(small.uuid, seen.uuid)]
+    on_table = _inst("cup", [0.0, 0.0, 0.75], [0.1, 0.1, 0.85])
+    on_floor = _inst("cup", [1.5, 0.0, 0.0], [1.6, 0.1, 0.1])
+    on_a_table = _inst("cup", [1.0, 0.0, 0.74], [1.1, 0.1, 0.84])  # nearer the floor one's place
+    assert _moved([on_a_table], [on_table, on_floor]) == [(on_table.uuid, on_a_table.uuid)]
+    in_reach = _inst("cup", [3.6, 0.0, 0.0], [3.7, 0.1, 0.1])  # 2.1 m
+    assert _moved([in_reach], [on_floor]) == [(on_floor.uuid, in_reach.uuid)]
+    assert _moved([_inst("cup", [4.7, 0.0, 0.0], [4.8, 0.1, 0.1])], [on_floor]) == []  # beyond 3 m
+
+
+def test_a_place_seen_empty_with_its_object_seen_there_all_the_same_is_not_vacated():
+    """A cup 6 cm off (drift) or a second instance of it: rays to its old points pass, the cup
+    stands there; a chair 0.8 m from one taken away, or a cup of another class, does not."""
+    duplicate = _inst("cup", [1.77, 1.85, 0.72], [1.87, 1.98, 0.81])
+    chair_gone = _inst("chair", [2.0, 2.4, 0.0], [2.44, 2.84, 0.92])
+    cup_gone = _inst("cup", [3.0, 0.0, 0.72], [3.08, 0.08, 0.8])
+    seen = [_inst("cup", [1.75, 1.92, 0.72], [1.89, 2.02, 0.83]),  # the cup this session
+            _inst("chair", [2.8, 2.4, 0.0], [3.24, 2.84, 0.92]),  # the chair beside the one taken away
+            _inst("bottle", [3.0, 0.0, 0.72], [3.08, 0.08, 1.0])]  # a bottle where the cup stood
+    assert still_seen([duplicate, chair_gone, cup_gone], seen) == {duplicate.uuid}
 
 
 def test_fold_keeps_the_earlier_uuid_and_the_box_seen_last():

@@ -57,6 +57,26 @@ def test_added_only_where_earlier_sessions_saw_free_space():
     assert not FreeBefore(None)(free)
 
 
+def test_occupied_before_when_the_earlier_cloud_held_its_surface():
+    """A chair found where the earlier sessions saw its surface stood there (unrecognised) and
+    did not move there; one on floor seen bare, or under a table top (off its surface), did."""
+    floor = np.array([[x, y, 0.0] for x in np.arange(-1.0, 5.01, 0.08) for y in np.arange(-0.5, 0.51, 0.08)])
+    seat = np.array([[x, y, 0.45] for x in np.arange(3.8, 4.21, 0.08) for y in np.arange(-0.2, 0.21, 0.08)])
+    top = np.arange(-0.6, 0.61, 0.08)
+    table_top = np.array([[x, y, 0.75] for x in top for y in top[1:-1]])
+    before = FreeBefore(np.concatenate([floor, seat, table_top]))
+    chair_surface = [[x, y, z] for z in (0.02, 0.45) for x in np.arange(-0.2, 0.21, 0.1) for y in (-0.2, 0.2)]
+
+    def chair(x):
+        return _inst("chair", x, 0, f"c{x}", surface_map=[[px + x, py, pz] for px, py, pz in chair_surface])
+
+    assert before.occupied(chair(4.0))  # its seat was in the earlier cloud
+    assert not before.occupied(chair(2.0))  # bare floor then
+    assert not before.occupied(chair(0.0))  # pushed under the table: the top is 0.3 m above the seat
+    assert before.occupied(_inst("chair", 0.0, 0, "box only"))  # no surface: the box holds the top
+    assert not FreeBefore(None).occupied(chair(4.0))
+
+
 def test_walkers_and_debris_make_no_changes():
     person, debris = _inst("person", 0, 0, "p"), _inst("unknown", 1, 0, "u")
     before = snapshot([person, debris])

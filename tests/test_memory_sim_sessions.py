@@ -45,3 +45,21 @@ def test_changes_need_a_second_session(tmp_path):
     result = runner.invoke(app, ["sim", "--changes", "2", "-s", "1", "-o", str(tmp_path / "x")])
     assert result.exit_code != 0
     assert "changes happen between sessions" in " ".join(result.output.split())
+
+
+def test_a_removal_and_an_addition_of_one_class_stay_apart(tmp_path):
+    """Where an object was taken away (removed, moved from) and where one of its class was put
+    (added, moved to) are ``APART_M`` apart: closer, no one who cannot tell two chairs apart
+    could say which moved (seed 8 moved a chair to 0.8 m from one removed after it)."""
+    from hiper_cli.sim.sessions import APART_M
+
+    for seed in (8, 9):
+        out = tmp_path / f"days{seed}"
+        result = runner.invoke(app, ["sim", "--sessions", "3", "--changes", "6", "-s", "1", "--rate-hz", "2",
+                                     "--width", "80", "--height", "60", "--seed", str(seed), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        changes = json.loads((out / "changes.json").read_text())["changes"]
+        for a in changes:
+            for b in changes:
+                if a is not b and a["class"] == b["class"] and a["from_m"] and b["to_m"]:
+                    assert np.hypot(*np.subtract(a["from_m"][:2], b["to_m"][:2])) >= APART_M, (seed, a, b)

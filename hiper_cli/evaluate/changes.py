@@ -10,6 +10,8 @@ Figures:
 - **re-identification precision**: of the instances observed in two or more sessions, the
   share that are one true object: the object of its class nearest its box in the last
   session that saw it (within ``MATCH_M``) stood in the place in every session that saw it.
+  A true object is any static thing of the class, of either layer: the simulator's tables are
+  background (structure a robot does not move), a table kept as an object is still one table.
 - **ghost rate**: of the instances remembered as present that are a true object of some
   session, the share whose object is gone from the last session (removed, or moved away and
   left behind as a stale copy).
@@ -34,6 +36,7 @@ __all__ = ["ChangeReport", "evaluate_changes"]
 
 MATCH_M = 0.75
 NOT_OBJECTS = frozenset({"unknown", "person", "cart"})
+STRUCTURE = frozenset({"wall", "floor", "ceiling", "stairs", "door", "window"})  # never objects
 KINDS = ("added", "removed", "moved")
 
 
@@ -96,12 +99,13 @@ def _score_changes(stored: list[dict[str, Any]], truth: list[dict[str, Any]]) ->
 
 
 def _worlds(root: Path, sessions: list[dict[str, Any]]) -> dict[int, list[dict[str, Any]]]:
-    """Per true session: its static foreground objects (id, class, centre)."""
+    """Per true session: its static objects of either layer (id, class, layer, centre), not
+    the structure."""
     out = {}
     for s in sessions:
         doc = json.loads((root / s["log"] / "gt" / "world.json").read_text())
-        out[int(s["session"])] = [i for i in doc["instances"] if i["layer"] == "foreground"
-                                  and i["state"] == "static" and i["class"] not in NOT_OBJECTS]
+        out[int(s["session"])] = [i for i in doc["instances"] if i["state"] == "static"
+                                  and i["class"] not in NOT_OBJECTS | STRUCTURE]
     return out
 
 
@@ -186,7 +190,7 @@ def _score_memory(report: ChangeReport, instances: list[Any], seen_in: dict[str,
     report.reid_merged = merged
     report.reid_precision = round(correct / merged, 3) if merged else None
     report.ghost_rate = round(report.ghosts / report.present_real, 3) if report.present_real else None
-    true_counts = Counter(o["class"] for o in worlds[last])
+    true_counts = Counter(o["class"] for o in worlds[last] if o["layer"] == "foreground")
     report.counts = {cls: {"stored": present.get(cls, 0), "true": true_counts.get(cls, 0),
                            "error": present.get(cls, 0) - true_counts.get(cls, 0)}
                      for cls in sorted(set(true_counts) | set(present))}

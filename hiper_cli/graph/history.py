@@ -128,13 +128,43 @@ class FreeBefore:
     SUPPORT_M = 0.08
     SUPPORT_POINTS = 2
     INSIDE_POINTS = 1
+    SURFACE_M = 0.1  # a surface point this near a point of the earlier cloud was seen then
+    SURFACE_SHARE = 0.5
 
     def __init__(self, points_m: np.ndarray | None) -> None:
         self.points = np.zeros((0, 3)) if points_m is None else np.asarray(points_m, dtype=np.float64)
+        self._tree: Any = None  # a KD-tree of the points, built when first needed
 
     def __call__(self, inst: Instance) -> bool:
+        support, inside = self._counts(inst)
+        return support >= self.SUPPORT_POINTS and inside <= self.INSIDE_POINTS
+
+    def occupied(self, inst: Instance) -> bool:
+        """Whether the earlier sessions saw the object's surface where it is now: at least
+        ``SURFACE_SHARE`` of its observed surface points (``data["surface_map"]``, those above
+        its foot) lie within ``SURFACE_M`` of the earlier cloud; for an object without them,
+        something inside its box (more than ``INSIDE_POINTS`` above its support band). An
+        object found there stood there then, unrecognised, and did not move there
+        (``reidentify.py`` pairs moves only elsewhere); a chair pushed under a table keeps the
+        table top off its surface."""
+        surface = np.asarray(inst.data.get("surface_map") or [], dtype=np.float64).reshape(-1, 3)
+        if len(surface):
+            surface = surface[surface[:, 2] >= surface[:, 2].min() + self.SUPPORT_M]
+        if len(surface) == 0:
+            return self._counts(inst)[1] > self.INSIDE_POINTS
         if len(self.points) == 0:
             return False
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.points)
+        dist, _ = self._tree.query(surface, distance_upper_bound=self.SURFACE_M)
+        return float(np.mean(np.isfinite(dist))) >= self.SURFACE_SHARE
+
+    def _counts(self, inst: Instance) -> tuple[int, int]:
+        """Points of the earlier cloud over the box's footprint: in its support band, inside it."""
+        if len(self.points) == 0:
+            return 0, 0
         lo, hi = inst.box.aabb()
         p = self.points
         over = (p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0]) & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1])
@@ -142,4 +172,4 @@ class FreeBefore:
         margin = min(self.SUPPORT_M, 0.3 * float(hi[2] - lo[2]))  # a cup is barely taller than this
         support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
         inside = int(((z >= lo[2] + margin) & (z <= hi[2])).sum())
-        return support >= self.SUPPORT_POINTS and inside <= self.INSIDE_POINTS
+        return support, inside

@@ -38,8 +38,9 @@ CHANGE_KINDS = ("moved", "removed", "added")
 MOVABLE = ("chair", "potted plant")
 CLEAR_M = 0.45  # a changed object's centre stays this far from furniture and walls
 ROUTE_CLEAR_M = 0.9  # ... and from the robot's waypoints
-APART_M = 3.5  # an object added or moved to stays this far from where one of its class was taken away
-# (closer, a removal and an addition are a move to anyone who cannot tell two chairs apart)
+APART_M = 3.5  # where an object of a class was taken away (removed, or moved from) and where one of
+# it was put (added, or moved to) stay this far apart, whichever came first (closer, a removal and
+# an addition are a move to anyone who cannot tell two chairs apart)
 MOVE_M = (1.2, 3.0)  # how far a moved object goes
 
 
@@ -84,6 +85,7 @@ class _Place:
         self.rng = rng
         self.taken: list[tuple[float, float]] = []  # spots changed already: keep changes apart
         self.gone: list[tuple[str, tuple[float, float]]] = []  # (class, spot) of objects taken away
+        self.placed: list[tuple[str, tuple[float, float]]] = []  # (class, spot) of objects put down
 
     def free_spot(self, cls: str, near: tuple[float, float] | None = None) -> tuple[float, float] | None:
         for _ in range(400):
@@ -96,11 +98,16 @@ class _Place:
                     and all(math.dist(p, q) >= 1.0 for q in self.taken)
                     and all(math.dist(p, q) >= APART_M for c, q in self.gone if c == cls)):
                 self.taken.append(p)
+                self.placed.append((cls, p))
                 return p
         return None
 
     def movable(self, changed: set[int]) -> list[SimObject]:
-        return [o for o in self.w.objects if o.class_name in MOVABLE and o.id not in changed]
+        """Objects that may be taken away: of a movable class, not changed yet, and ``APART_M``
+        from where one of their class was put."""
+        return [o for o in self.w.objects if o.class_name in MOVABLE and o.id not in changed
+                and all(math.dist(o.box.center_m[:2], q) >= APART_M
+                        for c, q in self.placed if c == o.class_name)]
 
     def remove(self, obj: SimObject) -> None:
         self.w.objects.remove(obj)

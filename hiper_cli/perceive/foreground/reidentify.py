@@ -8,12 +8,21 @@ static instance of a class that stays put (not a walker) is paired with an earli
 
 - **stayed**: of its class, whose box's footprint it overlaps by ``stitch_min_overlap`` of the
   smaller footprint (of the larger for ``unknown``), at most ``stitch_overlap_m`` apart
-  vertically (the rule that joins a static track seen again within a session), best first;
+  vertically (the rule that joins a static track seen again within a session);
 - **moved**: an earlier one whose place this session saw empty (``vacated.py``), of its class,
-  not paired otherwise, within ``reidentify_moved_m``, nearest first.
+  not paired otherwise, within ``reidentify_moved_m``.
 
+Each is one assignment over all the objects of a class at once (``_assign``): as many pairs as
+the rule allows, and among those the best overall (most overlap; for moves the least cost of
+distance, shape and support, ``move_cost``), not the nearest pair first: two chairs taken away
+and one set down between them go to the one whose size, height and support fit, and a nearest
+first choice cannot take back a pair that leaves another object without its only partner.
 Pairs are one to one; the earlier instance absorbs the new one (``fold``) and keeps its uuid.
-An earlier instance seen empty and left unpaired is marked vacated by the stage.
+An earlier instance seen empty and left unpaired is marked vacated by the stage, unless this
+session saw an object of its class at its place all the same (``still_seen``): a small object
+(a cup) a few centimetres off where it was, through pose drift, or a second instance an
+earlier session made of one object, is seen empty by rays aimed at its old points, yet the
+object is there.
 
 A walker is not where it was, so it is never joined by place; but one seen at the same times
 at the same place is the same walker (``cosighted_pairs``): the same log perceived again
@@ -30,13 +39,20 @@ import numpy as np
 from hiper_cli.model import ROW_STAMP, Instance
 from hiper_cli.perceive.foreground.stitch import STAMP_MATCH_S, common_distance_m, footprint_share
 
-__all__ = ["cosighted_pairs", "fold", "fold_mover", "moved_pairs", "pairs"]
+__all__ = ["cosighted_pairs", "fold", "fold_mover", "move_cost", "moved_pairs", "pairs", "still_seen"]
 
 # Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
 REIDENTIFY_MOVED_M: float = 3.0
 
 UNKNOWN = "unknown"
 SAME_ROW_M = 0.25  # a row at a stamp the earlier trajectory has, this near its row there, is it
+# a move's cost: its distance over the reach, plus how unlike the two boxes are (log ratio of
+# their heights and of their footprints' sides, per SHAPE_LOG unit) and how far their bottoms
+# are apart (per SUPPORT_M: a chair stays on the floor, a cup on a table or shelf top)
+SHAPE_LOG = 0.7  # a box half or twice as tall costs about as much as the whole reach
+SUPPORT_M = 0.4
+FORBIDDEN = 1e6  # no pair (far above any sum of allowed costs)
+POSE_SLACK_M = 0.1  # how far two sessions' views of one object may lie apart (drift, alignment)
 
 
 def pairs(
@@ -53,9 +69,9 @@ def pairs(
     def cost(e: Instance, n: Instance) -> float | None:
         share = footprint_share(n.box.aabb(), e.box.aabb(), max_gap_m=max_gap_m,
                                 larger=n.class_name == UNKNOWN)
-        return -share if share >= min_share else None
+        return 1.0 - share if share >= min_share else None
 
-    return _one_to_one(new, earlier, cost)
+    return _assign(new, earlier, cost)
 
 
 def moved_pairs(
@@ -63,13 +79,46 @@ def moved_pairs(
 ) -> list[tuple[Instance, Instance]]:
     """(earlier, new) pairs of one object that moved: an earlier instance whose place this
     session saw empty (``vacated.py``) and a new one of its class no other earlier instance
-    took, at most ``max_m`` apart (footprint centres), nearest first, one to one."""
+    took, at most ``max_m`` apart (footprint centres), one to one, of least total
+    ``move_cost``."""
+    return _assign(new, gone, lambda e, n: move_cost(e, n, max_m=max_m))
 
-    def cost(e: Instance, n: Instance) -> float | None:
-        d = float(np.hypot(*(e.box.center_m[:2] - n.box.center_m[:2])))
-        return d if d <= max_m else None
 
-    return _one_to_one(new, gone, cost)
+def move_cost(earlier: Instance, new: Instance, *, max_m: float) -> float | None:
+    """What pairing ``new`` with ``earlier`` as one object moved costs (None: beyond ``max_m``):
+    the distance over ``max_m``, the shape unlike (``SHAPE_LOG``) and the support apart
+    (``SUPPORT_M``)."""
+    d = float(np.hypot(*(earlier.box.center_m[:2] - new.box.center_m[:2])))
+    if d > max_m:
+        return None
+    size_e = np.maximum(np.asarray(earlier.box.extent_m, dtype=np.float64), 0.01)
+    size_n = np.maximum(np.asarray(new.box.extent_m, dtype=np.float64), 0.01)
+    # the footprint's sides sorted: a chair turned on the spot has the same footprint
+    sides = np.abs(np.log(np.sort(size_e[:2]) / np.sort(size_n[:2]))).mean()
+    shape = (abs(float(np.log(size_e[2] / size_n[2]))) + float(sides)) / SHAPE_LOG
+    support = abs(float(earlier.box.aabb()[0][2] - new.box.aabb()[0][2])) / SUPPORT_M
+    return d / max(max_m, 1e-9) + shape + support
+
+
+def still_seen(
+    gone: Iterable[Instance], seen: Iterable[Instance], *, slack_m: float = POSE_SLACK_M
+) -> set[str]:
+    """The uuids of the ``gone`` instances (their place seen empty) that an instance of their
+    class this session ``seen`` stands at all the same: their footprints, each grown by
+    ``slack_m``, meet (and they are less than ``slack_m`` apart vertically, per box gap)."""
+    seen = list(seen)
+    out = set()
+    for g in gone:
+        lo_g, hi_g = g.box.aabb()
+        for n in seen:
+            if n.class_name != g.class_name or n.uuid == g.uuid:
+                continue
+            lo_n, hi_n = n.box.aabb()
+            gap = np.maximum(lo_g - hi_n, lo_n - hi_g)  # per axis, > 0 where the boxes lie apart
+            if gap[0] <= 2 * slack_m and gap[1] <= 2 * slack_m and gap[2] <= slack_m:
+                out.add(g.uuid)
+                break
+    return out
 
 
 def cosighted_pairs(
@@ -91,27 +140,30 @@ def cosighted_pairs(
     return out
 
 
-def _one_to_one(
+def _assign(
     new: Iterable[Instance],
     earlier: Iterable[Instance],
     cost: Callable[[Instance, Instance], float | None],
 ) -> list[tuple[Instance, Instance]]:
-    """Greedy one-to-one (earlier, new) pairs of one class, lowest ``cost`` first (None: no
-    pair; ties go by uuid, so a run gives the same pairs every time)."""
-    candidates = []
-    earlier = list(earlier)
-    for n in new:
-        for e in earlier:
-            if e.class_name == n.class_name and e.uuid != n.uuid:
-                c = cost(e, n)
-                if c is not None:
-                    candidates.append((c, e.uuid, n.uuid, e, n))
+    """One-to-one (earlier, new) pairs, per class: as many as ``cost`` allows (None: no pair),
+    and of those the set of least total cost (scipy's Hungarian solver; both sides in uuid
+    order, so a run gives the same pairs every time)."""
+    from scipy.optimize import linear_sum_assignment
+
     out: list[tuple[Instance, Instance]] = []
-    used: set[str] = set()
-    for _, e_uuid, n_uuid, e, n in sorted(candidates, key=lambda c: c[:3]):
-        if e_uuid not in used and n_uuid not in used:
-            used.update((e_uuid, n_uuid))
-            out.append((e, n))
+    new, earlier = sorted(new, key=lambda i: i.uuid), sorted(earlier, key=lambda i: i.uuid)
+    for cls in sorted({n.class_name for n in new}):
+        ns = [n for n in new if n.class_name == cls]
+        es = [e for e in earlier if e.class_name == cls]
+        if not es:
+            continue
+        costs = np.full((len(es), len(ns)), FORBIDDEN)
+        for i, e in enumerate(es):
+            for j, n in enumerate(ns):
+                if e.uuid != n.uuid and (c := cost(e, n)) is not None:
+                    costs[i, j] = c
+        rows, cols = linear_sum_assignment(costs)
+        out += [(es[i], ns[j]) for i, j in zip(rows, cols, strict=True) if costs[i, j] < FORBIDDEN]
     return out
 
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
@@ -51,6 +51,7 @@ from hiper_cli.perceive.foreground.reidentify import (
     fold_mover,
     moved_pairs,
     pairs,
+    still_seen,
 )
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import DETECTION_NEAREST, WALKER_SOLID, detected_blobs, is_flat
@@ -189,6 +190,9 @@ class ForegroundStage:
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
+        # whether the earlier sessions saw something inside a box (set by the caller, who has
+        # the place's cloud): an object found there was not moved there (``_reidentify``)
+        self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
 
@@ -525,7 +529,9 @@ class ForegroundStage:
         vacated = self._empty.vacated() if self._empty is not None else {}
         # seen empty now, or by an earlier session: gone from where it was
         gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
-        moved = moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=REIDENTIFY_MOVED_M)
+        occupied = self.occupied_before or (lambda _: False)
+        movers = [n for n in new if n.uuid not in paired and not occupied(n)]
+        moved = moved_pairs(movers, gone, max_m=REIDENTIFY_MOVED_M)
         found += moved
         for old, absorbed in found:
             fold(old, absorbed)
@@ -542,7 +548,9 @@ class ForegroundStage:
             del self._instances[absorbed.uuid]
         found += cosighted
         joined = {old.uuid for old, _ in found}
-        marked = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
+        left = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
+        there = still_seen(left, new)  # seen empty by its old points, yet seen at its place
+        marked = [i for i in left if i.uuid not in there]
         for inst in marked:
             # never before it was last seen (logs whose stamps all start at 0 overlap in time)
             inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
