@@ -11,6 +11,7 @@ from hiper_cli.perceive.foreground.amodal import complete_footprint
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import World
+from tests.fg_constants import constants
 from tests.fg_scene import SceneBox, background_instances, make_frame, pose_looking_x, room
 
 STRIP = (np.array([10.0, 4.0, 0.0]), np.array([11.0, 4.26, 0.6]))  # a bed's side, 0.26 m deep
@@ -24,8 +25,9 @@ def _frames(*things):
 def _foreground(frames, **options):
     """The foreground instances a ``ForegroundStage`` (the frames' own detections) makes of
     ``frames``, with ``options``."""
-    stage = ForegroundStage(detector="log", pixel_step=2, **options)
-    world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+    with constants(**options) as fields:
+        stage = ForegroundStage(detector="log", pixel_step=2, **fields)
+        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
     return list(world.foreground.values())
 
 

@@ -7,6 +7,7 @@ import pytest
 from hiper_cli.perceive.foreground.carve import carve_small
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.segment import Blob, image_box
+from tests.fg_constants import constants
 
 FX, CX, CY, W, H, STEP = 525.0, 319.5, 239.5, 640, 480, 4
 CAMERA_Z_M = 1.2  # looking along map +y, level; image x along map +x
@@ -78,4 +79,5 @@ def test_only_small_classes_in_a_blob_too_big_for_them_are_cut():
     assert len(_carve(blob, box, "chair")[0]) == 1  # a chair's box: no small thing
     alone, alone_box = _scene(with_table=False)
     assert len(_carve(alone, alone_box)[0]) == 1  # the bottle on its own fits its class
-    assert len(_carve(blob, box, config=RefineConfig(carve_classes=()))[0]) == 1
+    with constants(carve_classes=()):
+        assert len(_carve(blob, box)[0]) == 1

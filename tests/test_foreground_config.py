@@ -1,4 +1,5 @@
-"""ForegroundConfig shows its parts: dotted options by part, the old flat names, each field in one part."""
+"""ForegroundConfig shows its concepts: dotted options by concept, the old part names and flat
+names, each field in one concept, at most 40 in all."""
 
 from dataclasses import fields
 
@@ -15,15 +16,19 @@ from hiper_cli.perceive.foreground.config import (
 )
 from hiper_cli.pipeline import parse_stage_options
 
-DETECTOR_FIELDS = {"detector", "min_detection_score", "detector_threads", "classes", "exclude_classes",
-                   "carried_classes", "carried_containment", "same_box_iou"}
+CONCEPTS = ("segment", "associate", "fuse", "track", "classify")
 
 
-def test_every_option_belongs_to_exactly_one_part_or_the_detector():
-    names = [name for part in ForegroundConfig.PARTS.values() for name in part]
+def test_every_option_belongs_to_exactly_one_concept_and_there_are_few():
+    names = [name for concept in CONCEPTS for name in ForegroundConfig.PARTS[concept]]
     assert len(names) == len(set(names))
-    assert set(names) | DETECTOR_FIELDS == {f.name for f in fields(ForegroundConfig)}
+    every = {f.name for f in fields(ForegroundConfig)}
+    assert set(names) == every
+    assert len(every) <= 40
+    for old in set(ForegroundConfig.PARTS) - set(CONCEPTS):  # the older part names: subsets
+        assert ForegroundConfig.PARTS[old] <= every
     assert "gate_m" in ForegroundConfig.PARTS["tracker"]
+    assert "gate_m" in ForegroundConfig.PARTS["associate"]
     assert "background_margin_m" in ForegroundConfig.PARTS["background_filter"]
 
 
@@ -35,19 +40,21 @@ def test_a_foreground_config_is_each_part():
 
 
 def test_dotted_and_flat_options_give_the_same_config():
-    dotted = parse_stage_options(["foreground.tracker.gate_m=0.8", "foreground.segment.pixel_step=2"])
-    assert dotted == {"foreground": {"tracker.gate_m": 0.8, "segment.pixel_step": 2}}
+    dotted = parse_stage_options(["foreground.tracker.gate_m=0.8", "foreground.segment.pixel_step=2",
+                                  "foreground.track.stitch=false"])
+    assert dotted == {"foreground": {"tracker.gate_m": 0.8, "segment.pixel_step": 2, "track.stitch": False}}
     assert ForegroundConfig.from_options(**dotted["foreground"]) == ForegroundConfig.from_options(
-        gate_m=0.8, pixel_step=2)
+        gate_m=0.8, pixel_step=2, stitch=False)
 
 
 @pytest.mark.parametrize(
     ("options", "match"),
     [
-        ({"trackr.gate_m": 1.0}, "unknown part 'trackr'; expected one of segment, background_filter"),
+        ({"trackr.gate_m": 1.0}, "unknown part 'trackr'; expected one of segment, associate, fuse"),
         ({"segment.gate_m": 1.0}, "segment has no option 'gate_m'"),
         ({"gate_m": 1.0, "tracker.gate_m": 2.0}, "'gate_m' given twice"),
         ({"gate": 1.0}, r"unknown foreground option\(s\) \['gate'\]"),
+        ({"stitch_margin_m": 1.0}, r"unknown foreground option\(s\) \['stitch_margin_m'\]"),
         ({"tracker.confirm_hits": 0}, "confirm_hits must be >= 1"),
     ],
 )
@@ -61,4 +68,4 @@ def test_each_part_checks_its_own_fields():
         SegmentConfig(pixel_step=0)
     with pytest.raises(ConfigError, match="iou_threshold must be in"):
         MatchConfig(iou_threshold=2.0)
-    assert TrackerConfig(search_classes="person, cart").search_classes == ("person", "cart")
+    assert TrackerConfig(walker_classes="person, cart").walker_classes == ("person", "cart")

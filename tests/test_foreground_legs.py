@@ -7,6 +7,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import drop_table_legs, leg_points
 from hiper_cli.perceive.foreground.segment import segment
+from tests.fg_constants import patched
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, pose_looking_x, room
 
 TOP = SceneBox(20, np.array([3.0, 0.6, 0.74]), np.array([0.8, 1.0, 0.04]), "table", True)
@@ -20,7 +21,7 @@ def blobs_of(boxes, cfg):
     return segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg)[0]
 
 
-def test_a_leg_merged_with_a_chair_is_removed():
+def test_a_leg_merged_with_a_chair_is_removed(monkeypatch):
     cfg = ForegroundConfig(pixel_step=2)
     (merged,) = blobs_of([*room(), TOP, LEG, CHAIR], cfg)  # the clustering joins leg and chair
     assert merged.points_map[:, 2].max() > 0.65
@@ -30,7 +31,7 @@ def test_a_leg_merged_with_a_chair_is_removed():
     assert chair.points_map[:, 1].mean() == pytest.approx(-0.12, abs=0.03)
     assert len(chair.points_map) < len(merged.points_map)
     # Off, or no table known: the blob stays as it is.
-    off = ForegroundConfig(pixel_step=2, table_leg_cell_m=0.0)
+    off = patched(monkeypatch, pixel_step=2, table_leg_cell_m=0.0)
     assert drop_table_legs([merged], [table], off, 2, CAMERA.width, CAMERA.height) == [merged]
     assert drop_table_legs([merged], [], cfg, 2, CAMERA.width, CAMERA.height) == [merged]
 
@@ -49,11 +50,11 @@ def test_columns_that_go_higher_or_stop_lower_are_not_legs():
     assert not leg_points(table_leg + np.array([3.0, 0.0, 0.0]), [table], cfg).any()  # far from the table
 
 
-def test_the_rim_of_a_table_top_no_longer_joins_a_chair_to_a_vase_on_the_table():
+def test_the_rim_of_a_table_top_no_longer_joins_a_chair_to_a_vase_on_the_table(monkeypatch):
     # The background layer knows the top as a thin plane; the top's edge under it survives the
     # filter and links the chair in front of the table to the vase standing at the edge.
     # (Block means off: the rim is a single row of samples here, a block would mix in the top.)
-    cfg = ForegroundConfig(pixel_step=2, table_rim_depth_m=0.08, background_block_mean=False)
+    cfg = patched(monkeypatch, pixel_step=2, table_rim_depth_m=0.08, background_block_mean=False)
     top_plane = Box3D(np.array([3.0, 0.6, 0.75]), np.array([0.8, 1.0, 0.01]))
     slab = SceneBox(30, np.array([3.0, 0.6, 0.715]), np.array([0.8, 1.0, 0.07]), "table")
     chair = SceneBox(31, np.array([2.36, 0.6, 0.3]), np.array([0.4, 0.4, 0.6]), "chair")

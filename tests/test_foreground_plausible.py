@@ -16,6 +16,7 @@ from hiper_cli.perceive.foreground.tracking import Measurement, Tracker, object_
 from hiper_cli.perceive.foreground.whole import in_full_view
 from hiper_cli.perceive.stage import World
 from hiper_cli.types import CameraIntrinsics, Detections, Frame
+from tests.fg_constants import constants
 from tests.fg_scene import SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 RATE_HZ = 15.0
@@ -43,11 +44,12 @@ def test_bounds_with_their_tolerance():
 
 
 def _track(longest, cls="bed", n=8, **options):
-    tracker = Tracker(TrackerConfig(**options))
-    for k in range(n):
-        m = Measurement(np.array([3.0, 0.0, 0.5]), np.array([0.85, 0.85, 1.0]), cls, 0.5, f"o{k}",
-                        longest_m=longest)
-        tracker.step(k / RATE_HZ, [m])
+    with constants(**options) as fields:
+        tracker = Tracker(TrackerConfig(**fields))
+        for k in range(n):
+            m = Measurement(np.array([3.0, 0.0, 0.5]), np.array([0.85, 0.85, 1.0]), cls, 0.5, f"o{k}",
+                            longest_m=longest)
+            tracker.step(k / RATE_HZ, [m])
     return tracker.tracks[0]
 
 
@@ -128,7 +130,8 @@ def test_stage_names_a_sink_only_against_a_wall(wall, expected):
     world = World(background=background_instances(scene))
     r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
     assert [o.class_name for o in r.observations] == [expected]
-    r = ForegroundStage(detector="log", pixel_step=2, fixture_classes="").process(frame, world)
+    with constants(fixture_classes=()):
+        r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
     assert [o.class_name for o in r.observations] == ["sink"]
 
 
@@ -164,10 +167,11 @@ def test_stage_names_a_walker_with_a_bag_person():
     world = World(background=background_instances(room()))
     r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
     assert [o.class_name for o in r.observations] == ["person"]
-    r = ForegroundStage(detector="log", pixel_step=2, carried_classes="").process(frame, world)
-    assert [o.class_name for o in r.observations] == ["unknown"]  # no 1.7 m handbag either
-    no_sizes = ForegroundStage(detector="log", pixel_step=2, carried_classes="", class_sizes=False)
-    r = no_sizes.process(frame, world)
+    with constants(carried_classes=()):
+        r = ForegroundStage(detector="log", pixel_step=2).process(frame, world)
+        assert [o.class_name for o in r.observations] == ["unknown"]  # no 1.7 m handbag either
+        no_sizes = ForegroundStage(detector="log", pixel_step=2, class_sizes=False)
+        r = no_sizes.process(frame, world)
     assert [o.class_name for o in r.observations] == ["handbag"]
 
 
@@ -191,15 +195,16 @@ def _refused_track(full_named: int, full_views: int = 10, within: frozenset[str]
     when not ``detected``), then seen in ``full_views`` full views of which the first
     ``full_named`` were named ``chair`` too, and the others held detections of the classes
     ``within`` inside the blob's box."""
-    tracker = Tracker(TrackerConfig(**options))
-    centre, extent = np.array([3.0, 0.0, 0.6]), np.array([0.8, 0.35, 1.2])
-    for k in range(12 + full_views):
-        full = k >= 12
-        named = not full or k - 12 < full_named
-        m = Measurement(centre, extent, "chair" if named else "unknown", 0.6 if named else 0.0, f"o{k}",
-                        full_view=full, named_within=frozenset() if named else within,
-                        detection_index=0 if named and detected else None)
-        tracker.step(k / RATE_HZ, [m])
+    with constants(**options) as fields:
+        tracker = Tracker(TrackerConfig(**fields))
+        centre, extent = np.array([3.0, 0.0, 0.6]), np.array([0.8, 0.35, 1.2])
+        for k in range(12 + full_views):
+            full = k >= 12
+            named = not full or k - 12 < full_named
+            m = Measurement(centre, extent, "chair" if named else "unknown", 0.6 if named else 0.0, f"o{k}",
+                            full_view=full, named_within=frozenset() if named else within,
+                            detection_index=0 if named and detected else None)
+            tracker.step(k / RATE_HZ, [m])
     return tracker.tracks[0]
 
 

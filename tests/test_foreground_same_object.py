@@ -10,6 +10,7 @@ from hiper_cli.perceive.foreground.motion import make_motion_model
 from hiper_cli.perceive.foreground.same_object import fold
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
+from tests.fg_constants import set_constants
 
 RATE_HZ = 15.0
 CHAIR = ([2.0, 1.0, 0.0], [2.45, 1.45, 0.9], "chair")
@@ -50,11 +51,12 @@ class _Run:
         return [t for t in self.tracker.tracks + self.tracker.dormant if t.confirmed]
 
 
-def test_a_chair_revisited_by_a_track_that_took_a_table_leg_first_is_one_chair():
+def test_a_chair_revisited_by_a_track_that_took_a_table_leg_first_is_one_chair(monkeypatch):
     """House 41: the chair's second track took a table leg for its first views; its box at
     confirmation missed the chair's, and it was never asked again (two chairs)."""
     for again, expected in ((True, 1), (False, 2)):
-        run = _Run(stitch_static_again=again)
+        set_constants(monkeypatch, stitch_static_again=again)
+        run = _Run()
         run.frames([CHAIR], 30)
         run.frames([], 75)  # the robot looks elsewhere: the chair's track closes
         run.frames([LEG], 3)  # its next track's first views
@@ -62,14 +64,15 @@ def test_a_chair_revisited_by_a_track_that_took_a_table_leg_first_is_one_chair()
         assert len(run.instances) == expected, again
 
 
-def test_a_bed_seen_in_parts_and_then_whole_is_one_bed_with_the_whole_box():
+def test_a_bed_seen_in_parts_and_then_whole_is_one_bed_with_the_whole_box(monkeypatch):
     """House 41: a track saw the foot end, then the side (its parts do not overlap: it seemed
     to move), and a later one the whole bed: two beds, the first with a part's box."""
     foot = ([0.0, 0.0, 0.0], [0.4, 1.4, 0.55], "bed")
     side = ([0.0, 1.1, 0.0], [2.0, 1.4, 0.55], "bed")
     whole = ([0.0, 0.0, 0.0], [2.0, 1.4, 0.6], "bed")
     for again, expected in ((True, 1), (False, 2)):
-        run = _Run(stitch_static_again=again)
+        set_constants(monkeypatch, stitch_static_again=again)
+        run = _Run()
         run.frames([foot], 20)
         run.frames([side], 20)
         run.frames([], 40)

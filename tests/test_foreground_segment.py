@@ -7,6 +7,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundConfig
 from hiper_cli.perceive.foreground.background_filter import inside_boxes
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, segment, support_below
+from tests.fg_constants import patched
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 
@@ -20,13 +21,13 @@ def test_inside_boxes_rotated_box_and_per_point_margin():
     assert not inside_boxes(pts, [], 0.1).any()
 
 
-def test_person_stands_on_the_floor_after_filtering():
+def test_person_stands_on_the_floor_after_filtering(monkeypatch):
     boxes = [*room(), person(10, 3.0, 0.0)]
     frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
     bg = background_instances(boxes)
     floor = [i.box for i in bg.values() if i.class_name == "floor"]
     # Samples only: a block mean where a foot meets the floor may keep one floor sample.
-    cfg = ForegroundConfig(pixel_step=2, background_block_mean=False)
+    cfg = patched(monkeypatch, pixel_step=2, background_block_mean=False)
     (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, [i.box for i in bg.values()], cfg, floor)
     assert blob.points_map[:, 2].min() > 0.05  # the filter cut the feet with the floor ...
     assert blob.support_z_m == pytest.approx(0.0)
@@ -36,7 +37,7 @@ def test_person_stands_on_the_floor_after_filtering():
     assert no_support.support_z_m is None and no_support.center_map_m[2] > 0.87
 
 
-def test_a_head_above_a_gap_joins_its_body():
+def test_a_head_above_a_gap_joins_its_body(monkeypatch):
     body = SceneBox(10, np.array([3.0, 0.0, 0.75]), np.array([0.3, 0.5, 1.5]), "person")
     head = SceneBox(11, np.array([3.0, 0.0, 1.75]), np.array([0.2, 0.2, 0.2]), "person")  # 0.4 m gap
     boxes = [*room(), body, head]
@@ -45,7 +46,7 @@ def test_a_head_above_a_gap_joins_its_body():
     cfg = ForegroundConfig(pixel_step=2, min_cluster_points=3)
     (blob,), _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
     assert blob.points_map[:, 2].max() > 1.8
-    apart, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, ForegroundConfig(
+    apart, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, patched(monkeypatch,
         pixel_step=2, min_cluster_points=3, fragment_ratio=0.0))
     assert len(apart) == 2
 

@@ -10,6 +10,7 @@ from hiper_cli.perceive.foreground.match import Match
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
 from hiper_cli.perceive.stage import World
+from tests.fg_constants import constants
 from tests.fg_scene import SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 RATE_HZ = 15.0
@@ -25,8 +26,9 @@ def test_a_poster_of_a_person_is_no_person_and_a_person_is():
     boxes = [*room(), _poster(20, 0.8), person(10, 3.0, -0.8)]
     frame = make_frame(boxes, pose_looking_x(), 0.0, 0)
     for solid, picture_class in ((True, "unknown"), (False, "person")):
-        stage = ForegroundStage(detector="log", pixel_step=2, walker_solid=solid)
-        result = stage.process(frame, World(background=background_instances(room())))
+        with constants(walker_solid=solid):
+            stage = ForegroundStage(detector="log", pixel_step=2)
+            result = stage.process(frame, World(background=background_instances(room())))
         by_side = sorted(result.observations, key=lambda o: o.data["center_map"][1])
         assert [o.class_name for o in by_side] == ["person", picture_class], solid
 

@@ -342,7 +342,7 @@ def test_each_learned_dynamics_prior_switches_alone():
     for name, opts in settings.items():
         stage = ForegroundStage(detector="log", pixel_step=2, **opts)
         stage.process(walker_frames(1)[0], world)
-        priors[name] = stage._class_prior("person")
+        priors[name] = stage._priors.class_prior("person")
     assert (priors["all"].cu_mps, priors["all"].sigma_mps) == (0.8, 0.03)
     assert (priors["no gates"].cu_mps, priors["no gates"].sigma_mps) == (None, 0.03)
     assert (priors["no noise"].cu_mps, priors["no noise"].sigma_mps) == (0.8, None)
@@ -359,4 +359,5 @@ def test_a_class_seen_only_standing_sets_no_motion_noise():
     world.analyses.append(standing.to_analysis("chair", 0, 1, created_s=1.0))
     stage = ForegroundStage(detector="log", pixel_step=2)
     stage.process(walker_frames(1)[0], world)
-    assert (stage._class_prior("chair").cu_mps, stage._class_prior("chair").sigma_mps) == (None, None)
+    chair = stage._priors.class_prior("chair")
+    assert (chair.cu_mps, chair.sigma_mps) == (None, None)

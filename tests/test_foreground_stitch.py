@@ -9,6 +9,7 @@ from hiper_cli.perceive.foreground.appearance import HISTOGRAM_BINS, histogram, 
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.stitch import RESUME, find_target
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
+from tests.fg_constants import set_constants
 
 RATE_HZ = 15.0
 PERSON = np.array([0.5, 0.4, 1.7])
@@ -82,10 +83,11 @@ def test_the_switch_and_a_walker_too_far_away_keep_two():
 
 
 @pytest.mark.parametrize(("pace_factor", "instances"), [(1.5, 2), (0.0, 1)])
-def test_the_next_person_in_a_corridor_is_not_the_slow_walker_lost_there(pace_factor, instances):
+def test_the_next_person_in_a_corridor_is_not_the_slow_walker_lost_there(pace_factor, instances, monkeypatch):
     """A walker at 0.6 m/s lost, and 2 s later a person in other clothes 4.6 m back the way it
     came: a walk of 2.3 m/s (1.5 m/s from its rows 3 s before), not at its pace."""
-    run = _Run(stitch_pace_factor=pace_factor)
+    set_constants(monkeypatch, stitch_pace_factor=pace_factor)
+    run = _Run()
     end = run.walk([0, 0, 0.85], [-0.6, 0, 0], 4.0, colours=_colours(0))
     run.idle(2.0)
     run.walk(end + np.array([4.6, 0.2, 0.0]), [-0.6, 0, 0], 3.0, colours=_colours(20))

@@ -5,6 +5,7 @@ import numpy as np
 from hiper_cli.perceive.foreground import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import segment
 from hiper_cli.perceive.foreground.tables import drop_unseen_tables, split_unseen_tables, unseen_table_top
+from tests.fg_constants import constants, set_constants
 from tests.fg_scene import CAMERA, SceneBox, background_instances, make_frame, person, pose_looking_x, room
 
 TABLE_ID, PERSON_ID = 20, 10
@@ -61,8 +62,8 @@ def test_furniture_with_tops_of_its_own_and_blobs_without_detection_stay_whole()
     assert [len(b.points_cam) for b in as_couch] == [len(b.points_cam) for b in blobs]
     no_dets = drop_unseen_tables(blobs, np.zeros((0, 4)), [], cfg, CAMERA.width, CAMERA.height)
     assert [len(b.points_cam) for b in no_dets] == [len(b.points_cam) for b in blobs]
-    off = ForegroundConfig(pixel_step=2, unseen_table_min_side_m=0.0)
-    kept = drop_unseen_tables(blobs, person_box, ["person"], off, CAMERA.width, CAMERA.height)
+    with constants(unseen_table_min_side_m=0.0):
+        kept = drop_unseen_tables(blobs, person_box, ["person"], cfg, CAMERA.width, CAMERA.height)
     assert len(kept) == len(blobs)
 
 
@@ -78,7 +79,7 @@ def test_a_narrow_slab_is_not_a_table():
     assert unseen_table_top(top, cfg) is not None
 
 
-def test_a_bottle_on_an_unmapped_table_comes_apart_from_it():
+def test_a_bottle_on_an_unmapped_table_comes_apart_from_it(monkeypatch):
     """Hospital 43: bottles and a cup on a bedside table the background never mapped stayed in
     the table's blob, which no detection names (their boxes are small inside it)."""
     bottle_id = 30
@@ -87,7 +88,8 @@ def test_a_bottle_on_an_unmapped_table_comes_apart_from_it():
     frame = make_frame(boxes, pose_looking_x(z=1.6), 0.0, 0)
     bg = [i.box for i in background_instances(boxes).values()]
     for holding, apart in ((0.8, True), (0.0, False)):
-        cfg = ForegroundConfig(pixel_step=2, unseen_table_holding=holding)
+        set_constants(monkeypatch, unseen_table_holding=holding)
+        cfg = ForegroundConfig(pixel_step=2)
         blobs, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
         ids = frame.extras["ids"]
         ys, xs = np.nonzero(ids == bottle_id)
@@ -170,8 +172,9 @@ def test_a_table_the_background_never_maps_is_a_table_until_it_does():
 
     frames = _bottle_on_table_frames(12)
     for on, classes in ((True, ["bottle", "table"]), (False, ["bottle"])):
-        stage = ForegroundStage(detector="log", pixel_step=2, unseen_table_instances=on)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+        with constants(unseen_table_instances=on):
+            stage = ForegroundStage(detector="log", pixel_step=2)
+            world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
         assert sorted(i.class_name for i in world.foreground.values()) == classes, on
     # the background layer maps the table: the foreground's table leaves, the bottle stays
     stage = ForegroundStage(detector="log", pixel_step=2)
@@ -234,8 +237,9 @@ def test_a_desk_taken_for_a_bench_is_a_table_in_the_knowledge_base():
     frames = [make_frame([*room(), *desk, bottle], pose_looking_x(z=1.6), k / 15.0, k) for k in range(20)]
 
     def classes(**options):
-        stage = ForegroundStage(detector="log", pixel_step=2, **options)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
+        with constants(**options) as fields:
+            stage = ForegroundStage(detector="log", pixel_step=2, **fields)
+            world, _ = run_stages(frames, [stage], World(background=background_instances(room())))
         return sorted(inst.class_name for inst in world.foreground.values())
 
     assert classes() == ["bottle", "table"]

@@ -8,6 +8,7 @@ from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
 from hiper_cli.perceive.foreground.whole import seen_whole, thickness_m
 from hiper_cli.types import CameraIntrinsics
+from tests.fg_constants import constants, patched
 
 CAMERA = CameraIntrinsics(width=640, height=480, fx=525.0, fy=525.0, cx=319.5, cy=239.5)
 RATE_HZ = 15.0
@@ -133,7 +134,7 @@ def _feed(tracker, views, start=0):
     return changed, withdrawn
 
 
-def test_an_unknown_instance_that_then_takes_pieces_of_structure_is_withdrawn():
+def test_an_unknown_instance_that_then_takes_pieces_of_structure_is_withdrawn(monkeypatch):
     # seen whole for 0.67 s (an instance), then 15 views cut by the border: 10 of 25 whole
     tracker = Tracker(ForegroundConfig())
     changed, withdrawn = _feed(tracker, "W" * 10 + "B" * 15)
@@ -141,7 +142,7 @@ def test_an_unknown_instance_that_then_takes_pieces_of_structure_is_withdrawn():
     assert [k for k, w in enumerate(withdrawn) if w] == [20]  # 10 whole of 21: less than half
     assert withdrawn[20] == [uuid]
     assert tracker.close_all() == []
-    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    old = Tracker(patched(monkeypatch, unknown_evidence_held=False))
     _feed(old, "W" * 10 + "B" * 15)
     assert len(old.close_all()) == 1
 
@@ -153,7 +154,7 @@ def test_a_withdrawn_track_seen_whole_again_comes_back():
     assert track.class_name == "unknown" and track.hits == 45
 
 
-def test_two_detections_do_not_make_an_unknown_instance_of_a_desk():
+def test_two_detections_do_not_make_an_unknown_instance_of_a_desk(monkeypatch):
     # a desk named `bed` twice (confirmed on its third view, most of them named), then cut by
     # the border: the class never comes and it is never seen whole
     tracker = Tracker(ForegroundConfig())
@@ -161,12 +162,12 @@ def test_two_detections_do_not_make_an_unknown_instance_of_a_desk():
     assert changed[2] and not any(changed[4:])
     assert withdrawn[3] == changed[2]
     assert tracker.close_all() == []
-    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    old = Tracker(patched(monkeypatch, unknown_evidence_held=False))
     _feed(old, "NNB" + "B" * 40)
     assert [t.class_name for t in old.close_all()] == ["unknown"]
 
 
-def test_a_blip_named_in_two_frames_is_no_instance_when_it_ends():
+def test_a_blip_named_in_two_frames_is_no_instance_when_it_ends(monkeypatch):
     tracker = Tracker(ForegroundConfig())
     changed, _ = _feed(tracker, "NNB")
     assert changed[2]  # confirmed while it lives: a class may still come
@@ -175,7 +176,7 @@ def test_a_blip_named_in_two_frames_is_no_instance_when_it_ends():
         tracker.step(k / RATE_HZ, [])
         closed += tracker.withdrawn
     assert closed == changed[2]
-    old = Tracker(ForegroundConfig(unknown_evidence_held=False))
+    old = Tracker(patched(monkeypatch, unknown_evidence_held=False))
     _feed(old, "NNB")
     assert [t.class_name for t in old.close_all()] == ["unknown"]
 
@@ -213,8 +214,9 @@ def test_the_stage_deletes_the_instance_of_a_withdrawn_track():
 
     for held, expected in ((True, 0), (False, 1)):
         deleted.clear()
-        stage = ForegroundStage(detector="log", pixel_step=2, unknown_evidence_held=held)
-        world, _ = run_stages(frames, [stage], World(background=background_instances(room())), on_frame)
+        with constants(unknown_evidence_held=held):
+            stage = ForegroundStage(detector="log", pixel_step=2)
+            world, _ = run_stages(frames, [stage], World(background=background_instances(room())), on_frame)
         assert len(world.foreground) == expected
         assert len(deleted) == 1 - expected
 

@@ -7,6 +7,7 @@ import pytest
 from hiper_cli.learned import path_speed_mps
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
+from tests.fg_constants import constants
 
 RATE_HZ = 30.0
 
@@ -29,7 +30,8 @@ def test_a_person_has_no_vertical_velocity():
 
 def test_other_classes_and_the_switch_keep_it():
     assert _rising_person(TrackerConfig(), cls="chair").velocity[2] > 0.3
-    assert _rising_person(TrackerConfig(walker_level=False)).velocity[2] > 0.3
+    with constants(walker_level=False):
+        assert _rising_person(TrackerConfig()).velocity[2] > 0.3
 
 
 def test_path_speed_ignores_jitter_and_gaps():

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
+from hiper_cli.perceive.foreground import tracking
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Tracker
+from tests.fg_constants import patched
 
 RATE_HZ = 30.0
 
@@ -63,8 +65,8 @@ def test_track_in_view_without_updates_dies():
     assert tracker.tracks == []
 
 
-def test_velocity_decays_while_unseen_but_not_after_one_miss():
-    cfg = ForegroundConfig(velocity_decay_s=0.5)
+def test_velocity_decays_while_unseen_but_not_after_one_miss(monkeypatch):
+    cfg = patched(monkeypatch, velocity_decay_s=0.5)
     tracker = Tracker(cfg)
     for k in range(30):
         tracker.step(k / RATE_HZ, [meas([1.0 + 0.6 * k / RATE_HZ, 0, 0.9], k=k)])
@@ -76,7 +78,7 @@ def test_velocity_decays_while_unseen_but_not_after_one_miss():
     for k in range(31, 61):
         tracker.step(k / RATE_HZ, [], lambda pts: np.zeros(len(pts), bool))
     v1 = np.linalg.norm(track.velocity)
-    unseen_decay_s = 60 / RATE_HZ - 30 / RATE_HZ - cfg.velocity_decay_grace_s
+    unseen_decay_s = 60 / RATE_HZ - 30 / RATE_HZ - tracking.VELOCITY_DECAY_GRACE_S
     assert v1 < v0 * 0.2
     assert v1 == pytest.approx(v0 * np.exp(-unseen_decay_s / 0.5), rel=0.15)
 
@@ -111,8 +113,8 @@ def test_a_settled_chair_whose_filter_was_dragged_away_still_takes_its_own_blob(
     assert joined == [chair.uuid]
 
 
-def test_same_class_wins_and_a_confused_detection_still_joins():
-    tracker = Tracker(ForegroundConfig(class_mismatch_m=0.5))
+def test_same_class_wins_and_a_confused_detection_still_joins(monkeypatch):
+    tracker = Tracker(patched(monkeypatch, class_mismatch_m=0.5))
     for k in range(10):
         tracker.step(k / RATE_HZ, [meas([1, 0, 0.5], "chair")])
     (chair,) = tracker.tracks
@@ -217,19 +219,19 @@ def _chair_piece_then_cup(cfg):
     return chair_track, joined
 
 
-def test_a_chair_out_of_view_for_half_a_second_does_not_take_the_cup_beside_it():
+def test_a_chair_out_of_view_for_half_a_second_does_not_take_the_cup_beside_it(monkeypatch):
     chair_track, joined = _chair_piece_then_cup(ForegroundConfig())
     assert joined == [None]
     # With the velocity uncertainty of every class relaxing towards walking speeds, the chair's
     # gate grows to gate_m within half a second and takes the cup.
-    chair_track, joined = _chair_piece_then_cup(ForegroundConfig(velocity_relax_static=True))
+    chair_track, joined = _chair_piece_then_cup(patched(monkeypatch, velocity_relax_static=True))
     assert joined == [chair_track.uuid]
 
 
-def test_a_walker_picked_up_again_relearns_its_speed_at_once():
+def test_a_walker_picked_up_again_relearns_its_speed_at_once(monkeypatch):
     def speed_after_gap(prior_mps):
         # the mechanism alone: a livelier filter (the walker default) also relearns faster
-        cfg = ForegroundConfig(velocity_prior_mps=prior_mps, walker_accel_noise_mps2=1.0)
+        cfg = patched(monkeypatch, velocity_prior_mps=prior_mps, walker_accel_noise_mps2=1.0)
         tracker = Tracker(cfg)
         for k in range(30):  # walks +x at 0.6 m/s
             tracker.step(k / RATE_HZ, [meas([1.0 + 0.6 * k / RATE_HZ, 0, 0.9], k=k)])
@@ -271,20 +273,20 @@ def _walker_ending_in_a_fragment(cfg):
     return tracker.close_all()
 
 
-def test_a_person_track_does_not_take_a_fragment_a_fraction_of_its_size():
+def test_a_person_track_does_not_take_a_fragment_a_fraction_of_its_size(monkeypatch):
     (track,) = _walker_ending_in_a_fragment(ForegroundConfig())
     assert len(track.trajectory) == 30  # the fragment starts a tentative track of its own
     speeds = np.hypot(*np.array(track.trajectory)[:, 4:6].T)
     assert speeds.min() > 0.8
     # with the rule off the fragment joins and the smoother spreads it back: the end slows
-    (plain,) = _walker_ending_in_a_fragment(ForegroundConfig(walker_min_size_ratio=0.0))
+    (plain,) = _walker_ending_in_a_fragment(patched(monkeypatch, walker_min_size_ratio=0.0))
     assert len(plain.trajectory) == 32
     assert np.hypot(*np.array(plain.trajectory)[-3:, 4:6].T).max() < 0.6
 
 
-def test_a_cup_beside_a_walker_does_not_join_its_track():
+def test_a_cup_beside_a_walker_does_not_join_its_track(monkeypatch):
     def joins(ratio):
-        tracker = Tracker(ForegroundConfig(walker_min_size_ratio=ratio))
+        tracker = Tracker(patched(monkeypatch, walker_min_size_ratio=ratio))
         for k in range(30):
             tracker.step(k / RATE_HZ, [meas([1.0 + 0.8 * k / RATE_HZ, 0, 0.9], k=k)])
         (track,) = tracker.tracks
@@ -296,7 +298,7 @@ def test_a_cup_beside_a_walker_does_not_join_its_track():
     assert joins(0.0)
 
 
-def test_a_sharply_turning_walker_keeps_its_speed():
+def test_a_sharply_turning_walker_keeps_its_speed(monkeypatch):
     def mean_speed(cfg):
         """0.9 m/s on a circle of 0.3 m radius (3 rad/s, as the simulated people turn) for 2 s."""
         rng = np.random.default_rng(8)
@@ -308,8 +310,9 @@ def test_a_sharply_turning_walker_keeps_its_speed():
         (track,) = tracker.close_all()
         return float(np.hypot(*np.array(track.trajectory)[:, 4:6].T).mean())
 
-    assert mean_speed(ForegroundConfig()) == pytest.approx(0.9, abs=0.1)
-    assert mean_speed(ForegroundConfig(walker_accel_noise_mps2=1.0)) < mean_speed(ForegroundConfig()) - 0.03
+    default = mean_speed(ForegroundConfig())
+    assert default == pytest.approx(0.9, abs=0.1)
+    assert mean_speed(patched(monkeypatch, walker_accel_noise_mps2=1.0)) < default - 0.03
 
 
 def _lost_person_track(cfg):
@@ -325,7 +328,7 @@ def _lost_person_track(cfg):
     return tracker, track
 
 
-def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate():
+def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate(monkeypatch):
     tracker, track = _lost_person_track(ForegroundConfig())
     far = track.position + np.array([1.2, 0.5, 0.0])  # 1.3 m from the prediction
     base, widened = tracker._gate(track, 2.0)
@@ -339,7 +342,7 @@ def test_a_lost_person_track_takes_only_a_person_beyond_its_normal_gate():
     tracker, track = _lost_person_track(ForegroundConfig())
     _, joined = tracker.step(2.0, [meas(far, "unknown", k=60)])
     assert joined == [track.uuid]  # unmatched but person-sized: the person coming back
-    tracker, track = _lost_person_track(ForegroundConfig(search_same_class=()))
+    tracker, track = _lost_person_track(patched(monkeypatch, search_same_class=()))
     _, joined = tracker.step(2.0, [chair])
     assert joined == [track.uuid]
 
@@ -354,7 +357,7 @@ def test_a_person_lost_for_long_takes_no_unnamed_blob_even_inside_its_grown_filt
         for k in range(30):
             tracker.step(k / RATE_HZ, [meas([1.0 + 0.8 * k / RATE_HZ, 0, 0.9], k=k)])
         (track,) = tracker.tracks
-        lost_s = 1.0 + cfg.search_unknown_max_s + 5.0
+        lost_s = 1.0 + tracking.SEARCH_UNKNOWN_MAX_S + 5.0
         tracker.step(lost_s - 0.5, [], lambda pts: np.zeros(len(pts), bool))
         tracker._predict(track, lost_s)
         near = track.position + np.array([0.3, 0.0, 0.0])
@@ -364,10 +367,10 @@ def test_a_person_lost_for_long_takes_no_unnamed_blob_even_inside_its_grown_filt
 
 
 @pytest.mark.parametrize(("max_footprint_m", "couch_joins"), [(1.2, False), (5.0, True)])
-def test_a_lost_person_track_does_not_take_a_couch(max_footprint_m, couch_joins):
+def test_a_lost_person_track_does_not_take_a_couch(max_footprint_m, couch_joins, monkeypatch):
     """An unmatched blob beyond the normal gate, as tall as half the person but 1.0 by 1.7 m
     seen from above: a couch, not the person coming back."""
-    tracker, track = _lost_person_track(ForegroundConfig(search_max_footprint_m=max_footprint_m))
+    tracker, track = _lost_person_track(patched(monkeypatch, search_max_footprint_m=max_footprint_m))
     couch = Measurement(track.position + np.array([1.2, 0.5, -0.45]), np.array([1.0, 1.7, 0.85]),
                         "unknown", 0.0, "couch")
     _, joined = tracker.step(2.0, [couch])
@@ -407,12 +410,12 @@ def _sliver_then_walker(cfg):
     return sliver_uuid, joined
 
 
-def test_a_settled_sliver_does_not_take_a_person_walking_past():
+def test_a_settled_sliver_does_not_take_a_person_walking_past(monkeypatch):
     sliver, joined = _sliver_then_walker(ForegroundConfig())
     assert sliver not in joined
     assert len({u for u in joined if u is not None}) == 1  # the walker is one track of its own
     # without the rule the sliver's track takes the person (the bug seen on a house log)
-    sliver_off, joined_off = _sliver_then_walker(ForegroundConfig(settled_hits=0))
+    sliver_off, joined_off = _sliver_then_walker(patched(monkeypatch, settled_hits=0))
     assert sliver_off in joined_off
 
 

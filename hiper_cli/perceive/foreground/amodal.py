@@ -36,6 +36,14 @@ from hiper_cli.model import Box3D
 __all__ = ["FLOOR_STANDING", "FOOTPRINT_MIN_WIDTH_M", "LEAST_HEIGHT_M", "complete_base", "complete_footprint",
            "complete_height"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+COMPLETE_FOOTPRINTS: bool = True
+"""A static bed, couch or refrigerator seen in part has its box extended behind the faces
+the camera saw, to its class's least footprint width, and a chair, couch or refrigerator
+whose top no view showed is raised to its class's least height (``amodal.py``; issue 17: a
+bed seen through a doorway as a strip of its side, its centre 0.54 m off; chairs behind a
+desk kept up to the seat)."""
+
 FloatArray = NDArray[np.float64]
 
 FOOTPRINT_MIN_WIDTH_M: dict[str, float] = {

@@ -26,6 +26,30 @@ from hiper_cli.types import CameraIntrinsics
 
 __all__ = ["background_mask", "inside_boxes", "table_leg_boxes"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+MAX_DEPTH_SLACK_M: float = 0.3
+"""... and points up to this much farther are kept, so that an object standing across the
+limit keeps its far side (a hard cut at 5 m moved a far chair's centre towards the camera)."""
+BACKGROUND_MARGIN_PER_M2: float = 0.0015
+"""... plus this times the squared depth (structured-light depth noise grows with z²)."""
+BACKGROUND_NOISE_ALONG_RAY: bool = True
+"""The z² part grows a box face by the noise projected on the face's normal (depth noise
+lies along the viewing ray: a floor seen at a grazing angle needs little of it) ..."""
+BACKGROUND_NOISE_MIN_COS: float = 0.25
+"""... at least this share of it (edges, flying pixels)."""
+BACKGROUND_BLOCK_MEAN: bool = True
+"""The filter tests each sample at the mean depth of its ``pixel_step`` × ``pixel_step``
+pixel block, on the block centre's ray, where that mean is within
+``background_block_tolerance`` filter margins of the sample's own depth (elsewhere the block
+straddles an edge and the sample itself is tested). Sixteen pixels average the depth noise
+down about four times, so a bed's head board or a chair's feet stand out from the wall or
+floor behind them; the points themselves keep their own depth. Where a foot meets the floor
+the block mixes both, and a floor sample may stay with the object."""
+BACKGROUND_BLOCK_TOLERANCE: float = 2.0
+TABLE_LEG_BAND_M: float = 0.0
+"""Filter a band this wide under the edges of every background table top: its legs (0: off;
+needs accurate table boxes: with the background stage's table estimates it cut chairs)."""
+
 FloatArray = NDArray[np.float64]
 
 
@@ -45,16 +69,16 @@ def background_mask(
     block means)."""
     step = config.pixel_step
     R, t = T_map_cam[:3, :3], T_map_cam[:3, 3]
-    noise = config.background_margin_per_m2 * z * z
-    if config.background_noise_along_ray:
+    noise = BACKGROUND_MARGIN_PER_M2 * z * z
+    if BACKGROUND_NOISE_ALONG_RAY:
         margin, along = np.full(z.shape, config.background_margin_m), noise
     else:
         margin, along = config.background_margin_m + noise, None
     # The points tested (block means where usable) as map-frame columns, and their unit
     # viewing rays: x = rx·z, y = ry·z, so the ray is (rx, ry, 1) normalised, whatever z.
     ray_x, ray_y, z_test = rx, ry, z
-    if config.background_block_mean and step > 1:
-        tol = config.background_block_tolerance * (config.background_margin_m + noise)
+    if BACKGROUND_BLOCK_MEAN and step > 1:
+        tol = BACKGROUND_BLOCK_TOLERANCE * (config.background_margin_m + noise)
         z_test, use = _block_mean_depth(depth_m, step, z, tol)
         centre = (step - 1) / 2.0 - step // 2  # the block's centre, from its sample's pixel
         ray_x = np.where(use, rx + centre / camera.fx, rx)
@@ -161,7 +185,7 @@ def _box_rois(
     corners += (centres @ T_cam_map[:3, :3].T + T_cam_map[:3, 3])[:, None, :]
     z = corners[:, :, 2]
     h, w = shape
-    reach_m = config.max_depth_m + config.max_depth_slack_m
+    reach_m = config.max_depth_m + MAX_DEPTH_SLACK_M
     lo_c, hi_c = corners.min(axis=1), corners.max(axis=1)
     gap_m = np.linalg.norm(np.maximum(np.maximum(lo_c, -hi_c), 0.0), axis=1)
     behind = np.all(z < config.min_depth_m, axis=1)
@@ -279,7 +303,7 @@ def _filter_background(
     ray_grids = [c.reshape(h, w) for c in ray_cols]
     M_grid = M.reshape(h, w)
     N_grid = None if N is None else N.reshape(h, w)
-    min_cos = config.background_noise_min_cos
+    min_cos = BACKGROUND_NOISE_MIN_COS
 
     # Largest boxes first (floor, walls): they remove most points, the others test fewer.
     boxes = sorted(boxes, key=lambda b: -b.volume_m3)

@@ -20,6 +20,14 @@ from hiper_cli.types import Detections
 
 __all__ = ["drop_carried"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+CARRIED_CLASSES: tuple[str, ...] = ("backpack", "umbrella", "handbag", "tie", "suitcase", "cell phone")
+"""Things people carry (``carried.py``): a detection of one of these classes whose box lies
+inside a walker detection's box (``carried_containment`` of its area) is part of that person
+(a bag on a walker's arm, a phone at an ear) and is dropped before refinement, so the
+person's box names the blob; empty: off."""
+CARRIED_CONTAINMENT: float = 0.8
+
 
 def drop_carried(
     detections: Detections,

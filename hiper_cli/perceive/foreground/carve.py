@@ -22,9 +22,28 @@ from numpy.typing import NDArray
 
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.plausible import longest_m, max_longest_m
-from hiper_cli.perceive.foreground.segment import Blob, boxes_within, pixels_in_boxes, sub_blob
+from hiper_cli.perceive.foreground.segment import (
+    JOIN_CONTAINMENT,
+    Blob,
+    boxes_within,
+    pixels_in_boxes,
+    sub_blob,
+)
 
 __all__ = ["carve_small"]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+CARVE_CLASSES: tuple[str, ...] = (
+        "bottle", "cup", "wine glass", "bowl", "vase", "laptop", "keyboard", "mouse", "remote",
+        "cell phone", "clock", "scissors", "toothbrush", "potted plant", "teddy bear",
+    )
+"""A detection of one of these inside a blob longer than any instance of its class
+    (``class_sizes``) cuts its object out of the blob (``carve.py``: a bottle on an unmapped
+    side table; empty: off). Not ``book``: books stand in rows on a shelf, a box covers one
+    spine or several, and a shelf's books are often part of the shelf (house 61 with
+    ``yolox``: a ``book`` cut out of the shelf was a false positive) ..."""
+CARVE_DEPTH_M: float = 0.2
+"""... the points in its box within this of the box's front."""
 
 FRONT_PERCENTILE = 10.0  # the front of what a box holds: robust to a few stray nearer samples
 
@@ -43,7 +62,7 @@ def _cut(
         return None
     z = blob.points_cam[:, 2]
     front = float(np.percentile(z[inside], FRONT_PERCENTILE))
-    part = inside & (z <= front + config.carve_depth_m)
+    part = inside & (z <= front + CARVE_DEPTH_M)
     n_part = int(np.count_nonzero(part))
     if n_part < config.min_cluster_points or len(z) - n_part < config.min_cluster_points:
         return None
@@ -66,17 +85,17 @@ def carve_small(
     of the furniture they belong to, and per blob whether it is new (``changed``, per blob
     given, carried over; a blob cut in two is replaced by the rest, the part is appended)."""
     out, changed = list(blobs), list(changed)
-    if not config.carve_classes or len(classes) != len(boxes):
+    if not CARVE_CLASSES or len(classes) != len(boxes):
         return out, changed
     order = np.argsort((boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]))
     for k in order.tolist():
         name = classes[k]
-        if name not in config.carve_classes:
+        if name not in CARVE_CLASSES:
             continue
         limit_m = max_longest_m(name, size_tolerance)
         box = boxes[k : k + 1]
         for i, blob in enumerate(out):
-            if blob.fragment or not boxes_within(blob.image_box_xyxy, box, config.join_containment)[0]:
+            if blob.fragment or not boxes_within(blob.image_box_xyxy, box, JOIN_CONTAINMENT)[0]:
                 continue
             if _longest(blob) <= limit_m:
                 continue

@@ -32,10 +32,34 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, point_bounds
+from hiper_cli.perceive.foreground.background_filter import BACKGROUND_MARGIN_PER_M2
 from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
-from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
+from hiper_cli.perceive.foreground.segment import SUPPORT_GAP_M, Blob, cell_inverse, grid_components, sub_blob
 
 __all__ = ["drop_table_legs", "leg_points"]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+TABLE_LEG_CELL_M: float = 0.05
+"""Table legs leave the blobs (``legs.py``): points are binned horizontally in cells this
+wide (0: off) ..."""
+TABLE_LEG_REACH_M: float = 0.1
+"""... near a background table (its footprint grown by this) ..."""
+TABLE_LEG_MIN_HEIGHT_M: float = 0.4
+"""... a cell whose points reach from this far below the table top ..."""
+TABLE_LEG_TOP_BAND_M: float = 0.2
+"""... up to within this of the top ..."""
+TABLE_LEG_ABOVE_M: float = 0.03
+"""... and no more than this above it is a leg."""
+TABLE_RIM_DEPTH_M: float = 0.08
+"""After the unmapped tables (``drop_unseen_tables``): a cell near a table whose points all
+lie between this far below its top and ``table_rim_above_m`` above it is the top's edge
+(the background layer knows the top as a plane; the few centimetres of edge under it
+survive the filter, and at 4-5 m, with the cluster tolerance grown to 0.3 m, they joined a
+chair to the cups on the table) and leaves the blob with the legs; the rest is clustered
+again (0: off)."""
+TABLE_RIM_ABOVE_M: float = 0.01
+TABLE_RIM_REACH_M: float = 0.1
+"""Rim cells count this far outside the mapped top, and the legs under them too."""
 
 FloatArray = NDArray[np.float64]
 
@@ -47,7 +71,7 @@ def leg_points(
     legs = np.zeros(len(points_map), dtype=bool)
     if len(points_map) == 0 or not tables:
         return legs
-    cell = config.table_leg_cell_m
+    cell = TABLE_LEG_CELL_M
     inverse = cell_inverse(points_map[:, :2], cell)
     n_cells = int(inverse.max()) + 1
     z = points_map[:, 2]
@@ -61,10 +85,10 @@ def leg_points(
         if rims:
             # The top's rim, and the part of the top the background layer has not mapped yet:
             # cells that lie wholly in the top's band; the legs under them count too.
-            rim_cells = (z_lo >= top_z - config.table_rim_depth_m) & (
-                z_hi <= top_z + config.table_rim_above_m
+            rim_cells = (z_lo >= top_z - TABLE_RIM_DEPTH_M) & (
+                z_hi <= top_z + TABLE_RIM_ABOVE_M
             )
-            grow = config.table_rim_reach_m
+            grow = TABLE_RIM_REACH_M
             xy = points_map[:, :2]
             inside = np.all(xy >= lo[:2] - grow, axis=1) & np.all(xy <= hi[:2] + grow, axis=1)
             rim = rim_cells[inverse] & inside
@@ -72,7 +96,7 @@ def leg_points(
                 rim_lo, rim_hi = point_bounds(points_map[rim, :2])
                 lo[:2] = np.minimum(lo[:2], rim_lo)
                 hi[:2] = np.maximum(hi[:2], rim_hi)
-        reach = config.table_leg_reach_m
+        reach = TABLE_LEG_REACH_M
         near = (
             (points_map[:, 0] >= lo[0] - reach) & (points_map[:, 0] <= hi[0] + reach)
             & (points_map[:, 1] >= lo[1] - reach) & (points_map[:, 1] <= hi[1] + reach)
@@ -80,9 +104,9 @@ def leg_points(
         if not near.any():
             continue
         column = (
-            (z_hi >= top_z - config.table_leg_top_band_m)
-            & (z_hi <= top_z + config.table_leg_above_m)
-            & (z_lo <= top_z - config.table_leg_min_height_m)
+            (z_hi >= top_z - TABLE_LEG_TOP_BAND_M)
+            & (z_hi <= top_z + TABLE_LEG_ABOVE_M)
+            & (z_lo <= top_z - TABLE_LEG_MIN_HEIGHT_M)
         )
         if rims:
             column |= rim_cells
@@ -95,9 +119,9 @@ def standing_on(blob: Blob, supports_z_m: Sequence[float | None], config: Segmen
     support) that the blob's base is within the filter margin plus ``support_gap_m`` above."""
     base = float(blob.bounds_map[0][2])
     depth = float(np.median(blob.points_cam[:, 2]))
-    reach = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    reach = config.background_margin_m + BACKGROUND_MARGIN_PER_M2 * depth * depth
     for support in supports_z_m:
-        if support is not None and 0.0 <= base - support <= reach + config.support_gap_m:
+        if support is not None and 0.0 <= base - support <= reach + SUPPORT_GAP_M:
             return support
     return None
 
@@ -107,11 +131,11 @@ def drop_table_legs(
     rims: bool = False,
 ) -> list[Blob]:
     """``blobs`` without their table-leg points; a blob that was only legs is gone."""
-    if not tables or config.table_leg_cell_m <= 0:
+    if not tables or TABLE_LEG_CELL_M <= 0:
         return blobs
     # A table farther from a blob's bounds than the reach of its legs (and rim) cannot take a
     # point of it: only the tables near it are tested (same result, a fraction of the work).
-    reach = config.table_leg_reach_m + (config.table_rim_reach_m if rims else 0.0)
+    reach = TABLE_LEG_REACH_M + (TABLE_RIM_REACH_M if rims else 0.0)
     footprints = [table.aabb() for table in tables]
     tops = [float(hi[2]) for _, hi in footprints]
     out: list[Blob] = []

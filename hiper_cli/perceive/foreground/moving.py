@@ -23,6 +23,23 @@ if TYPE_CHECKING:
 
 __all__ = ["has_moved", "is_dynamic", "is_static", "note_travel", "was_moving"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+MOVING_SPEED_MPS: float = 0.3
+"""Only a track that was moving faster than this when last seen (filtered velocity and
+displacement over ``moving_window_s``) widens its gate while unseen: static objects do not
+walk away, people walk at 0.5-1.4 m/s ..."""
+MOVING_WINDOW_S: float = 1.0
+MIN_MOVING_SPAN_S: float = 0.5
+"""... and a track observed for less than this long is not known to move."""
+DYNAMIC_MOVING_S: float = 1.0
+DYNAMIC_TRAVEL_M: float = 0.5
+"""A track is ``dynamic`` once it was moving (as above) and both sides of its blobs' box
+went this far horizontally, one not of a walker class only after it kept moving at every
+update for ``dynamic_moving_s`` and when its blobs moved (``SeenBox.moved``; not asked of
+``unknown``) (``moving.is_dynamic``); it stays so after it stops or is lost: a person who
+walked is a dynamic object. A static blob that changes as the camera passes moves in spells
+of a few frames, and one that grew as more of it came into view went nowhere."""
+
 
 def is_static(track: Track, config: TrackerConfig) -> bool:
     """Whether a track is a static object: not of a walking class, and its blobs stayed where
@@ -69,8 +86,8 @@ def note_travel(track: Track, config: TrackerConfig) -> None:
     if track.moving_since_s is None:
         track.moving_since_s = stamp
     walker = track.class_name in config.walker_classes
-    if walker or stamp - track.moving_since_s >= config.dynamic_moving_s:
-        track.travelled = track.seen.shift_m() >= config.dynamic_travel_m
+    if walker or stamp - track.moving_since_s >= DYNAMIC_MOVING_S:
+        track.travelled = track.seen.shift_m() >= DYNAMIC_TRAVEL_M
 
 
 def is_dynamic(track: Track, config: TrackerConfig) -> bool:
@@ -95,17 +112,17 @@ def has_moved(track: Track, config: TrackerConfig) -> bool:
 
 
 def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:
-    if not rows or math.hypot(*rows[-1][ROW_VELOCITY][:2]) <= config.moving_speed_mps:
+    if not rows or math.hypot(*rows[-1][ROW_VELOCITY][:2]) <= MOVING_SPEED_MPS:
         return False
     t_end = rows[-1][ROW_STAMP]
     start = rows[0]
     for row in reversed(rows):
-        if t_end - row[ROW_STAMP] >= config.moving_window_s:
+        if t_end - row[ROW_STAMP] >= MOVING_WINDOW_S:
             start = row
             break
     span = t_end - start[ROW_STAMP]
-    if span < config.min_moving_span_s:
+    if span < MIN_MOVING_SPAN_S:
         return False
     (x_end, y_end), (x_start, y_start) = rows[-1][ROW_POSITION][:2], start[ROW_POSITION][:2]
     dx, dy = x_end - x_start, y_end - y_start
-    return math.hypot(dx, dy) / span > config.moving_speed_mps
+    return math.hypot(dx, dy) / span > MOVING_SPEED_MPS

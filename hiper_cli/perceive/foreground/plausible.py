@@ -43,6 +43,17 @@ from hiper_cli.model import Box3D
 
 __all__ = ["CLASS_SIZES", "attached", "longest_m", "max_longest_m", "min_longest_m"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+FIXTURE_CLASSES: tuple[str, ...] = ("sink", "toilet")
+"""Plumbing fixtures (``plausible.attached``): a blob named one of these classes is ``unknown``
+unless it stands against a wall (within ``fixture_reach_m`` of a background wall) or is
+built into a counter (its centre inside a background table top's footprint, its top within
+``fixture_reach_m`` of the top's height). Pipes come out of walls; a round stool seen from
+above, standing free in the room, is no sink (empty: off)."""
+FIXTURE_REACH_M: float = 0.3
+CLASS_SIZE_TOLERANCE: float = 0.15
+"""The sizes' margin for measurement: the largest times 1 + this, the smallest times 1 - this."""
+
 CLASS_SIZES: dict[str, tuple[float, float]] = {
     # people and what they carry
     "person": (0.0, 2.5),

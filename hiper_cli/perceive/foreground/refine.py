@@ -43,10 +43,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
-from hiper_cli.perceive.foreground.carve import carve_small
+from hiper_cli.perceive.foreground.carve import CARVE_CLASSES, carve_small
 from hiper_cli.perceive.foreground.config import RefineConfig
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.segment import (
+    JOIN_CONTAINMENT,
     Blob,
     boxes_within,
     concat_blobs,
@@ -56,6 +57,42 @@ from hiper_cli.perceive.foreground.segment import (
 )
 
 __all__ = ["refine_blobs"]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+TRIM_IOU: float = 0.3
+"""A blob overlapping a detection box with at least this IoU loses its points outside the
+(grown) box, when they are at most ``trim_max_share`` of it (1: off) ..."""
+TRIM_MAX_SHARE: float = 0.4
+TRIM_MARGIN_FRAC: float = 0.1
+"""The trimming box is the detection box grown by this share of its size on every side:
+a jittered box (the ``truth`` detector's corners move by 5 % of the size, σ) otherwise cuts
+the head of a person or the top of a chair back. Only points at the depth of the blob's
+part inside the box (within ``trim_depth_m`` of its median) are kept there: a table leg or a
+wall behind is not."""
+TRIM_DEPTH_M: float = 0.2
+SPLIT_ATTACH_M: float = 0.15
+"""A split blob's point outside every box joins the nearest labelled point within this."""
+SPLIT_TWINS: bool = True
+"""Even with ``detection_split`` off, split a blob that holds two or more detection boxes of
+one class side by side (each at least ``join_containment`` inside the blob's image box,
+none half inside another): bottles, cups or chairs in a row that the clustering joined (its
+tolerance grows with the depth: 0.26 m at 4 m). Boxes of one class side by side are two
+objects whatever the jitter; a person beside a chair keeps to the rule above."""
+TWIN_DEPTH_GAP_M: float = 0.5
+"""Two boxes of one class that overlap by half or more are still twins when the points only
+one holds lie this much farther than the other's in median depth (two chairs one behind the
+other at a table's far end); nearer, they are duplicate boxes of one object (a chair's back
+is 0.2-0.45 m behind its seat's front; 0: never)."""
+DETECTION_MARGIN_FRAC: float = 0.1
+"""... the box grown by this share of its size on every side (detector jitter: without it a
+chair's seat cut off by its own back at the image's lower edge stays apart) ..."""
+JOIN_DEPTH_M: float = 0.25
+"""... their median depths at most this far apart ..."""
+JOIN_GAP_M: float = 0.3
+"""... and their nearest points at most this far apart."""
+JOIN_MAX_IOU_LOSS: float = 0.05
+"""... unless the joined image box's IoU with the detection box is lower than before by
+more than this (a piece of an unmapped table top beside a chair's box)."""
 
 FloatArray = NDArray[np.float64]
 SMALL = "\0small"  # ``_twins``: the one kind of every class in ``carve_classes``
@@ -100,7 +137,7 @@ def _split(
     own = np.flatnonzero(labels >= 0)
     if len(free) and len(own):
         near, dist = _nearest_label(blob.points_cam[free], blob.points_cam[own], labels[own])
-        labels[free] = np.where(dist <= config.split_attach_m, near, len(cand))
+        labels[free] = np.where(dist <= SPLIT_ATTACH_M, near, len(cand))
     # 4. groups too small join the group of their nearest point
     sizes = np.bincount(labels, minlength=len(cand) + 1)
     small = np.flatnonzero((sizes > 0) & (sizes < config.min_cluster_points))
@@ -120,7 +157,7 @@ def _apart_in_depth(blob: Blob, a: FloatArray, b: FloatArray, config: RefineConf
     (or, for a box inside the other, those the inner one holds) lie more than
     ``twin_depth_gap_m`` apart in median depth: one object behind the other, not one object's
     duplicate boxes. False when either side has fewer than ``min_cluster_points``."""
-    if config.twin_depth_gap_m <= 0:
+    if TWIN_DEPTH_GAP_M <= 0:
         return False
     inside = pixels_in_boxes(blob.pixels_uv, np.stack([a, b]))
     only_a, only_b = inside[:, 0] & ~inside[:, 1], inside[:, 1] & ~inside[:, 0]
@@ -132,7 +169,7 @@ def _apart_in_depth(blob: Blob, a: FloatArray, b: FloatArray, config: RefineConf
     if min(np.count_nonzero(only_a), np.count_nonzero(only_b)) < config.min_cluster_points:
         return False
     z = blob.points_cam[:, 2]
-    return bool(abs(float(np.median(z[only_a])) - float(np.median(z[only_b]))) > config.twin_depth_gap_m)
+    return bool(abs(float(np.median(z[only_a])) - float(np.median(z[only_b]))) > TWIN_DEPTH_GAP_M)
 
 
 def _twins(
@@ -143,10 +180,10 @@ def _twins(
     (each at least ``join_containment`` inside it, none half inside another unless the two lie
     at different depths, ``_apart_in_depth``: duplicate boxes of one object, a chair and its
     back, are no twins; two chairs one behind the other are); empty when fewer than two."""
-    inside = boxes_within(blob.image_box_xyxy, boxes, config.join_containment)
+    inside = boxes_within(blob.image_box_xyxy, boxes, JOIN_CONTAINMENT)
     area = np.maximum(np.prod(boxes[:, 2:] - boxes[:, :2], axis=1), 1e-9)
     best = np.zeros(0, dtype=np.int64)
-    kinds = np.array([SMALL if c in config.carve_classes else c for c in classes], dtype=object)
+    kinds = np.array([SMALL if c in CARVE_CLASSES else c for c in classes], dtype=object)
     for name in sorted({c for c, ok in zip(kinds, inside, strict=True) if ok}):
         idx = np.flatnonzero(inside & (kinds == name))
         if len(idx) < 2:
@@ -171,16 +208,16 @@ def _trim(
     (K,) of its image box with ``boxes``), when that IoU reaches ``trim_iou`` and the points
     outside are at most ``trim_max_share``."""
     k = int(np.argmax(iou))
-    if iou[k] < config.trim_iou:
+    if iou[k] < TRIM_IOU:
         return None
     inside = pixels_in_boxes(blob.pixels_uv, boxes[k : k + 1] + step_pad)[:, 0]
     near = pixels_in_boxes(blob.pixels_uv, grown[k : k + 1])[:, 0] & ~inside
     if near.any() and inside.any():
         # Just outside the box at the depth of what is inside: the box was jittered smaller.
         z = blob.points_cam[:, 2]
-        inside |= near & (np.abs(z - float(np.median(z[inside]))) <= config.trim_depth_m)
+        inside |= near & (np.abs(z - float(np.median(z[inside]))) <= TRIM_DEPTH_M)
     n_out = int((~inside).sum())
-    if n_out == 0 or n_out > config.trim_max_share * len(inside):
+    if n_out == 0 or n_out > TRIM_MAX_SHARE * len(inside):
         return None
     keep = np.flatnonzero(inside)
     return keep if len(keep) >= config.min_cluster_points else None
@@ -189,7 +226,7 @@ def _trim(
 def _owner(blob: Blob, boxes: FloatArray, areas: FloatArray, config: RefineConfig) -> int | None:
     """The smallest (jitter-grown) detection box holding ``join_containment`` of the blob."""
     share = np.count_nonzero(pixels_in_boxes(blob.pixels_uv, boxes), axis=0) / len(blob.pixels_uv)
-    ok = np.flatnonzero(share >= config.join_containment)
+    ok = np.flatnonzero(share >= JOIN_CONTAINMENT)
     if len(ok) == 0:
         return None
     return int(ok[np.argmin(areas[ok])])
@@ -201,17 +238,17 @@ def _close(a: Blob, b: Blob, config: RefineConfig) -> bool:
     # Boxes farther apart than the gap hold no points within it (distances are the same in the
     # map frame, where the blobs' bounds are known already).
     (a_min, a_max), (b_min, b_max) = a.bounds_map, b.bounds_map
-    if np.linalg.norm(np.maximum(np.maximum(a_min - b_max, b_min - a_max), 0.0)) > config.join_gap_m:
+    if np.linalg.norm(np.maximum(np.maximum(a_min - b_max, b_min - a_max), 0.0)) > JOIN_GAP_M:
         return False
     # Depth ranges (10th to 90th percentile), not medians: a chair's back legs lie 0.4 m
     # behind the middle of its front.
     za, zb = a.points_cam[:, 2], b.points_cam[:, 2]
     a_lo, a_hi = np.percentile(za, [10, 90])
     b_lo, b_hi = np.percentile(zb, [10, 90])
-    if max(a_lo - b_hi, b_lo - a_hi) > config.join_depth_m:
+    if max(a_lo - b_hi, b_lo - a_hi) > JOIN_DEPTH_M:
         return False
     small, large = (a, b) if len(a.points_cam) <= len(b.points_cam) else (b, a)
-    dist, _ = cKDTree(large.points_cam).query(small.points_cam, distance_upper_bound=config.join_gap_m)
+    dist, _ = cKDTree(large.points_cam).query(small.points_cam, distance_upper_bound=JOIN_GAP_M)
     return bool(np.isfinite(dist).any())
 
 
@@ -224,7 +261,7 @@ def _fits_better(group: Sequence[Blob], blob: Blob, box_xyxy: FloatArray, config
     box = blob.image_box_xyxy
     joined = np.r_[np.minimum(union[:2], box[:2]), np.maximum(union[2:], box[2:])]
     iou = iou_matrix(np.stack([union, joined]), box_xyxy.reshape(1, 4))[:, 0]
-    return bool(iou[1] >= iou[0] - config.join_max_iou_loss)
+    return bool(iou[1] >= iou[0] - JOIN_MAX_IOU_LOSS)
 
 
 def refine_blobs(
@@ -254,7 +291,7 @@ def refine_blobs(
     out, changed = _split_all(blobs, boxes, classes, config, image)
     if size_tolerance is not None:
         out, changed = carve_small(out, changed, boxes, classes, config, size_tolerance, width, height)
-    if config.trim_iou < 1.0:
+    if TRIM_IOU < 1.0:
         _trim_all(out, changed, boxes, config, image)
     if config.detection_join and len(out) >= 2:
         out, changed = _join_all(out, changed, boxes, config, image)
@@ -274,7 +311,7 @@ def _split_all(
     """The blobs split by the detection boxes (``detection_split``; else only twins of a class,
     ``split_twins``), and per blob out whether it is new."""
     areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
-    twins_on = config.split_twins and len(classes) == len(boxes)
+    twins_on = SPLIT_TWINS and len(classes) == len(boxes)
 
     def groups_of(blob: Blob) -> list[NDArray[np.int64]] | None:
         if blob.fragment:
@@ -306,7 +343,7 @@ def _trim_all(
     step = config.pixel_step
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
     sign = np.array([-1.0, -1.0, 1.0, 1.0])
-    trim_pad = np.tile(size * config.trim_margin_frac + step, 2) * sign
+    trim_pad = np.tile(size * TRIM_MARGIN_FRAC + step, 2) * sign
     step_pad = step * sign
     ious = iou_matrix(np.array([blob.image_box_xyxy for blob in out]).reshape(-1, 4), boxes)
     for i, blob in enumerate(out):
@@ -326,7 +363,7 @@ def _join_all(
     step = config.pixel_step
     areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
     size = np.stack([boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1]], axis=1)
-    grown = boxes + np.tile(size * config.detection_margin_frac + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
+    grown = boxes + np.tile(size * DETECTION_MARGIN_FRAC + step, 2) * np.array([-1.0, -1.0, 1.0, 1.0])
     by_owner: dict[int, list[int]] = {}
     for i, blob in enumerate(out):
         k = _owner(blob, grown, areas, config)

@@ -32,6 +32,9 @@ from hiper_cli.perceive.foreground.stitch import STAMP_MATCH_S, common_distance_
 
 __all__ = ["cosighted_pairs", "fold", "fold_mover", "moved_pairs", "pairs"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+REIDENTIFY_MOVED_M: float = 3.0
+
 UNKNOWN = "unknown"
 SAME_ROW_M = 0.25  # a row at a stamp the earlier trajectory has, this near its row there, is it
 

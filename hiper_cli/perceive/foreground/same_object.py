@@ -36,6 +36,8 @@ from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.seen_box import SeenBox
 from hiper_cli.perceive.foreground.stitch import (
     REVISIT,
+    STITCH_MIN_OVERLAP,
+    STITCH_OVERLAP_M,
     absorb,
     find_target,
     footprint_share,
@@ -124,8 +126,8 @@ def cut_in_two(a: NamedBlob, b: NamedBlob, config: TrackerConfig) -> bool:
     narrower_px = min(a.xyxy_px[2] - a.xyxy_px[0], b.xyxy_px[2] - b.xyxy_px[0])
     if common_px < STACKED_SHARE * narrower_px:
         return False
-    share = footprint_share((a.lower_m, a.upper_m), (b.lower_m, b.upper_m), max_gap_m=config.stitch_overlap_m)
-    return share >= config.stitch_min_overlap
+    share = footprint_share((a.lower_m, a.upper_m), (b.lower_m, b.upper_m), max_gap_m=STITCH_OVERLAP_M)
+    return share >= STITCH_MIN_OVERLAP
 
 
 def static_together(

@@ -29,7 +29,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, point_bounds
-from hiper_cli.perceive.foreground.background_filter import background_mask
+from hiper_cli.perceive.foreground.background_filter import (
+    BACKGROUND_MARGIN_PER_M2,
+    MAX_DEPTH_SLACK_M,
+    background_mask,
+)
 from hiper_cli.perceive.foreground.config import SegmentConfig
 from hiper_cli.types import CameraIntrinsics
 
@@ -37,6 +41,28 @@ __all__ = [
     "Blob", "SegmentStats", "boxes_within", "cell_inverse", "concat_blobs", "grid_components", "image_box",
     "pixels_in_boxes", "segment", "sub_blob", "support_below",
 ]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+CLUSTER_TOLERANCE_PER_M: float = 0.04
+"""... plus this much per metre of depth (grazing surfaces, depth noise)."""
+CLUSTER_NEIGHBOUR_CELLS: int = 2
+"""How far (in subsampled grid cells) a neighbour may be; bridges small depth holes."""
+FRAGMENT_RATIO: float = 0.25
+"""A cluster smaller than this share of a touching, nearby cluster is a fragment of it ..."""
+FRAGMENT_DISTANCE_M: float = 0.3
+"""... when its centre is this close to that cluster's box (grazing sides, heads)."""
+SUPPORT_GAP_M: float = 0.1
+"""A blob whose base is at most the filter margin plus this above a floor or table top
+stands on it: its box reaches down to the support (a wider gap, to catch chairs whose thin
+legs lose their lowest samples, moves the centre away from what the sensor sees)."""
+SUPPORT_EDGE_BAND_M: float = 0.01
+"""... unless its lowest points (within this of its lowest) reach the image's lower edge: its
+base is out of view (a chair cut there by its front legs, its back feet in view, stands)."""
+MAX_CLUSTER_POINTS: int = 8000
+MAX_CLUSTER_EXTENT_M: float = 3.0
+"""Clusters longer than this in any direction are structure (walls, floor), not objects."""
+JOIN_CONTAINMENT: float = 0.8
+"""Share of a blob's pixels that must lie in the (grown) detection box to join ..."""
 
 FloatArray = NDArray[np.float64]
 
@@ -54,9 +80,6 @@ class Blob:
     """Top of the floor or table the blob stands on, when the background filter cut its base."""
     fragment: bool = False
     """Fewer points than ``min_cluster_points``: kept only to be joined to an object (refine)."""
-    cut_from_table_m: tuple[FloatArray, FloatArray] | None = None
-    """(lower, upper) corners, map frame, of the table top and legs found in the blob this one
-    was cut from (``tables.split_unseen_tables``; ``split_parts``); None: not cut from one."""
     _bounds: tuple[FloatArray, FloatArray] | None = field(default=None, init=False, repr=False, compare=False)
     _mean: FloatArray | None = field(default=None, init=False, repr=False, compare=False)
 
@@ -257,8 +280,8 @@ def grid_components(
     points[grid[:, 1], grid[:, 0]] = blob.points_cam[sel]
     valid[grid[:, 1], grid[:, 0]] = True
     labels = _cluster_labels(
-        points, valid, config.cluster_tolerance_m, config.cluster_tolerance_per_m,
-        config.cluster_neighbour_cells,
+        points, valid, config.cluster_tolerance_m, CLUSTER_TOLERANCE_PER_M,
+        CLUSTER_NEIGHBOUR_CELLS,
     )[grid[:, 1] * width + grid[:, 0]]
     _, first = np.unique(labels, return_index=True)
     return [np.flatnonzero(labels == labels[i]) for i in np.sort(first)]
@@ -288,7 +311,7 @@ def _merge_fragments(
     pts = map_full[member]
     lows = np.minimum.reduceat(pts, starts, axis=0)
     highs = np.maximum.reduceat(pts, starts, axis=0)
-    pad = config.cluster_neighbour_cells + 1
+    pad = CLUSTER_NEIGHBOUR_CELLS + 1
     gy, gx = member // grid_w, member % grid_w
     grid_boxes = np.stack([
         np.minimum.reduceat(gy, starts) - pad, np.minimum.reduceat(gx, starts) - pad,
@@ -297,7 +320,7 @@ def _merge_fragments(
     order = keep[np.argsort(-sizes[keep], kind="stable")].tolist()  # largest first
     kept: list[int] = []
     members: dict[int, list[NDArray[np.int64]]] = {}
-    ratio, reach = config.fragment_ratio, config.fragment_distance_m
+    ratio, reach = FRAGMENT_RATIO, FRAGMENT_DISTANCE_M
     for i in order:
         target = None
         a = grid_boxes[i]
@@ -336,18 +359,18 @@ def support_below(
     if edge_v is not None and blob.image_box_xyxy[3] >= edge_v:
         # Cut by the lower edge: the base is out of view when the lowest points are at the edge
         # (a chair's front legs may be cut while its back feet stand in view).
-        low = blob.points_map[:, 2] <= lo[2] + config.support_edge_band_m
+        low = blob.points_map[:, 2] <= lo[2] + SUPPORT_EDGE_BAND_M
         if np.any(blob.pixels_uv[low, 1] >= edge_v):
             return None
     depth = float(np.median(blob.points_cam[:, 2]))
-    margin = config.background_margin_m + config.background_margin_per_m2 * depth * depth
+    margin = config.background_margin_m + BACKGROUND_MARGIN_PER_M2 * depth * depth
     best: float | None = None
     for box in supports:
         b_lo, b_hi = box.aabb()
         if b_lo[0] > hi[0] or b_hi[0] < lo[0] or b_lo[1] > hi[1] or b_hi[1] < lo[1]:
             continue  # not under the blob
         top = float(b_hi[2])
-        if 0.0 <= lo[2] - top <= margin + config.support_gap_m and (best is None or top > best):
+        if 0.0 <= lo[2] - top <= margin + SUPPORT_GAP_M and (best is None or top > best):
             best = top
     return best
 
@@ -377,7 +400,7 @@ def segment(
     rx, ry, U, V = _rays(camera, step)
     off = step // 2
     z = depth_m[off::step, off::step].astype(np.float64)
-    valid = (z >= config.min_depth_m) & (z <= config.max_depth_m + config.max_depth_slack_m) & np.isfinite(z)
+    valid = (z >= config.min_depth_m) & (z <= config.max_depth_m + MAX_DEPTH_SLACK_M) & np.isfinite(z)
     P = np.stack([rx * z, ry * z, z], axis=-1)  # (h, w, 3) camera frame
     stats.points = int(valid.sum())
     P_flat = P.reshape(-1, 3)
@@ -388,7 +411,7 @@ def segment(
     stats.after_background = int(valid.sum())
     t2 = time.perf_counter()
     labels = _cluster_labels(
-        P, valid, config.cluster_tolerance_m, config.cluster_tolerance_per_m, config.cluster_neighbour_cells
+        P, valid, config.cluster_tolerance_m, CLUSTER_TOLERANCE_PER_M, CLUSTER_NEIGHBOUR_CELLS
     )
     member = np.flatnonzero(labels >= 0)
     blobs: list[Blob] = []
@@ -404,14 +427,14 @@ def segment(
             fragment = size < config.min_cluster_points
             if fragment and not keep_fragments:
                 continue
-            if size > config.max_cluster_points:
+            if size > MAX_CLUSTER_POINTS:
                 stats.rejected_clusters += 1
                 continue
-            if config.max_depth_slack_m > 0 and np.median(P_flat[sel, 2]) > config.max_depth_m:
+            if MAX_DEPTH_SLACK_M > 0 and np.median(P_flat[sel, 2]) > config.max_depth_m:
                 continue  # beyond the range: the slack only keeps the far side of nearer objects
             pm = map_full[sel]
             lo, hi = point_bounds(pm)
-            if np.any(hi - lo > config.max_cluster_extent_m):
+            if np.any(hi - lo > MAX_CLUSTER_EXTENT_M):
                 stats.rejected_clusters += 1
                 continue
             uv = np.stack([U_flat[sel], V_flat[sel]], axis=1).astype(np.int32)

@@ -33,11 +33,26 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.perceive.foreground.background_filter import BACKGROUND_MARGIN_PER_M2
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.match import Match
-from hiper_cli.perceive.foreground.whole import thickness_m
+from hiper_cli.perceive.foreground.refine import JOIN_DEPTH_M
+from hiper_cli.perceive.foreground.whole import UNKNOWN_MIN_THICKNESS_M, thickness_m
 
 __all__ = ["detected_blobs", "is_flat"]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+WALKER_SOLID: bool = True
+"""A walker is a solid body (``solid.py``): a flat blob (as ``unknown_min_thickness_m``
+says: a picture or a screen showing people, a wall piece) named a walker class stays
+``unknown``, and a walker's track does not take a flat blob."""
+DETECTION_NEAREST: bool = True
+"""A detection names one of the blobs it matches and those at its depth
+(``solid.detected_blobs``): for a walker class the nearest (a wall behind a person stays
+``unknown``), for other classes the one that fits its box best (a desk's end in front of
+a chair stays ``unknown``); blobs more than ``join_depth_m`` behind or in front of it do not
+keep the name."""
 
 DEPTH_RANGE_PERCENTILES = (5.0, 95.0)  # a blob's depth range, robust to a few stray points
 PANEL_MIN_SPAN_M = 0.5  # a flat blob this large would show a body's relief (a torso's width)
@@ -59,7 +74,7 @@ def is_flat(points_cam: NDArray[np.float64], config: ForegroundConfig) -> bool:
     if float(np.max(np.ptp(points_cam, axis=0))) < PANEL_MIN_SPAN_M:
         return False
     depth = float(np.median(points_cam[:, 2]))
-    flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
+    flat_m = UNKNOWN_MIN_THICKNESS_M + BACKGROUND_MARGIN_PER_M2 * depth * depth
     if depth < PANEL_MIN_DEPTH_M or flat_m >= BODY_RELIEF_M:
         return False
     return thickness_m(points_cam) < flat_m
@@ -91,8 +106,8 @@ def detected_blobs(
             seen = max(named, key=lambda i: (matches[i].iou, -float(ranges[i][1])))
         near_end, far_end = float(ranges[seen][0]), float(ranges[seen][2])
         for i in named:
-            if float(ranges[i][0]) > far_end + config.join_depth_m or (
-                float(ranges[i][2]) < near_end - config.join_depth_m
+            if float(ranges[i][0]) > far_end + JOIN_DEPTH_M or (
+                float(ranges[i][2]) < near_end - JOIN_DEPTH_M
             ):
-                out[i] = Match(config.unknown_class, 0.0, None, matches[i].iou)
+                out[i] = Match(UNKNOWN, 0.0, None, matches[i].iou)
     return out

@@ -13,20 +13,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.errors import DataError, PerceptionError
-from hiper_cli.learned import (
-    FEATURE_KINDS,
-    KIND_ALTITUDE,
-    KIND_ODS,
-    KIND_SIZE,
-    AltitudeFeature,
-    ObjectDynamics,
-    SizeFeature,
-    feature_from_analysis,
-)
+from hiper_cli.errors import PerceptionError
 from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, check_class_names, make_detector
 from hiper_cli.perceive.foreground.amodal import (
+    COMPLETE_FOOTPRINTS,
     FLOOR_STANDING,
     LEAST_HEIGHT_M,
     complete_base,
@@ -34,32 +25,51 @@ from hiper_cli.perceive.foreground.amodal import (
     complete_height,
 )
 from hiper_cli.perceive.foreground.appearance import histogram
-from hiper_cli.perceive.foreground.background_filter import table_leg_boxes
-from hiper_cli.perceive.foreground.carried import drop_carried
+from hiper_cli.perceive.foreground.background_filter import TABLE_LEG_BAND_M, table_leg_boxes
+from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTAINMENT, drop_carried
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
-from hiper_cli.perceive.foreground.couch_or_bed import BED, COUCH, couch_or_bed
-from hiper_cli.perceive.foreground.legs import drop_table_legs
+from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import has_moved, is_static
-from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
+from hiper_cli.perceive.foreground.plausible import (
+    CLASS_SIZE_TOLERANCE,
+    FIXTURE_CLASSES,
+    FIXTURE_REACH_M,
+    attached,
+    longest_m,
+    max_longest_m,
+    min_longest_m,
+)
+from hiper_cli.perceive.foreground.priors import LearnedPriors
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
+from hiper_cli.perceive.foreground.reidentify import (
+    REIDENTIFY_MOVED_M,
+    cosighted_pairs,
+    fold,
+    fold_mover,
+    moved_pairs,
+    pairs,
+)
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
+from hiper_cli.perceive.foreground.solid import DETECTION_NEAREST, WALKER_SOLID, detected_blobs, is_flat
+from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
+from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
-from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
-from hiper_cli.perceive.foreground.tracking import ClassPrior, Measurement, Track, Tracker, object_box
+from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
     TABLE_CLASS,
     TABLE_SCORE,
+    UNSEEN_TABLE_INSTANCES,
     table_match,
     withdraw_mapped,
 )
 from hiper_cli.perceive.foreground.vacated import EmptyPlaces
 from hiper_cli.perceive.foreground.whole import (
+    FULL_VIEW_COVER,
+    FULL_VIEW_MIN_PX2,
     bottom_hidden,
     in_full_view,
     inside_image,
@@ -72,14 +82,34 @@ from hiper_cli.types import Detections, Frame
 
 __all__ = ["ForegroundStage"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+POINTS_PER_OBSERVATION: int = 64
+"""Subsample of ``points_cam`` stored in each observation."""
+PIXELS_PER_OBSERVATION: int = 48
+"""Sample of pixel coordinates ``pixels_uv`` stored in each observation."""
+WALKER_MAX_BASE_M: float = 1.2
+"""A blob named by a walker class whose lowest point lies more than this above the floor
+(the lowest floor instance's top; the map's z = 0 before one) is no walker: it stays
+``unknown`` (0: off). People stand on the floor; behind a counter they still show below."""
+WALKER_FROM_FLOOR: bool = True
+"""An observation a detection names a walker class spans from the floor to its blob's top
+(the centre halfway): people stand on the floor, and a person behind a shelf or a table
+shows only the upper body (issue 17: person centres 0.5-0.8 m off in height)."""
+SAME_BOX_IOU: float = 0.8
+"""Two detections of different classes whose boxes overlap by this IoU are one object the
+detector named twice (``classes.one_name_per_box``: a bottle and a vase, a bench and a
+chair): the one with the higher score stays; ``walker_classes`` are left out; 1: off."""
+
 FloatArray = NDArray[np.float64]
 SUPPORT_CLASSES = ("floor", "table")
 # Named constants (not the paper's): chosen so that they never bind on the simulated worlds.
 HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
-MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this span
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
+VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
+STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
+STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -152,87 +182,15 @@ class ForegroundStage:
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
         self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
-        self._priors: dict[tuple[str, str], ObjectDynamics | SizeFeature | AltitudeFeature] = {}
-        self._analyses_seen = -1
+        self._priors = LearnedPriors(cfg)
         self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
         self._floor_mapped = False  # the background found a floor (``complete_base``)
-        self.tracker = Tracker(cfg, self._class_prior)
+        self.tracker = Tracker(cfg, self._priors.class_prior)
         self._instances: dict[str, Instance] = {}
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
-
-    # --- learned priors ---------------------------------------------------------------------
-    def _refresh_priors(self, world: World) -> None:
-        if len(world.analyses) == self._analyses_seen:
-            return
-        self._analyses_seen = len(world.analyses)
-        self._priors = {}
-        for a in sorted(world.analyses, key=lambda a: a.created_s):
-            if a.kind in FEATURE_KINDS:
-                try:
-                    self._priors[(a.kind, a.class_name)] = feature_from_analysis(a)
-                except DataError:  # written by an older hiper: no prior rather than no run
-                    continue
-
-    def _prior(self, kind: str, class_name: str) -> ObjectDynamics | SizeFeature | AltitudeFeature | None:
-        """The learned feature of a class, when learned from ``prior_min_instances`` instances."""
-        found = self._priors.get((kind, class_name))
-        return found if found is not None and found.instances >= self.config.prior_min_instances else None
-
-    def _class_prior(self, class_name: str) -> ClassPrior:
-        cfg = self.config
-        ods = self._prior(KIND_ODS, class_name)
-        if not isinstance(ods, ObjectDynamics) or not cfg.use_learned_priors:
-            return ClassPrior()
-        return ClassPrior(
-            cu_mps=ods.cu_mps if cfg.learned_gates else None,
-            # a class seen only standing taught no motion: its σ is the drift of its own filter
-            sigma_mps=ods.sigma_mps if cfg.learned_motion_noise and ods.dynamic_rows else None,
-        )
-
-    def _fits_priors(self, class_name: str, blob: Blob, frame: Frame) -> bool:
-        """False when the learned size / altitude of ``class_name`` rule the blob out.
-
-        The priors are learned from instances, each the extent of all its views; one view shows
-        at most the whole object. A blob larger than the class's range, or whose bottom lies
-        below it, is something else. A smaller one is no evidence: a partial view, or samples a
-        pixel step apart (a bottle at 3 m is a column of points). A walker's instance box is a
-        running mean of its views, partial ones included, so its size range bounds no view. A
-        bottom above the range rules the class out only when the blob is seen whole (inside the
-        image, nothing nearer cuts it): a person close by, legs below the image, keeps its class."""
-        cfg = self.config
-        if not cfg.use_learned_priors:
-            return True
-        tol = cfg.prior_tolerance
-        size = self._prior(KIND_SIZE, class_name)
-        bounded = cfg.learned_size and class_name not in cfg.walker_classes  # walkers: a mean box
-        volume_m3 = float(np.prod(blob.extent_map_m))
-        if bounded and isinstance(size, SizeFeature) and volume_m3 > size.hi_m3 * (1 + tol):
-            return False
-        alt = self._prior(KIND_ALTITUDE, class_name)
-        if cfg.learned_altitude and isinstance(alt, AltitudeFeature):
-            slack = tol * max(alt.hi_m - alt.lo_m, MIN_ALTITUDE_SPAN_M)
-            bottom = float(blob.center_map_m[2] - blob.extent_map_m[2] / 2.0)
-            if bottom < alt.lo_m - slack:
-                return False
-            if bottom > alt.hi_m + slack:  # seen whole, its bottom is the object's
-                step = cfg.pixel_step
-                return not inside_image(blob, step, frame.camera) or occluded(
-                    blob, frame.depth_m, frame.camera, frame.T_map_cam, step
-                )
-        return True
-
-    def _couch_or_bed(self, match: Match, blob: Blob) -> Match:
-        """``match`` renamed to the other of couch and bed when the blob's tall part says so
-        (``couch_or_bed.py``) and that class is one the stage names."""
-        cfg = self.config
-        told = couch_or_bed(blob.points_map, self._floor_z_m)
-        if told is None or told == match.class_name or told in cfg.exclude_classes or (
-            cfg.classes and told not in cfg.classes
-        ):
-            return match
-        return Match(told, match.score, match.detection_index, match.iou)
+        self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
 
     def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
         """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
@@ -245,15 +203,15 @@ class ForegroundStage:
             return True
         if flat:
             return False
-        if cfg.walker_max_base_m <= 0:
+        if WALKER_MAX_BASE_M <= 0:
             return True
-        return float(blob.bounds_map[0][2]) - self._floor_z_m <= cfg.walker_max_base_m
+        return float(blob.bounds_map[0][2]) - self._floor_z_m <= WALKER_MAX_BASE_M
 
     def _standing_box(self, blob: Blob) -> tuple[FloatArray, FloatArray] | None:
         """The blob's box if it were a walker (``walker_from_floor``): from the floor to the
         blob's top. A person seen over a shelf or a table shows only the upper body, whose
         centre lies far above the person's; people stand on the floor."""
-        if not self.config.walker_from_floor:
+        if not WALKER_FROM_FLOOR:
             return None
         top = float(blob.bounds_map[1][2])
         if top <= self._floor_z_m:
@@ -286,7 +244,7 @@ class ForegroundStage:
         and track them (associate, fuse, move); the changed instances and their observations."""
         clock = [time.perf_counter()]
         future = self._detection_of(frame)
-        self._refresh_priors(world)
+        self._priors.refresh(world)
         if self.config.reidentify:
             self._look_for_earlier(frame, world)
         scene = self._read_background(world)
@@ -294,12 +252,11 @@ class ForegroundStage:
         clock.append(time.perf_counter())
         dets, detect_s = self._detections(frame, future)
         clock.append(time.perf_counter())
-        hidden = self._hidden(frame)
-        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets, hidden)
+        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets)
         clock.append(time.perf_counter())
         observations, measurements, surfaces = self._measure(frame, scene, blobs, dets, found_tables)
         clock.append(time.perf_counter())
-        instances, merged = self._track(frame, scene, (observations, measurements, surfaces), hidden)
+        instances, merged = self._track(frame, scene, (observations, measurements, surfaces))
         clock.append(time.perf_counter())
         return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
                            timings_s=_timings(clock, detect_s, seg))
@@ -327,8 +284,8 @@ class ForegroundStage:
         else:
             dets, detect_s = self._detect_timed(frame)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
-        dets = one_name_per_box(dets, cfg.same_box_iou, cfg.walker_classes)
-        dets = drop_carried(dets, cfg.carried_classes, cfg.walker_classes, cfg.carried_containment,
+        dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
+        dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
                             cfg.min_detection_score)
         return dets, detect_s
 
@@ -342,9 +299,9 @@ class ForegroundStage:
         self._floor_mapped = any(inst.class_name == "floor" for inst in background)
         tables = [inst for inst in background if inst.class_name == "table"]
         dropped = [inst.box for inst in background] if cfg.background_filter else []
-        if cfg.background_filter and cfg.table_leg_band_m > 0:
+        if cfg.background_filter and TABLE_LEG_BAND_M > 0:
             for inst in tables:
-                dropped.extend(table_leg_boxes(inst.box, cfg.table_leg_band_m))
+                dropped.extend(table_leg_boxes(inst.box, TABLE_LEG_BAND_M))
         return _Background(dropped, support_boxes(background), [inst.box for inst in tables],
                            support_boxes(tables))
 
@@ -362,7 +319,7 @@ class ForegroundStage:
         return blobs, seg
 
     def _split_and_refine(
-        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections, hidden: Any
+        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections
     ) -> tuple[list[Blob], list[Blob], Detections]:
         """The blobs split from the tables the background has not mapped (``tables.py``), and
         trimmed and joined with the detections (``refine.py``); those tables' blobs; the
@@ -377,12 +334,11 @@ class ForegroundStage:
             blobs, found_tables, lookalikes = split_unseen_tables(blobs, usable, names, cfg, width, height)
             if lookalikes:
                 dets, ok, usable, names = _without(dets, ok, np.flatnonzero(ok)[lookalikes])
-            found_tables = join_hidden_pieces(found_tables, hidden, cfg, width, height)
-            if cfg.table_rim_depth_m > 0:
+            if TABLE_RIM_DEPTH_M > 0:
                 blobs = drop_table_legs(blobs, scene.tables, cfg, cfg.pixel_step, width, height, rims=True)
         if cfg.detection_split or cfg.detection_join:
             blobs = refine_blobs(blobs, usable, cfg, width, height, scene.supports, classes=names,
-                                 size_tolerance=cfg.class_size_tolerance if cfg.class_sizes else None)
+                                 size_tolerance=CLASS_SIZE_TOLERANCE if cfg.class_sizes else None)
         return blobs, found_tables, dets
 
     def _measure(
@@ -396,51 +352,55 @@ class ForegroundStage:
             dets,
             iou_threshold=cfg.iou_threshold,
             min_score=cfg.min_detection_score,
-            unknown=cfg.unknown_class,
+            unknown=UNKNOWN,
         )
-        if cfg.detection_nearest:
+        if DETECTION_NEAREST:
             matches = detected_blobs(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
+        keyframe = self._solid.due(frame.stamp_s)
+        unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
-            flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
+            flat = WALKER_SOLID and is_flat(blob.points_cam, cfg)
             match, longest = self._judged(frame, scene, blob, match, flat)
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
+            if keyframe and match.detection_index is None and is_solid(blob.points_cam):
+                unnamed.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
             measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
-        for blob in found_tables if cfg.unseen_table_instances else []:
+        for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
             surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
+        if keyframe:
+            self._solid.add(frame, unnamed)
         return observations, measurements, surfaces
 
     def _judged(
         self, frame: Frame, scene: _Background, blob: Blob, match: Match, flat: bool
     ) -> tuple[Match, float | None]:
-        """``match`` as the checks of a named class leave it (couch or bed; else ``unknown``
-        when the class's learned priors, standing, size or attachment rule the blob out), and
+        """``match`` as the checks of a named class leave it (``unknown`` when the class's
+        learned priors, standing, size or attachment rule the blob out), and
         the blob's longest side when it tells the class's size (seen whole; else None)."""
         cfg = self.config
-        if cfg.couch_or_bed and match.class_name in (COUCH, BED):
-            match = self._couch_or_bed(match, blob)
         if match.detection_index is None:
             return match, None
         longest = longest_m(blob.points_map, float(blob.extent_map_m[2])) if cfg.class_sizes else None
         if not (
-            self._fits_priors(match.class_name, blob, frame)
+            self._priors.fits(match.class_name, blob, frame)
             and self._stands(match.class_name, blob, flat)
-            and (longest is None or longest <= max_longest_m(match.class_name, cfg.class_size_tolerance))
-            and (match.class_name not in cfg.fixture_classes
-                 or attached(blob.points_map, self._walls, scene.tops, cfg.fixture_reach_m))
+            and (longest is None or longest <= max_longest_m(match.class_name, CLASS_SIZE_TOLERANCE))
+            and (match.class_name not in FIXTURE_CLASSES
+                 or attached(blob.points_map, self._walls, scene.tops, FIXTURE_REACH_M))
         ):
-            return Match(cfg.unknown_class, 0.0, None, match.iou), None
-        if longest is not None and min_longest_m(match.class_name, cfg.class_size_tolerance) > 0 and (
+            return Match(UNKNOWN, 0.0, None, match.iou), None
+        if longest is not None and min_longest_m(match.class_name, CLASS_SIZE_TOLERANCE) > 0 and (
             not inside_image(blob, cfg.pixel_step, frame.camera)
             or occluded(blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step)
         ):
@@ -456,7 +416,7 @@ class ForegroundStage:
         cfg = self.config
         obs, longest, flat = seen
         full = cfg.refused_min_views > 0 and in_full_view(
-            blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, cfg.full_view_min_px2
+            blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, FULL_VIEW_MIN_PX2
         )
         walker = match.class_name in cfg.walker_classes
         return Measurement(
@@ -471,39 +431,31 @@ class ForegroundStage:
             detection_index=match.detection_index,
             detection_xyxy_px=None if match.detection_index is None else dets.xyxy[match.detection_index],
             viewpoint_map_m=frame.T_map_cam[:3, 3],
-            top_hidden=cfg.complete_footprints and match.class_name in LEAST_HEIGHT_M
+            top_hidden=COMPLETE_FOOTPRINTS and match.class_name in LEAST_HEIGHT_M
             and top_hidden(blob, frame.depth_m, cfg.pixel_step),
-            bottom_hidden=cfg.complete_footprints and match.class_name in FLOOR_STANDING
+            bottom_hidden=COMPLETE_FOOTPRINTS and match.class_name in FLOOR_STANDING
             and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
             full_view=full,
             named_within=named_within(
-                blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=cfg.full_view_cover,
+                blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),
-            cut_from_table_m=blob.cut_from_table_m,
         )
 
     def _track(
         self, frame: Frame, scene: _Background,
-        measured: tuple[list[Observation], list[Measurement], list[FloatArray | None]], hidden: Any,
+        measured: tuple[list[Observation], list[Measurement], list[FloatArray | None]],
     ) -> tuple[list[Instance], list[str]]:
         """Track the frame's measurements; their observations get their instance, the tracks'
         surfaces their points. The instances changed and the uuids of those merged away (a
         track stitched into another, one whose evidence failed, a table the background mapped)."""
-        cfg = self.config
         observations, measurements, surfaces = measured
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
         tables_withdrawn = (
-            withdraw_mapped(self.tracker, scene.tables, cfg.table_leg_reach_m)
-            if cfg.unseen_table_instances else []
+            withdraw_mapped(self.tracker, scene.tables, TABLE_LEG_REACH_M)
+            if UNSEEN_TABLE_INSTANCES else []
         )
         if tables_withdrawn:  # the background layer mapped them: its instance is the table
             changed = [t for t in changed if t.uuid not in tables_withdrawn]
-        pieces = join_hidden_tracks(self.tracker, hidden, cfg) if cfg.unseen_table_instances else {}
-        if pieces:  # two tracks of one table a chair cut in two: the newer folded into the older
-            joined = [pieces[u].uuid if u in pieces else u for u in joined]
-            changed = [t for t in changed if t.uuid not in pieces]
-            listed = {id(t) for t in changed}
-            changed += [t for t in {id(t): t for t in pieces.values()}.values() if id(t) not in listed]
         confirmed = {t.uuid for t in self.tracker.tracks if t.confirmed}
         for obs, points, track_uuid in zip(observations, surfaces, joined, strict=True):
             if track_uuid in confirmed:
@@ -513,7 +465,7 @@ class ForegroundStage:
         instances = [self._instance(t) for t in changed]
         # a track closed for good has its instance's surface already (tentative ones: none)
         self._surfaces.keep({t.uuid for t in (*self.tracker.tracks, *self.tracker.dormant)})
-        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn, *pieces]
+        gone = [*self.tracker.absorbed, *self.tracker.withdrawn, *tables_withdrawn]
         return instances, [u for u in gone if self._instances.pop(u, None) is not None]
 
     def finish(self, world: World) -> FrameResult:
@@ -532,7 +484,20 @@ class ForegroundStage:
             earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
+        instances += self._geometry_only(world, instances)
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
+
+    def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
+        """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
+        standing on the floor or a support, outside the background and every instance."""
+        background = list(world.background.values())
+        taken = [i.box for i in (*world.foreground.values(), *self._instances.values(), *instances)
+                 if i.layer == "foreground"]
+        grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
+        ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
+        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown,
+                                  min(ceilings) if ceilings else None)
+        return [_solid_instance(p) for p in parts]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
@@ -553,15 +518,14 @@ class ForegroundStage:
         walker seen at the same times (``reidentify.py``), or whose place this session saw
         empty (``vacated.py``), the uuids of the instances absorbed, and how many were found
         again, moved and vacated."""
-        cfg = self.config
         earlier = {u: i for u, i in world.foreground.items() if u not in self._instances and self._stays(i)}
         new = [i for u, i in self._instances.items() if u in static and self._stays(i)]
-        found = pairs(new, earlier.values(), min_share=cfg.stitch_min_overlap, max_gap_m=cfg.stitch_overlap_m)
+        found = pairs(new, earlier.values(), min_share=STITCH_MIN_OVERLAP, max_gap_m=STITCH_OVERLAP_M)
         paired = {u for e, n in found for u in (e.uuid, n.uuid)}
         vacated = self._empty.vacated() if self._empty is not None else {}
         # seen empty now, or by an earlier session: gone from where it was
         gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
-        moved = moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=cfg.reidentify_moved_m)
+        moved = moved_pairs([n for n in new if n.uuid not in paired], gone, max_m=REIDENTIFY_MOVED_M)
         found += moved
         for old, absorbed in found:
             fold(old, absorbed)
@@ -571,7 +535,7 @@ class ForegroundStage:
         cosighted = cosighted_pairs(
             [i for i in self._instances.values() if i.class_name in walkers],
             [i for u, i in world.foreground.items() if u not in self._instances and i.class_name in walkers],
-            max_m=tracking.stitch_duplicate_m, min_common=tracking.confirm_hits,
+            max_m=STITCH_DUPLICATE_M, min_common=tracking.confirm_hits,
         )
         for old, absorbed in cosighted:
             fold_mover(old, absorbed)
@@ -588,10 +552,9 @@ class ForegroundStage:
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
-        cfg = self.config
         n = len(blob.points_cam)
-        pts_idx = _spread(n, cfg.points_per_observation)
-        pix_idx = _spread(n, cfg.pixels_per_observation)
+        pts_idx = _spread(n, POINTS_PER_OBSERVATION)
+        pix_idx = _spread(n, PIXELS_PER_OBSERVATION)
         detection = None
         if match.detection_index is not None:
             k = match.detection_index
@@ -652,7 +615,7 @@ class ForegroundStage:
         down to the floor when no view showed where it stands, and up to its class's least height
         when no view showed its top (``amodal.py``)."""
         centre, extent = object_box(track, self.tracker.config)
-        if self.config.complete_footprints and is_static(track, self.tracker.config):
+        if COMPLETE_FOOTPRINTS and is_static(track, self.tracker.config):
             lower, upper = complete_footprint(centre - extent / 2.0, centre + extent / 2.0, track.class_name,
                                               track.seen.viewpoint(), self._walls)
             if self._floor_mapped:
@@ -680,17 +643,6 @@ class ForegroundStage:
             return ok, z, depth[vi, ui]
 
         return project
-
-    def _hidden(self, frame: Frame) -> Any:
-        """A function telling, per map point, whether it is in the camera's view and whether
-        something measured nearer (``HIDDEN_MARGIN_M``) hides it."""
-        project = self._projector(frame)
-
-        def hidden(points_map: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-            ok, z, measured = project(points_map)
-            return ok, np.asarray(ok & (measured > 0) & (measured < z - HIDDEN_MARGIN_M))
-
-        return hidden
 
     def _visibility(self, frame: Frame) -> Any:
         """A function telling which map points the camera sees now (in image, not occluded)."""
@@ -755,6 +707,25 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
     out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
     out[:, ROW_POSITION] = box.center_m
     return out.tolist()
+
+
+def _grown(box: Box3D, tall: bool) -> Box3D:
+    """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
+    its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
+    background saw)."""
+    extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
+    if tall:
+        extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
+    return Box3D(box.center_m, extent, box.R)
+
+
+def _solid_instance(part: SolidPart) -> Instance:
+    """The ``unknown`` instance of a geometry-only object: static, at rest at its box's centre."""
+    rows = [[stamp_s, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0] for stamp_s in (part.first_seen_s, part.last_seen_s)]
+    return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
+                    last_seen_s=part.last_seen_s, confidence=part.seen_share,
+                    observation_uuids=part.observation_uuids,
+                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True})
 
 
 def _wall_boxes(world: World) -> list[Box3D]:

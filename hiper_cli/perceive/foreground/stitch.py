@@ -42,6 +42,31 @@ if TYPE_CHECKING:
 __all__ = ["DUPLICATE", "RESUME", "REVISIT", "absorb", "common_distance_m", "find_target", "footprint_share",
            "gap_ok", "provisional_class", "stale_rows"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+STITCH_MAX_GAP_S: float = 3.0
+"""... a walker's new track starting at most this long after one of the old one's rows ..."""
+STITCH_SPEED_MPS: float = 1.5
+STITCH_MARGIN_M: float = 0.5
+"""... within ``stitch_margin_m`` plus this speed times the gap of that row's position ..."""
+STITCH_PACE_FACTOR: float = 1.5
+STITCH_MIN_PACE_MPS: float = 0.6
+"""... where the speed is the old walker's own pace, at most this factor times its median
+speed (at least ``stitch_min_pace_mps``, at most ``stitch_speed_mps``): a person who walked
+at 0.6 m/s did not cover 5 m in 3 s, another person came into view (0: any walker may go
+``stitch_speed_mps``) ..."""
+STITCH_APPEARANCE_GAP_S: float = 60.0
+STITCH_MIN_SIMILARITY: float = 0.8
+"""... or after a longer gap, up to ``stitch_appearance_gap_s``, with colour histograms
+(Bhattacharyya coefficient) at least this similar: one person's tracks 0.92-1.0 and two
+people's 0.46-0.55 on the realistic worlds ..."""
+STITCH_DUPLICATE_M: float = 0.4
+"""... or, tracked at the same time, within this of it (median, horizontal) ..."""
+STITCH_OVERLAP_M: float = 0.3
+"""... and a static track whose box's footprint overlaps the other's, at most this far
+apart vertically (a chair's back over a table, its seat under it) ..."""
+STITCH_MIN_OVERLAP: float = 0.5
+"""... by this share of the smaller footprint (of the larger when one is ``unknown``)."""
+
 FloatArray = NDArray[np.float64]
 RESUME, DUPLICATE, REVISIT = "resume", "duplicate", "revisit"
 STAMP_MATCH_S = 1e-6  # two trajectory rows of one frame share its stamp
@@ -102,28 +127,28 @@ def _walker_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
         # Any of the old track's rows of the last stitch_max_gap_s may be where the walker
         # was last: a lost track's last rows are often junk blobs it took while searching.
         gap_s, dist, reach, _ = _resume_geometry(new, old, config)
-        near = gap_s <= config.stitch_max_gap_s
-        paced = config.stitch_margin_m + _pace_mps(old, config) * np.maximum(gap_s, 0.0)
+        near = gap_s <= STITCH_MAX_GAP_S
+        paced = STITCH_MARGIN_M + _pace_mps(old, config) * np.maximum(gap_s, 0.0)
         if near.any() and (ratio := float((dist[near] / paced[near]).min())) <= 1.0:
             return ratio, RESUME
         # Lost for longer: the same clothes, and reachable walking from where it was.
         similar = _similarity(new, old)
         if (
-            similar >= config.stitch_min_similarity
-            and gap_s[-1] <= config.stitch_appearance_gap_s
+            similar >= STITCH_MIN_SIMILARITY
+            and gap_s[-1] <= STITCH_APPEARANCE_GAP_S
             and bool(np.any(dist <= reach))
         ):
             return 1.0 + (1.0 - similar), RESUME
         return None
     apart_m = common_distance_m(new.trajectory, old.trajectory, config.confirm_hits)
-    if apart_m is not None and apart_m <= config.stitch_duplicate_m:
-        return apart_m / config.stitch_duplicate_m, DUPLICATE
+    if apart_m is not None and apart_m <= STITCH_DUPLICATE_M:
+        return apart_m / STITCH_DUPLICATE_M, DUPLICATE
     if old.last_update_s - new.first_seen_s <= HANDOVER_MAX_S:
         # A handover: the old track took the walker once or twice more after the new one
         # started, too few common stamps for a duplicate; the new one goes on as the walker.
         apart_m = common_distance_m(new.trajectory, old.trajectory, 1)
-        if apart_m is not None and apart_m <= config.stitch_duplicate_m:
-            return apart_m / config.stitch_duplicate_m, RESUME
+        if apart_m is not None and apart_m <= STITCH_DUPLICATE_M:
+            return apart_m / STITCH_DUPLICATE_M, RESUME
     return None
 
 
@@ -138,7 +163,7 @@ def _resume_geometry(
     gap_s = new.first_seen_s - rows[:, ROW_STAMP]
     start = np.asarray(new.trajectory[0][ROW_POSITION][:2])
     dist = np.hypot(*(rows[:, 1:3] - start).T)
-    reach = config.stitch_margin_m + config.stitch_speed_mps * np.maximum(gap_s, 0.0)
+    reach = STITCH_MARGIN_M + STITCH_SPEED_MPS * np.maximum(gap_s, 0.0)
     return gap_s, dist, reach, first
 
 
@@ -146,12 +171,12 @@ def _pace_mps(old: Track, config: TrackerConfig) -> float:
     """How fast the old walker may have gone while unseen: ``stitch_pace_factor`` times its
     median speed over the rows a resume looks back on, within [``stitch_min_pace_mps``,
     ``stitch_speed_mps``]; ``stitch_speed_mps`` when the factor is 0."""
-    if config.stitch_pace_factor <= 0:
-        return config.stitch_speed_mps
+    if STITCH_PACE_FACTOR <= 0:
+        return STITCH_SPEED_MPS
     rows = np.asarray(old.trajectory[-MAX_RESUME_ROWS:], dtype=np.float64)
     speed = float(np.median(np.hypot(*rows[:, ROW_VELOCITY][:, :2].T)))
-    pace = config.stitch_pace_factor * speed
-    return float(min(max(pace, config.stitch_min_pace_mps), config.stitch_speed_mps))
+    pace = STITCH_PACE_FACTOR * speed
+    return float(min(max(pace, STITCH_MIN_PACE_MPS), STITCH_SPEED_MPS))
 
 
 def stale_rows(new: Track, old: Track, config: TrackerConfig) -> int:
@@ -202,9 +227,9 @@ def _static_match(new: Track, old: Track, config: TrackerConfig) -> tuple[float,
     c_new, e_new = box_new if box_new is not None else (new.position, new.extent_m)
     c_old, e_old = box_old if box_old is not None else (old.position, old.extent_m)
     share = footprint_share((c_new - e_new / 2.0, c_new + e_new / 2.0),
-                            (c_old - e_old / 2.0, c_old + e_old / 2.0), max_gap_m=config.stitch_overlap_m,
+                            (c_old - e_old / 2.0, c_old + e_old / 2.0), max_gap_m=STITCH_OVERLAP_M,
                             larger=UNKNOWN in (provisional_class(new), provisional_class(old)))
-    if share < config.stitch_min_overlap:
+    if share < STITCH_MIN_OVERLAP:
         return None
     return 1.0 - share, REVISIT
 
@@ -280,4 +305,4 @@ def gap_ok(old: Track, now_s: float, config: TrackerConfig) -> bool:
     where it was), a walker within ``stitch_appearance_gap_s``."""
     if old.class_name not in config.walker_classes:
         return True
-    return now_s - old.last_update_s <= max(config.stitch_max_gap_s, config.stitch_appearance_gap_s)
+    return now_s - old.last_update_s <= max(STITCH_MAX_GAP_S, STITCH_APPEARANCE_GAP_S)

@@ -26,13 +26,43 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.model import Box3D, point_bounds
+from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.config import RefineConfig, SegmentConfig
-from hiper_cli.perceive.foreground.legs import leg_points, standing_on
+from hiper_cli.perceive.foreground.legs import (
+    TABLE_LEG_ABOVE_M,
+    TABLE_LEG_CELL_M,
+    TABLE_LEG_REACH_M,
+    leg_points,
+    standing_on,
+)
 from hiper_cli.perceive.foreground.match import iou_matrix
+from hiper_cli.perceive.foreground.refine import TRIM_IOU
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
 __all__ = ["drop_unseen_tables", "one_board", "split_unseen_tables", "table_points", "unseen_table_top"]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+UNSEEN_TABLE_MIN_SIDE_M: float = 0.3
+"""A table the background layer has not mapped yet (its top seen at a grazing angle in the
+first seconds) merges the chairs around it into one blob. When such a blob overlaps a
+detection (IoU >= ``trim_iou``) and holds a horizontal slab between
+``unseen_table_min_height_m`` and ``unseen_table_max_height_m`` whose footprint spans this
+much along both map axes, the slab and its legs leave the blob and the rest is clustered
+again (``legs.py``, ``refine.py``; 0: off) ..."""
+UNSEEN_TABLE_MIN_HEIGHT_M: float = 0.6
+UNSEEN_TABLE_MAX_HEIGHT_M: float = 1.2
+UNSEEN_TABLE_SKIP_CLASSES: tuple[str, ...] = ("couch", "bed", "dining table", "toilet")
+"""... except in blobs matched to these detector classes: furniture with tops of its own (a
+couch's arms and back are such a slab) ..."""
+UNSEEN_TABLE_LOOKALIKES: tuple[str, ...] = ("bench",)
+"""... A detection of these classes (no top at table height: a bench's seat lies below it)
+whose blob holds a table top named the table, and names nothing else in that frame
+(YOLOX-Nano names a table with things on it ``bench``) ..."""
+UNSEEN_TABLE_HOLDING: float = 0.8
+"""... and also in a blob that no detection names but that holds a detected object: a
+detection box (not of those classes) lies at least this share inside the blob's image box
+(a bottle or a cup standing on a table the background has not mapped, a bedside table seen
+only from a doorway, joins the table's blob, and no detection names that blob; 0: off)."""
 
 FloatArray = NDArray[np.float64]
 SLAB_BIN_M = 0.02  # height bins of the search for a table top
@@ -57,11 +87,11 @@ def unseen_table_top(points_map: FloatArray, config: SegmentConfig) -> Box3D | N
     if len(points_map) < config.min_cluster_points:
         return None
     z = points_map[:, 2]
-    at_height = (z >= config.unseen_table_min_height_m) & (z <= config.unseen_table_max_height_m)
+    at_height = (z >= UNSEEN_TABLE_MIN_HEIGHT_M) & (z <= UNSEEN_TABLE_MAX_HEIGHT_M)
     if np.count_nonzero(at_height) < config.min_cluster_points:
         return None  # too few points at table height, whichever columns end there
-    reach = 2 * SLAB_BIN_M + config.table_leg_above_m
-    ending = _column_tops(points_map, config.table_leg_cell_m) <= z + reach
+    reach = 2 * SLAB_BIN_M + TABLE_LEG_ABOVE_M
+    ending = _column_tops(points_map, TABLE_LEG_CELL_M) <= z + reach
     sel = np.flatnonzero(at_height & ending)
     if len(sel) < config.min_cluster_points:
         return None
@@ -70,7 +100,7 @@ def unseen_table_top(points_map: FloatArray, config: SegmentConfig) -> Box3D | N
     slab = sel[np.abs(z[sel] - mode) <= SLAB_BIN_M]
     if len(slab) < config.min_cluster_points:
         return None
-    if _minor_extent_m(points_map[slab, :2]) < config.unseen_table_min_side_m:
+    if _minor_extent_m(points_map[slab, :2]) < UNSEEN_TABLE_MIN_SIDE_M:
         return None
     lo, hi = np.percentile(points_map[slab, :2], [5, 95], axis=0)
     top = float(np.median(z[slab]))
@@ -94,11 +124,11 @@ def _top_points(points_map: FloatArray, top: Box3D, config: SegmentConfig) -> ND
     """Which points (N, 3) are the table's top: within its footprint grown by
     ``table_leg_reach_m``, two slab bins of its top height, in columns that end there."""
     lo, hi = top.aabb()
-    reach = 2 * SLAB_BIN_M + config.table_leg_above_m
-    ending = _column_tops(points_map, config.table_leg_cell_m) <= hi[2] + reach
+    reach = 2 * SLAB_BIN_M + TABLE_LEG_ABOVE_M
+    ending = _column_tops(points_map, TABLE_LEG_CELL_M) <= hi[2] + reach
     return np.asarray(
-        np.all(points_map[:, :2] >= lo[:2] - config.table_leg_reach_m, axis=1)
-        & np.all(points_map[:, :2] <= hi[:2] + config.table_leg_reach_m, axis=1)
+        np.all(points_map[:, :2] >= lo[:2] - TABLE_LEG_REACH_M, axis=1)
+        & np.all(points_map[:, :2] <= hi[:2] + TABLE_LEG_REACH_M, axis=1)
         & (np.abs(points_map[:, 2] - hi[2]) <= 2 * SLAB_BIN_M) & ending
     )
 
@@ -121,7 +151,7 @@ def one_board(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
     largest = on_top[max(parts, key=len)]
     if len(largest) < config.min_cluster_points:
         return False
-    return _minor_extent_m(blob.points_map[largest, :2]) >= config.unseen_table_min_side_m
+    return _minor_extent_m(blob.points_map[largest, :2]) >= UNSEEN_TABLE_MIN_SIDE_M
 
 
 def drop_unseen_tables(
@@ -143,7 +173,7 @@ def split_unseen_tables(
     are this frame's detections."""
     tables: list[Blob] = []
     lookalikes: list[int] = []
-    if config.unseen_table_min_side_m <= 0 or not blobs:
+    if UNSEEN_TABLE_MIN_SIDE_M <= 0 or not blobs:
         return blobs, tables, lookalikes
     boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0:
@@ -156,24 +186,23 @@ def split_unseen_tables(
         top = None
         if not blob.fragment:
             k = int(np.argmax(iou))
-            named = iou[k] >= config.trim_iou
-            if (named and classes[k] not in config.unseen_table_skip_classes) or (not named and holds):
+            named = iou[k] >= TRIM_IOU
+            if (named and classes[k] not in UNSEEN_TABLE_SKIP_CLASSES) or (not named and holds):
                 top = unseen_table_top(blob.points_map, config)
                 if top is not None and not one_board(blob, top, config):
                     top = None
         if top is None:
             out.append(blob)
             continue
-        lookalikes.extend(j for j in np.flatnonzero(iou >= config.trim_iou).tolist()
-                          if classes[j] in config.unseen_table_lookalikes)
+        lookalikes.extend(j for j in np.flatnonzero(iou >= TRIM_IOU).tolist()
+                          if classes[j] in UNSEEN_TABLE_LOOKALIKES)
         on_table = table_points(blob.points_map, top, config)
         if np.count_nonzero(on_table) >= config.min_cluster_points:
             tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
-        table_box = point_bounds(blob.points_map[on_table]) if on_table.any() else None
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
-                out.append(_part(blob, rest[part], top, table_box, config, width, height))
+                out.append(_part(blob, rest[part], top, config, width, height))
     return out, tables, lookalikes
 
 
@@ -182,24 +211,23 @@ def _held(
 ) -> NDArray[np.bool_]:
     """Per blob, whether a detection box (not of ``unseen_table_skip_classes``) lies at least
     ``unseen_table_holding`` inside its image box: an object in or on it (0: never)."""
-    if config.unseen_table_holding <= 0:
+    if UNSEEN_TABLE_HOLDING <= 0:
         return np.zeros(len(blob_boxes), dtype=bool)
-    usable = np.array([c not in config.unseen_table_skip_classes for c in classes], dtype=bool)
+    usable = np.array([c not in UNSEEN_TABLE_SKIP_CLASSES for c in classes], dtype=bool)
     lo = np.maximum(blob_boxes[:, None, :2], boxes[None, :, :2])
     hi = np.minimum(blob_boxes[:, None, 2:], boxes[None, :, 2:])
     inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
     area = np.prod(np.clip(boxes[:, 2:] - boxes[:, :2], 0.0, None), axis=1)
-    inside = inter >= config.unseen_table_holding * np.maximum(area, 1e-9)[None, :]
+    inside = inter >= UNSEEN_TABLE_HOLDING * np.maximum(area, 1e-9)[None, :]
     return np.asarray((inside & usable[None, :]).any(axis=1))
 
 
 def _part(
-    blob: Blob, sel: NDArray[np.int64], top: Box3D, table_box: tuple[FloatArray, FloatArray] | None,
+    blob: Blob, sel: NDArray[np.int64], top: Box3D,
     config: SegmentConfig, width: int, height: int,
 ) -> Blob:
     """A part of ``blob`` as a blob of its own, standing on the table top, on the floor below the
-    blob (as the segmentation found it), or on nothing known; cut from the table in ``table_box``."""
+    blob (as the segmentation found it), or on nothing known."""
     part = sub_blob(blob, sel, config.pixel_step, width, height)
     part.support_z_m = standing_on(part, [float(top.aabb()[1][2]), blob.support_z_m], config)
-    part.cut_from_table_m = table_box
     return part

@@ -2,7 +2,7 @@
 class votes, its trajectory), a ``Measurement`` (one observed blob) and a ``ClassPrior``.
 
 The data the tracker's parts share (``tracking.py`` runs them; ``class_vote``, ``moving``,
-``same_object``, ``stitch``, ``split_parts`` and ``smoother`` read and change a ``Track``); it
+``same_object``, ``stitch`` and ``smoother`` read and change a ``Track``); it
 imports none of them but the class vote, so that the parts import it, not the tracker.
 """
 
@@ -76,9 +76,6 @@ class Measurement:
     counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
-    cut_from_table_m: tuple[FloatArray, FloatArray] | None = None
-    """(lower, upper) corners of the table found in the blob this one was cut from
-    (``Blob.cut_from_table_m``; ``split_parts``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:

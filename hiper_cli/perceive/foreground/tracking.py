@@ -56,7 +56,8 @@ from hiper_cli.perceive.foreground.association import get_association
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN, record
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, make_motion_model
-from hiper_cli.perceive.foreground.moving import is_static, note_travel, was_moving
+from hiper_cli.perceive.foreground.moving import MOVING_SPEED_MPS, is_static, note_travel, was_moving
+from hiper_cli.perceive.foreground.plausible import CLASS_SIZE_TOLERANCE
 from hiper_cli.perceive.foreground.same_object import (
     STAMP_DECIMALS,
     due,
@@ -66,7 +67,6 @@ from hiper_cli.perceive.foreground.same_object import (
     static_together,
 )
 from hiper_cli.perceive.foreground.smoother import smooth_trajectory
-from hiper_cli.perceive.foreground.split_parts import held_tables, last_box
 from hiper_cli.perceive.foreground.stitch import (
     DUPLICATE,
     RESUME,
@@ -80,6 +80,108 @@ from hiper_cli.perceive.foreground.stitch import (
 from hiper_cli.perceive.foreground.track import ClassPrior, Measurement, NamedBlob, Track
 
 __all__ = ["ClassPrior", "Measurement", "Track", "Tracker", "object_box"]  # the first three: ``track.py``
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+UNKNOWN_MIN_SPAN_S: float = 0.5
+"""... seen over at least this long (what shows in a few frames is not a lasting object) ..."""
+UNKNOWN_MIN_WHOLE_SHARE: float = 0.5
+"""... and making at least this share of its observations (a track that mostly took pieces of
+something larger, cut by the border, is that larger thing)."""
+UNKNOWN_EVIDENCE_HELD: bool = True
+"""The evidence must hold for the class an instance carries, all its life (checked at every
+update and when the track closes): detections count once they give the track its class, or
+while they name most of its observations (a person is named from its first view; a track
+that ends so without a class must have lasted ``unknown_min_span_s``); otherwise the whole
+evidence above, over all of its observations so far (a track confirmed on a few named
+views that then takes pieces of structure cut by the image border is that structure). A
+track that loses its evidence is withdrawn (``Tracker.withdrawn``): its instance is
+deleted, and comes back with the evidence. False: evidence is checked once, while the
+track is tentative, and ``min_class_observations`` detections count without a class."""
+GATE_SIGMAS: float = 4.0
+MIN_GATE_M: float = 0.5
+"""... and a settled track gates at gate_sigmas times its predicted position σ, at least
+min_gate_m (a chair does not take the bottle on the table beside it)."""
+REFUSED_MAX_SHARE: float = 0.0
+CLASS_MISMATCH_M: float = 0.5
+"""Association cost added (inside the gate) when a track and an observation have
+different known classes: same-class pairs win, a confused detection still joins."""
+GATE_MARGIN_M: float = 0.15
+"""Added to the learned c_u·dt gate (position noise of two measurements)."""
+TENTATIVE_MAX_AGE_S: float = 0.3
+"""A tentative (unconfirmed) track without an update for this long is dropped."""
+LOST_MAX_S: float = 20.0
+"""A track unseen for this long is closed even while out of view."""
+TENTATIVE_LOST_MAX_S: float = 2.0
+"""A tentative track unseen for this long is dropped even while out of view."""
+SEARCH_SPEED_MPS: float = 0.6
+"""The gate of an unseen track that was moving widens by this much per second unseen ..."""
+MAX_GATE_M: float = 3.0
+"""... up to this."""
+SEARCH_CLASSES: tuple[str, ...] = ("person", "unknown")
+"""Classes whose lost tracks search (widen their gate while unseen) when they were moving:
+the centre of a bed's or couch's blob slides as the view changes, which looks like motion."""
+SEARCH_SAME_CLASS: tuple[str, ...] = ("person",)
+"""Beyond its normal gate a searching track of these classes only takes an observation of
+its own class: a lost person track otherwise took a chair or junk blob metres away."""
+SEARCH_MIN_SIZE_RATIO: float = 0.5
+"""... or an ``unknown`` one at least this share of the track's largest blob (a person coming
+back cut by the image border, unmatched; 0.75 split the fixture's person; above 1: never) ..."""
+SEARCH_UNKNOWN_MAX_S: float = 3.0
+"""... and that only within this long of its last update: a person comes back through the
+border soon after leaving it, while after longer only a detection says a blob is the person,
+inside the normal gate too (a track lost for 13 s took a 1.5 m wall and ceiling corner 3 m
+away; one lost for 11 s, another person's unnamed blob 0.9 m away) ..."""
+SEARCH_MAX_FOOTPRINT_M: float = 1.2
+"""... and no wider than this seen from above (the diagonal of its box's footprint): a
+person is about a metre across at most; a lost person's track took a couch's blob, 1.0 by
+1.7 m, and kept it while the person went on as a new track."""
+VELOCITY_DECAY_S: float = 0.5
+"""Time constant of the exponential decay of a track's velocity while it gets no updates."""
+VELOCITY_PRIOR_MPS: float = 1.0
+"""While the velocity decays, its uncertainty relaxes towards this (walking speeds), so a
+track picked up again learns its new velocity at once ..."""
+VELOCITY_RELAX_STATIC: bool = False
+"""... also for tracks of classes that do not search (``search_classes``), if true. False:
+a chair's or a cup's only decays, and its gate does not grow to ``gate_m`` within half a
+second unseen (else the piece of a chair leaving the view can take the cup on the table
+0.85 m away)."""
+VELOCITY_DECAY_GRACE_S: float = 0.1
+"""No decay for this long after the last update (a missed detection must not slow a walker)."""
+WALKER_ACCEL_NOISE_MPS2: float = 2.0
+"""... and for tracks of a class in ``walker_classes``: people start, stop and turn sharply
+(the simulated ones turn at up to 3 rad/s, 2.7 m/s² at 0.9 m/s); with 1.0 the filter lagged
+and the smoother cut the corners: speeds biased low."""
+VERTICAL_NOISE_RATIO: float = 0.3
+"""Vertical process noise relative to horizontal (objects mostly move on the floor)."""
+PRIOR_ACCEL_TIME_S: float = 0.5
+"""With a learned speed spread sigma, the acceleration noise is sigma / this time."""
+WALKER_MIN_SIZE_RATIO: float = 0.2
+"""A track of a walker class does not take a blob smaller than this share of the largest
+blob it took (size: the larger of footprint diagonal and height): a 20-point junk blob or a
+cup is not the person who just left the view (0: off)."""
+WALKER_LEVEL: bool = True
+"""Tracks of a walker class (or, before a track has a class, observations of one) have no
+vertical velocity: people walk on the floor, so their centre is half their height up (a high
+quantile of their blobs' tops) and is never extrapolated (issue 17: person boxes below the
+floor, and 0.7 m low from the mean of partial blobs)."""
+SETTLED_HITS: int = 15
+"""A track not of a walker class, with at least this many observations and not moving (a
+named one: its blobs stayed where they were, ``SeenBox.moved``; an ``unknown`` one: its
+filter, ``moving_speed_mps``), is settled: it only takes an observation whose box overlaps the
+box of its blobs (``SeenBox``; the filter's centre drifts as partial views come and go: a
+TV's track took a wall sliver 0.7 m away) grown by ``settled_overlap_m``. Something that
+stood still is where it stood: the 2 cm
+sliver of a door frame must not take the person walking past it half a metre away, and
+turn its standing rows into the person's (0: off) ..."""
+SETTLED_OVERLAP_M: float = 0.05
+STITCH_STATIC_AGAIN: bool = True
+"""A confirmed track of any class is offered to stitching again each time its observations
+double (not only walkers), either way round (the older track keeps its instance), and a
+pair of static tracks is judged static on the boxes of their blobs together
+(``same_object.py``): a track's box is young when it is confirmed, and a track that saw only
+part of a large object seems to move on its own (false: offered once, at confirmation)."""
+SMOOTH_CLOSED_TRACKS: bool = True
+"""Refine a closed track's trajectory with a Rauch-Tung-Striebel smoother."""
 
 FloatArray = NDArray[np.float64]
 
@@ -188,9 +290,9 @@ class Tracker:
     def _accel_noise(self, class_name: str) -> float:
         prior = self.priors(class_name)
         if self.config.use_learned_priors and prior.sigma_mps is not None:
-            return max(float(prior.sigma_mps), MIN_PRIOR_SIGMA_MPS) / self.config.prior_accel_time_s
+            return max(float(prior.sigma_mps), MIN_PRIOR_SIGMA_MPS) / PRIOR_ACCEL_TIME_S
         if class_name in self.config.walker_classes:
-            return self.config.walker_accel_noise_mps2
+            return WALKER_ACCEL_NOISE_MPS2
         return self.config.accel_noise_mps2
 
     def _predict(self, track: Track, stamp_s: float) -> None:
@@ -204,7 +306,7 @@ class Tracker:
     def _walks(self, track: Track, m: Measurement | None = None) -> bool:
         """Whether ``track`` is held level (``walker_level``): its class walks, or, while it has
         none yet, this observation's does."""
-        if not self.config.walker_level:
+        if not WALKER_LEVEL:
             return False
         name = track.class_name
         if name == UNKNOWN and m is not None:
@@ -212,7 +314,7 @@ class Tracker:
         return name in self.config.walker_classes
 
     def _vertical_noise(self, track: Track, q: float) -> float:
-        return 0.0 if self._walks(track) else q * self.config.vertical_noise_ratio**2
+        return 0.0 if self._walks(track) else q * VERTICAL_NOISE_RATIO**2
 
     def _hold_level(self, track: Track) -> None:
         """No vertical velocity: people walk on the floor, so a walker's centre is half its
@@ -246,13 +348,13 @@ class Tracker:
         """
         # At 4 Hz one frame (0.25 s) is longer than velocity_decay_grace_s: without the frame
         # term every single miss would decay and unsettle the velocity.
-        grace = max(self.config.velocity_decay_grace_s, DECAY_GRACE_FRAMES * dt)
+        grace = max(VELOCITY_DECAY_GRACE_S, DECAY_GRACE_FRAMES * dt)
         if stamp_s - track.last_update_s <= grace or dt <= 0:
             return
-        relaxes = self.config.velocity_relax_static or track.search_class in self.config.search_classes
-        prior = self.config.velocity_prior_mps**2 if relaxes else 0.0
+        relaxes = VELOCITY_RELAX_STATIC or track.search_class in SEARCH_CLASSES
+        prior = VELOCITY_PRIOR_MPS**2 if relaxes else 0.0
         factor, scale, relax = _decay_terms(
-            dt, self.config.velocity_decay_s, prior, self.config.vertical_noise_ratio**2
+            dt, VELOCITY_DECAY_S, prior, VERTICAL_NOISE_RATIO**2
         )
         track.motion.decay_velocity(factor, scale, relax)
 
@@ -293,7 +395,7 @@ class Tracker:
         evidence no longer holds (``unknown_evidence_held``: listed in ``withdrawn``)."""
         if not track.confirmed:
             track.confirmed = not closing and self._evidence_enough(track)
-        elif self.config.unknown_evidence_held and not self._evidence_enough(track, closing):
+        elif UNKNOWN_EVIDENCE_HELD and not self._evidence_enough(track, closing):
             track.confirmed = False
             self.withdrawn.append(track.uuid)
 
@@ -311,10 +413,10 @@ class Tracker:
         if cfg.unknown_confirm_whole <= 0:
             return True
         named = sum(n for k, n in track.class_counts.items() if k != UNKNOWN)
-        if cfg.unknown_evidence_held:
+        if UNKNOWN_EVIDENCE_HELD:
             if track.class_name != UNKNOWN:
                 return True  # detections gave it its class
-            lasted = track.last_update_s - track.first_seen_s >= cfg.unknown_min_span_s
+            lasted = track.last_update_s - track.first_seen_s >= UNKNOWN_MIN_SPAN_S
             if named >= cfg.min_class_share * track.hits and (lasted or not closing):
                 return True  # detections name it most of the time
         elif named >= cfg.min_class_observations or named >= cfg.min_class_share * track.hits:
@@ -322,8 +424,8 @@ class Tracker:
         stamps = track.whole_stamps_s
         return (
             len(stamps) >= cfg.unknown_confirm_whole
-            and stamps[-1] - stamps[0] >= cfg.unknown_min_span_s
-            and len(stamps) >= cfg.unknown_min_whole_share * (track.hits - track.unsure_views)
+            and stamps[-1] - stamps[0] >= UNKNOWN_MIN_SPAN_S
+            and len(stamps) >= UNKNOWN_MIN_WHOLE_SHARE * (track.hits - track.unsure_views)
         )
 
     def _vote(self, track: Track, m: Measurement) -> None:
@@ -359,31 +461,31 @@ class Tracker:
         if cfg.use_learned_priors and prior.cu_mps is not None and 0 < dt < 1.0:
             # The paper rejects pairs beyond c_u · dt: a bound on the gate, never a widening
             # (a bottle's c_u comes from its noisiest rows; as a gate it joined two bottles).
-            learned = float(prior.cu_mps) * dt + cfg.gate_margin_m
+            learned = float(prior.cu_mps) * dt + GATE_MARGIN_M
             return min(base, learned), min(gate, learned)
         return base, gate
 
     def _own_gate(self, track: Track, dt: float, variance_m2: float | None) -> tuple[float, float]:
         """(base gate, gate) from the track's filter and search state alone."""
         cfg = self.config
-        searching = track.search_class in cfg.search_classes and was_moving(track, cfg)
-        unseen_s = max(dt - cfg.velocity_decay_grace_s, 0.0) if searching else 0.0
+        searching = track.search_class in SEARCH_CLASSES and was_moving(track, cfg)
+        unseen_s = max(dt - VELOCITY_DECAY_GRACE_S, 0.0) if searching else 0.0
         # The filter's own uncertainty: a settled track (a chair) gets a tight gate, a young
         # or fast-changing one up to gate_m.
         if variance_m2 is None:
             variance_m2 = float(np.linalg.eigvalsh(track.motion.P[:3, :3]).max())
         sigma = math.sqrt(variance_m2 + cfg.measurement_noise_m**2)
-        base = min(max(cfg.gate_sigmas * sigma, cfg.min_gate_m), cfg.gate_m)
-        return base, min(base + cfg.search_speed_mps * unseen_s, cfg.max_gate_m)
+        base = min(max(GATE_SIGMAS * sigma, MIN_GATE_M), cfg.gate_m)
+        return base, min(base + SEARCH_SPEED_MPS * unseen_s, MAX_GATE_M)
 
     def _settled(self, track: Track) -> bool:
         """Whether a track stood still long enough to be known where it is (``settled_hits``)."""
         cfg = self.config
-        if cfg.settled_hits <= 0 or track.hits < cfg.settled_hits or track.class_name in cfg.walker_classes:
+        if SETTLED_HITS <= 0 or track.hits < SETTLED_HITS or track.class_name in cfg.walker_classes:
             return False
         if track.class_name != UNKNOWN:  # where its blobs were, not where partial views move its filter
             return is_static(track, cfg)
-        return not was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= cfg.moving_speed_mps
+        return not was_moving(track, cfg) and math.hypot(*track.velocity[:2]) <= MOVING_SPEED_MPS
 
     def associate(self, measurements: Sequence[Measurement], stamp_s: float) -> list[tuple[int, int]]:
         """(track index, measurement index) pairs of the gated assignment (``association``)."""
@@ -394,7 +496,7 @@ class Tracker:
         cost = np.linalg.norm(pred[:, None, :] - obs[None, :, :], axis=2)
         settled = [self._settled(t) for t in self.tracks]
         for k in np.flatnonzero(settled):  # a filter that left the box of its blobs: the box's middle
-            seen, margin = self.tracks[k].seen.corners(), self.config.settled_overlap_m
+            seen, margin = self.tracks[k].seen.corners(), SETTLED_OVERLAP_M
             if seen is not None and not np.all((seen[0] - margin <= pred[k]) & (pred[k] <= seen[1] + margin)):
                 cost[k] = np.linalg.norm((seen[0] + seen[1]) / 2.0 - obs, axis=1)
         walking = np.array([self._walks(t) for t in self.tracks])
@@ -411,7 +513,7 @@ class Tracker:
         searched = cost > gates[:, 0:1]
         cfg = self.config
         # lost: more than one frame missed (picked up again after one miss, the gap is 2 frames)
-        grace = max(cfg.velocity_decay_grace_s, LOST_AFTER_FRAMES * self._frame_dt_s)
+        grace = max(VELOCITY_DECAY_GRACE_S, LOST_AFTER_FRAMES * self._frame_dt_s)
         classes = np.array([m.class_name for m in measurements], dtype=object)
         unknown = classes == UNKNOWN
         sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
@@ -424,24 +526,21 @@ class Tracker:
             if settled[i]:
                 # where its blobs were (``SeenBox``), not where a drifting filter puts it
                 lo, hi = t.seen.corners() or (t.position - t.extent_m / 2.0, t.position + t.extent_m / 2.0)
-                near = np.all(obs - half_extents <= hi + cfg.settled_overlap_m, axis=1)
-                allowed[i] &= near & np.all(obs + half_extents >= lo - cfg.settled_overlap_m, axis=1)
+                near = np.all(obs - half_extents <= hi + SETTLED_OVERLAP_M, axis=1)
+                allowed[i] &= near & np.all(obs + half_extents >= lo - SETTLED_OVERLAP_M, axis=1)
             if cls != UNKNOWN:  # two different known classes cost more; unknown is neutral
-                cost[i, ~unknown & (classes != cls)] += cfg.class_mismatch_m
+                cost[i, ~unknown & (classes != cls)] += CLASS_MISMATCH_M
             if cls in cfg.walker_classes:
-                allowed[i] &= (sizes >= cfg.walker_min_size_ratio * t.max_size_m) & solid
-            if cls in cfg.search_same_class and stamp_s - t.last_update_s > grace:
+                allowed[i] &= (sizes >= WALKER_MIN_SIZE_RATIO * t.max_size_m) & solid
+            if cls in SEARCH_SAME_CLASS and stamp_s - t.last_update_s > grace:
                 # Lost and searching: another class only when it is an unmatched blob as big as
                 # the person (the person cut by the border).
-                person_sized = unknown & (sizes >= cfg.search_min_size_ratio * t.max_size_m)
-                person_sized &= footprints <= cfg.search_max_footprint_m
-                person_sized &= stamp_s - t.last_update_s <= cfg.search_unknown_max_s
+                person_sized = unknown & (sizes >= SEARCH_MIN_SIZE_RATIO * t.max_size_m)
+                person_sized &= footprints <= SEARCH_MAX_FOOTPRINT_M
+                person_sized &= stamp_s - t.last_update_s <= SEARCH_UNKNOWN_MAX_S
                 # past that, also inside the base gate its filter's uncertainty grew to
-                judged = searched[i] | (stamp_s - t.last_update_s > cfg.search_unknown_max_s)
+                judged = searched[i] | (stamp_s - t.last_update_s > SEARCH_UNKNOWN_MAX_S)
                 allowed[i] &= ~(judged & (classes != cls) & ~person_sized)
-        cut = [m.cut_from_table_m for m in measurements]
-        if any(box is not None for box in cut):  # not the unnamed track of the blob it was cut from
-            allowed &= ~held_tables([last_box(t) for t in self.tracks], cut)
         return self._assign(cost, allowed)
 
     # --- one step ---------------------------------------------------------------------------
@@ -489,8 +588,8 @@ class Tracker:
                 if in_view:
                     track.unseen_in_view_s += dt_frame
                 limit, lost = (
-                    (cfg.max_age_s, cfg.lost_max_s) if track.confirmed
-                    else (cfg.tentative_max_age_s, cfg.tentative_lost_max_s)
+                    (cfg.max_age_s, LOST_MAX_S) if track.confirmed
+                    else (TENTATIVE_MAX_AGE_S, TENTATIVE_LOST_MAX_S)
                 )
                 if track.unseen_in_view_s > limit or stamp_s - track.last_update_s > lost:
                     track.closed = True
@@ -518,7 +617,7 @@ class Tracker:
         self.absorbed = []
         cfg = self.config
         fresh = [
-            t for t in self.tracks if t.confirmed and due(t, cfg.walker_classes, cfg.stitch_static_again)
+            t for t in self.tracks if t.confirmed and due(t, cfg.walker_classes, STITCH_STATIC_AGAIN)
         ]
         if not fresh:
             return {}
@@ -531,7 +630,7 @@ class Tracker:
         def together(a: Track, b: Track) -> bool:
             return static_together(a, b, cfg, lambda t: was_moving(t, cfg))
 
-        pair = together if cfg.stitch_static_again else None
+        pair = together if STITCH_STATIC_AGAIN else None
         for new in fresh:
             if new.uuid in aliases:  # folded into an older track earlier in this loop
                 continue
@@ -578,22 +677,22 @@ class Tracker:
         a walker (``stitch.gap_ok`` drops it later)."""
         if not self.config.stitch:
             return
-        if self.config.stitch_static_again or track.class_name in self.config.walker_classes or is_static(
+        if STITCH_STATIC_AGAIN or track.class_name in self.config.walker_classes or is_static(
             track, self.config
         ):
             self.dormant.append(track)
 
     def _close(self, track: Track) -> None:
-        if self.config.smooth_closed_tracks:
+        if SMOOTH_CLOSED_TRACKS:
             smooth_trajectory(track)
         level = standing_level(track)
-        if self.config.walker_level and track.class_name in self.config.walker_classes and level is not None:
+        if WALKER_LEVEL and track.class_name in self.config.walker_classes and level is not None:
             for row in track.trajectory:  # a walker stood on the floor all along
                 row[3], row[6] = level[0], 0.0
         track.covariances, track.noises = [], []
 
     def _birth(self, m: Measurement, stamp_s: float) -> Track:
-        walks = self.config.walker_level and m.class_name in self.config.walker_classes
+        walks = WALKER_LEVEL and m.class_name in self.config.walker_classes
         center, extent = m.for_walker() if walks else (m.center_map_m, m.extent_map_m)
         track = Track(
             uuid=new_uuid(),
@@ -605,9 +704,9 @@ class Tracker:
             first_center=np.asarray(center, dtype=np.float64).copy(),
             min_class_observations=self.config.min_class_observations,
             min_class_share=self.config.min_class_share,
-            size_tolerance=self.config.class_size_tolerance if self.config.class_sizes else None,
+            size_tolerance=CLASS_SIZE_TOLERANCE if self.config.class_sizes else None,
             refused_min_views=self.config.refused_min_views,
-            refused_max_share=self.config.refused_max_share,
+            refused_max_share=REFUSED_MAX_SHARE,
         )
         track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
                        m.bottom_hidden, m.class_name)

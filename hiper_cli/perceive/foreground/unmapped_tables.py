@@ -33,6 +33,13 @@ if TYPE_CHECKING:
 
 __all__ = ["TABLE_CLASS", "TABLE_SCORE", "table_match", "withdraw_mapped"]
 
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+UNSEEN_TABLE_INSTANCES: bool = True
+"""A table top found so (and its legs) is an observation of class ``table``, tracked as
+any object (``unmapped_tables.py``): a bedside table or a desk the background layer never
+maps is still a table. It is withdrawn once the background layer maps a table that it
+touches at the height of its top (within ``table_leg_reach_m``)."""
+
 TABLE_CLASS = "table"
 TABLE_SCORE = 1.0  # the geometry says so: a vote as strong as a sure detection's
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.perceive.foreground.background_filter import BACKGROUND_MARGIN_PER_M2
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.segment import Blob
 from hiper_cli.types import CameraIntrinsics
@@ -35,6 +36,23 @@ __all__ = [
     "thickness_m",
     "top_hidden",
 ]
+
+# Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
+UNKNOWN_MAX_EXTENT_M: float = 1.0
+"""An unmatched blob is seen *whole* (``whole.py``: evidence for an ``unknown`` instance)
+only when inside the image (not within one ``pixel_step`` of its edge: a shelf, a wall or a
+floor remnant cut by the border is a piece of something larger), no longer than this ..."""
+UNKNOWN_MIN_THICKNESS_M: float = 0.01
+"""... and not flat: the thinnest spread σ of its points at least this plus
+``background_margin_per_m2`` · depth² (a flat blob is a piece of a wall, a floor or a
+furniture side the background did not claim)."""
+FULL_VIEW_MIN_PX2: float = 1024.0
+"""... where a full view's image box covers at least this many pixels (32 x 32; smaller, a
+detector may miss what it names up close) ..."""
+FULL_VIEW_COVER: float = 0.5
+"""... and a full view counts for every class of a detection lying (this share of its box's
+area) inside the blob's image box, named for the blob or not (``match.named_within``): a
+bottle joined with the cup beside it in one blob was still named a bottle."""
 
 OCCLUDER_MARGIN_M = 0.15  # a surface this much nearer than the blob beside it stands in front
 OCCLUDER_RING_CELLS = 2  # ... within this many samples of the blob's outline
@@ -69,10 +87,10 @@ def seen_whole(
     one may be a whole thing or a part; a plant seen behind a chair is whole elsewhere)."""
     if not inside_image(blob, config.pixel_step, camera):
         return False
-    if float(np.max(blob.extent_map_m)) > config.unknown_max_extent_m:
+    if float(np.max(blob.extent_map_m)) > UNKNOWN_MAX_EXTENT_M:
         return False
     depth = float(np.median(blob.points_cam[:, 2]))
-    flat_m = config.unknown_min_thickness_m + config.background_margin_per_m2 * depth * depth
+    flat_m = UNKNOWN_MIN_THICKNESS_M + BACKGROUND_MARGIN_PER_M2 * depth * depth
     if thickness_m(blob.points_cam) < flat_m:
         return False
     if view is not None and base_occluded(blob, view[0], camera, view[1], config.pixel_step):

@@ -1,0 +1,271 @@
+"""Geometry-only objects: solid things the depth shows that no detector names (a pallet, a box
+stack, a bucket, a shelf), fused over views in a voxel map and kept as ``unknown`` instances.
+
+A track of unnamed blobs becomes an instance only when the camera saw the whole object
+(``whole.py``), which a stack longer than a metre, or one always cut by the image's border,
+never is. This map asks instead whether a surface is *there*. At keyframes (every
+``KEYFRAME_S``) the points of the unnamed, not flat blobs add their voxels (``VOXEL_M``), and
+every voxel kept so far is projected into the depth image: measured at its depth, the surface
+is seen there again; measured well behind it, the camera looked through it (expected, not
+seen). A voxel found there in ``MIN_SEEN_SHARE`` of the keyframes that could tell is evidence;
+a passing person, flying pixels at a depth edge and a drifting fragment are seen through from
+the next viewpoint and are not.
+
+At the end of the log the evidence voxels outside the background are grouped into connected
+parts (voxels one above the other across a gap of ``STACK_GAP_M`` join: a rack's boards, a
+stack whose middle was hidden). A part is an object when its voxels were found there at
+``MIN_SEEN_PART`` keyframes (median), it is solid (not one sheet of voxels: a wall or a
+furniture side the background left), large enough, stands on the floor or a support
+(``BASE_REACH_M``), is at most ``MAX_EXTENT_M`` long, and no instance of the session (any
+class) covers it. Its box is the box of its voxels.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.whole import thickness_m
+from hiper_cli.types import Frame
+
+__all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid"]
+
+FloatArray = NDArray[np.float64]
+KEYFRAME_S = 0.5  # the static map is refined at most this often (s of log)
+VOXEL_M = 0.1  # edge of a voxel of the map
+MIN_SEEN_SHARE = 0.6  # of the keyframes that could tell, the share that found a voxel's surface
+MIN_SEEN_PART = 2  # a part: its voxels found there at this many keyframes (median)
+NOISE_M = 0.02  # depth noise at 1 m; a surface is "there" within VOXEL_M + NOISE_M · z² of it
+STACK_GAP_M = 0.4  # voxels one above the other across at most this gap are one part
+MIN_VOXELS = 10  # a part with fewer is debris, not an object (0.01 m³ of surface at 0.1 m)
+MIN_HEIGHT_M = 0.15  # ... or lower than this
+MIN_THICKNESS_M = 0.05  # the spread of a part's voxels across their thinnest direction: a sheet
+BASE_REACH_M = 0.25  # its lowest voxel this near the floor or a support top: it stands there
+CEILING_REACH_M = 0.3  # its top this near the ceiling: it is the building's, or joined to it
+MAX_EXTENT_M = 4.5  # a longer part is structure or several things run together
+FLAT_M = 0.01  # a blob whose points spread less than this (σ, plus FLAT_PER_M2 · depth²) across
+FLAT_PER_M2 = 0.0015  # ... their thinnest direction is a piece of a surface: it adds no voxels
+COVERED_SHARE = 0.3  # a part whose box an instance's box covers by this share of it is that one
+_OFFSET = 1 << 20  # voxel indices are packed into one int64 key, 21 bits each
+_BITS = 21
+
+
+def is_solid(points_cam: FloatArray) -> bool:
+    """Whether a blob's points (camera frame) spread across their thinnest direction by more
+    than the depth noise: a body, not a piece of a wall or a furniture side."""
+    if len(points_cam) < 4:
+        return False
+    depth_m = float(np.median(points_cam[:, 2]))
+    return thickness_m(points_cam) >= FLAT_M + FLAT_PER_M2 * depth_m * depth_m
+
+
+def _pack(ijk: NDArray[np.int64]) -> NDArray[np.int64]:
+    shifted = ijk + _OFFSET
+    return (shifted[:, 0] << (2 * _BITS)) | (shifted[:, 1] << _BITS) | shifted[:, 2]
+
+
+def _centres(keys: NDArray[np.int64]) -> FloatArray:
+    """The centres (N, 3; map frame, m) of the voxels ``keys``."""
+    return np.asarray((_unpack(keys) + 0.5) * VOXEL_M, dtype=np.float64)
+
+
+def _unpack(keys: NDArray[np.int64]) -> NDArray[np.int64]:
+    mask = (1 << _BITS) - 1
+    return np.stack([(keys >> (2 * _BITS)) & mask, (keys >> _BITS) & mask, keys & mask], axis=1) - _OFFSET
+
+
+@dataclass(frozen=True)
+class SolidPart:
+    """One geometry-only object: its box (map frame), when it was first and last held, the
+    observations of the blobs that held it, and the share of views that found it there."""
+
+    box: Box3D
+    first_seen_s: float
+    last_seen_s: float
+    observation_uuids: list[str]
+    seen_share: float
+
+
+class SolidMap:
+    """The voxel map of unnamed solid surfaces (see the module docstring)."""
+
+    def __init__(self) -> None:
+        self._keys = np.zeros(0, dtype=np.int64)  # sorted
+        self._seen = np.zeros(0, dtype=np.int32)
+        self._free = np.zeros(0, dtype=np.int32)
+        self._first_s = np.zeros(0, dtype=np.float64)
+        self._last_s = np.zeros(0, dtype=np.float64)
+        # per blob added: its observation's uuid, its keyframe and its voxels' keys
+        self._blobs: list[tuple[str, int, NDArray[np.int64]]] = []
+        self._keyframes = 0
+        self._last_keyframe_s: float | None = None
+
+    def due(self, stamp_s: float) -> bool:
+        """Whether ``stamp_s`` is a keyframe (``KEYFRAME_S`` after the last one)."""
+        return self._last_keyframe_s is None or stamp_s - self._last_keyframe_s >= KEYFRAME_S
+
+    def add(self, frame: Frame, blobs: Sequence[tuple[str, FloatArray]]) -> None:
+        """One keyframe: ``blobs`` are (observation uuid, map points) of its unnamed solid blobs."""
+        self._last_keyframe_s = frame.stamp_s
+        self._keyframes += 1
+        self._look(frame)  # the voxels kept so far: there, or seen through
+        held: list[NDArray[np.int64]] = []
+        for uuid, points in blobs:
+            if len(points) == 0:
+                continue
+            keys = np.unique(_pack(np.floor(points / VOXEL_M).astype(np.int64)))
+            self._blobs.append((uuid, self._keyframes, keys))
+            held.append(keys)
+        if not held:
+            return
+        keys = np.unique(np.concatenate(held))
+        new = np.setdiff1d(keys, self._keys, assume_unique=True)
+        if len(new):
+            self._insert(new, frame.stamp_s)
+        self._last_s[np.searchsorted(self._keys, keys)] = frame.stamp_s
+
+    def _insert(self, new: NDArray[np.int64], stamp_s: float) -> None:
+        keys = np.concatenate([self._keys, new])
+        order = np.argsort(keys, kind="stable")
+        self._keys = keys[order]
+        n = len(new)
+        self._seen = np.concatenate([self._seen, np.ones(n, np.int32)])[order]  # the view that found it
+        self._free = np.concatenate([self._free, np.zeros(n, np.int32)])[order]
+        self._first_s = np.concatenate([self._first_s, np.full(n, stamp_s)])[order]
+        self._last_s = np.concatenate([self._last_s, np.full(n, stamp_s)])[order]
+
+    def _look(self, frame: Frame) -> None:
+        """Count, per kept voxel in the camera's view, whether the depth image finds a surface
+        at it (seen) or well behind it (free); nearer depth or no return tells nothing."""
+        if not len(self._keys):
+            return
+        centres = _centres(self._keys)
+        T_cam_map = np.linalg.inv(frame.T_map_cam)
+        p = centres @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+        z = p[:, 2]
+        cam = frame.camera
+        ok = z > VOXEL_M
+        safe_z = np.where(ok, z, 1.0)
+        u = np.floor(cam.fx * p[:, 0] / safe_z + cam.cx).astype(np.int64)
+        v = np.floor(cam.fy * p[:, 1] / safe_z + cam.cy).astype(np.int64)
+        ok &= (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+        idx = np.flatnonzero(ok)
+        measured = frame.depth_m[v[idx], u[idx]].astype(np.float64)
+        margin = VOXEL_M + NOISE_M * z[idx] ** 2
+        there = (measured > 0) & (np.abs(measured - z[idx]) <= margin)
+        through = measured > z[idx] + margin
+        self._seen[idx[there]] += 1
+        self._free[idx[through]] += 1
+
+    def parts(self, floor_z_m: float, supports: Sequence[Box3D], taken: Sequence[Box3D],
+              background: Sequence[Box3D], ceiling_z_m: float | None = None) -> list[SolidPart]:
+        """The geometry-only objects: evidence voxels outside the ``background`` boxes, grouped
+        into connected parts, kept when found there again, solid, standing and not ``taken`` by
+        an instance (see the module docstring)."""
+        told = self._seen + self._free
+        evidence = self._seen >= MIN_SEEN_SHARE * np.maximum(told, 1)
+        idx = np.flatnonzero(evidence)
+        if len(idx):
+            centres = _centres(self._keys[idx])
+            inside = np.zeros(len(idx), dtype=bool)
+            for box in background:  # in the box's own axes: a wall at an angle holds no room
+                local = (centres - box.center_m) @ box.R
+                inside |= np.all(np.abs(local) <= box.extent_m / 2.0, axis=1)
+            idx = idx[~inside]
+        if not len(idx):
+            return []
+        labels = np.full(len(self._keys), -1, dtype=np.int64)
+        labels[idx] = _components(_unpack(self._keys[idx]))
+        held = self._held_by(labels)
+        tops = [float(b.aabb()[1][2]) for b in supports] + [floor_z_m]
+        out: list[SolidPart] = []
+        for label in range(int(labels.max()) + 1):
+            frames, uuids = held.get(label, (set(), []))
+            members = np.flatnonzero(labels == label)
+            if not frames or np.median(self._seen[members]) < MIN_SEEN_PART:
+                continue
+            part = self._part(members, (tops, ceiling_z_m), taken, uuids)
+            if part is not None:
+                out.append(part)
+        return out
+
+    def _held_by(self, labels: NDArray[np.int64]) -> dict[int, tuple[set[int], list[str]]]:
+        """Per part label, the keyframes and observations of the blobs whose voxels lie in it
+        for the most part."""
+        held: dict[int, tuple[set[int], list[str]]] = {}
+        for uuid, keyframe, keys in self._blobs:
+            of = labels[np.searchsorted(self._keys, keys)]
+            of = of[of >= 0]
+            if not len(of):
+                continue
+            values, counts = np.unique(of, return_counts=True)
+            best = int(np.argmax(counts))
+            if counts[best] >= 0.5 * len(keys):
+                frames, uuids = held.setdefault(int(values[best]), (set(), []))
+                frames.add(keyframe)
+                uuids.append(uuid)
+        return held
+
+    def _part(
+        self, members: NDArray[np.int64], levels: tuple[Sequence[float], float | None],
+        taken: Sequence[Box3D], uuids: list[str],
+    ) -> SolidPart | None:
+        """The object of one connected part (``members``: voxel indices), or None when it is
+        debris, a sheet, afloat, reaching the ceiling, too long or an instance's already;
+        ``levels``: the tops of the floor and the supports, and the ceiling's height (None:
+        none mapped)."""
+        tops, ceiling_z_m = levels
+        if len(members) < MIN_VOXELS:
+            return None
+        centres = _centres(self._keys[members])
+        lo, hi = centres.min(axis=0) - VOXEL_M / 2.0, centres.max(axis=0) + VOXEL_M / 2.0
+        extent = hi - lo
+        if extent[2] < MIN_HEIGHT_M or max(float(extent[0]), float(extent[1])) > MAX_EXTENT_M:
+            return None
+        if not any(abs(float(lo[2]) - top) <= BASE_REACH_M for top in tops):
+            return None
+        if ceiling_z_m is not None and float(hi[2]) >= ceiling_z_m - CEILING_REACH_M:
+            return None  # from the floor to the ceiling: building structure, or run into it
+        if _thinnest_spread_m(centres) < MIN_THICKNESS_M:
+            return None
+        box = Box3D((lo + hi) / 2.0, extent)
+        if any(_overlap_share(box, other) >= COVERED_SHARE for other in taken):
+            return None
+        told = self._seen[members] + self._free[members]
+        return SolidPart(box, float(self._first_s[members].min()), float(self._last_s[members].max()),
+                         uuids, float(self._seen[members].sum() / max(int(told.sum()), 1)))
+
+
+def _components(ijk: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Labels 0..k-1 of the 26-connected parts of the voxels ``ijk`` (N, 3)."""
+    from scipy.ndimage import binary_dilation, label
+
+    base = ijk.min(axis=0)
+    local = ijk - base
+    grid = np.zeros(tuple(int(v) + 1 for v in local.max(axis=0)), dtype=bool)
+    grid[local[:, 0], local[:, 1], local[:, 2]] = True
+    if STACK_GAP_M >= VOXEL_M:  # one above the other across a gap: a rack's boards, a stack
+        grid = binary_dilation(grid, structure=np.ones((1, 1, 3), dtype=bool),
+                               iterations=int(STACK_GAP_M / VOXEL_M / 2.0 + 0.5))
+    labelled, _ = label(grid, structure=np.ones((3, 3, 3), dtype=bool))
+    return np.asarray(labelled[local[:, 0], local[:, 1], local[:, 2]], dtype=np.int64) - 1
+
+
+def _thinnest_spread_m(points: FloatArray) -> float:
+    """The spread (σ, m) of ``points`` across their thinnest direction."""
+    centred = points - points.mean(axis=0)
+    cov = centred.T @ centred / len(points)
+    return float(np.sqrt(max(float(np.linalg.eigvalsh(cov)[0]), 0.0)))
+
+
+def _overlap_share(a: Box3D, b: Box3D) -> float:
+    """The volume the boxes share, as a share of ``a``'s."""
+    alo, ahi = a.aabb()
+    blo, bhi = b.aabb()
+    inter = np.clip(np.minimum(ahi, bhi) - np.maximum(alo, blo), 0.0, None)
+    volume = float(np.prod(ahi - alo))
+    return float(np.prod(inter)) / volume if volume > 0 else 0.0

@@ -1,0 +1,147 @@
+"""Geometry-only objects (``solid_map.py``): a solid thing on the floor that no detector names is
+one ``unknown`` part, fused over views; what passes, what is flat, what floats and what an
+instance already holds is not.
+
+The scenes are rendered here: boxes' surfaces sampled every 1.5 cm, projected into a small
+depth image with a z-buffer, seen by a camera that drives past them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.solid_map import KEYFRAME_S, SolidMap, is_solid
+from hiper_cli.types import CameraIntrinsics, Frame
+
+CAM = CameraIntrinsics(width=160, height=120, fx=100.0, fy=100.0, cx=79.5, cy=59.5)
+FLOOR = Box3D(np.array([0.0, 0.0, -0.05]), np.array([20.0, 20.0, 0.1]))
+
+
+def box_surface(lo: list[float], hi: list[float], step_m: float = 0.015) -> NDArray[np.float64]:
+    """Points on the faces of the axis-aligned box ``lo``..``hi`` (map frame)."""
+    lo_a, hi_a = np.array(lo, float), np.array(hi, float)
+    faces = []
+    for axis in range(3):
+        a, b = [k for k in range(3) if k != axis]
+        ua = np.arange(lo_a[a], hi_a[a] + 1e-9, step_m)
+        ub = np.arange(lo_a[b], hi_a[b] + 1e-9, step_m)
+        grid_a, grid_b = np.meshgrid(ua, ub, indexing="ij")
+        for level in (lo_a[axis], hi_a[axis]):
+            face = np.zeros((grid_a.size, 3))
+            face[:, a], face[:, b], face[:, axis] = grid_a.ravel(), grid_b.ravel(), level
+            faces.append(face)
+    return np.concatenate(faces)
+
+
+def pose_looking_at(eye: list[float], target: list[float]) -> NDArray[np.float64]:
+    """T_map_cam of an optical camera (z forward, y down) at ``eye`` looking at ``target``."""
+    eye_a, tgt = np.array(eye, float), np.array(target, float)
+    z = (tgt - eye_a) / np.linalg.norm(tgt - eye_a)
+    x = np.cross(z, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    T = np.eye(4)
+    T[:3, :3] = np.stack([x, y, z], axis=1)
+    T[:3, 3] = eye_a
+    return T
+
+
+def render(points_map: list[NDArray[np.float64]], T_map_cam: NDArray[np.float64], stamp_s: float
+           ) -> tuple[Frame, list[NDArray[np.float64]]]:
+    """The depth image of ``points_map`` (one array per thing) and, per thing, its visible points."""
+    T_cam_map = np.linalg.inv(T_map_cam)
+    depth = np.full((CAM.height, CAM.width), np.inf)
+    owner = np.full((CAM.height, CAM.width), -1)
+    projected = []
+    for pts in points_map:
+        p = pts @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
+        p = p[p[:, 2] > 0.1]
+        u = np.floor(CAM.fx * p[:, 0] / p[:, 2] + CAM.cx).astype(int)
+        v = np.floor(CAM.fy * p[:, 1] / p[:, 2] + CAM.cy).astype(int)
+        inside = (u >= 0) & (u < CAM.width) & (v >= 0) & (v < CAM.height)
+        projected.append((v[inside], u[inside], p[inside, 2]))
+        np.minimum.at(depth, (v[inside], u[inside]), p[inside, 2])
+    for k, (v, u, z) in enumerate(projected):  # the nearest thing owns the pixel
+        nearest = z <= depth[v, u]
+        owner[v[nearest], u[nearest]] = k
+    depth[~np.isfinite(depth)] = 0.0
+    vs, us = np.nonzero(owner >= 0)
+    zs = depth[vs, us]
+    cam_pts = np.stack([(us + 0.5 - CAM.cx) / CAM.fx * zs, (vs + 0.5 - CAM.cy) / CAM.fy * zs, zs], axis=1)
+    map_pts = cam_pts @ T_map_cam[:3, :3].T + T_map_cam[:3, 3]
+    seen = [map_pts[owner[vs, us] == k] for k in range(len(points_map))]
+    frame = Frame(stamp_s=stamp_s, rgb=np.zeros((CAM.height, CAM.width, 3), np.uint8),
+                  depth_m=depth.astype(np.float32), camera=CAM, T_map_cam=T_map_cam, pose_id=0)
+    return frame, seen
+
+
+def drive_past(things: list[NDArray[np.float64]], unnamed: list[int], movers: dict[int, NDArray[np.float64]]
+               | None = None, views: int = 8) -> SolidMap:
+    """A camera 1.2 m high driving along y = -3 past the things at the origin, a keyframe per
+    view; ``unnamed``: the things whose blobs no detector names; ``movers``: thing -> its
+    velocity (m per view)."""
+    solid = SolidMap()
+    for k in range(views):
+        x = -2.0 + 4.0 * k / (views - 1)
+        shifted = [pts + (movers or {}).get(i, np.zeros(3)) * k for i, pts in enumerate(things)]
+        frame, seen = render(shifted, pose_looking_at([x, -3.0, 1.2], [0.0, 0.0, 0.4]), 10.0 + k * KEYFRAME_S)
+        assert solid.due(frame.stamp_s)
+        solid.add(frame, [(f"obs-{k}-{i}", seen[i]) for i in unnamed if len(seen[i])])
+    return solid
+
+
+def floor_points() -> NDArray[np.float64]:
+    return box_surface([-4.0, -2.0, -0.02], [4.0, 4.0, -0.01], step_m=0.03)[:, :]
+
+
+def test_a_box_on_the_floor_seen_from_several_sides_is_one_part_with_its_box() -> None:
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    parts = drive_past([crate, floor_points()], unnamed=[0]).parts(0.0, [FLOOR], [], [])
+    assert len(parts) == 1
+    lo, hi = parts[0].box.aabb()
+    assert np.allclose(lo, [-0.4, -0.3, 0.0], atol=0.15) and np.allclose(hi[2], 0.7, atol=0.15)
+    assert hi[0] > 0.25 and hi[1] > 0.15  # faces seen from the side and from the front
+    assert parts[0].seen_share > 0.9 and parts[0].observation_uuids
+
+
+def test_a_thing_that_moves_on_is_seen_through_and_is_no_part() -> None:
+    crate = box_surface([-0.2, -0.2, 0.0], [0.2, 0.2, 1.6])
+    solid = drive_past([crate, floor_points()], unnamed=[0], movers={0: np.array([0.0, 0.5, 0.0])})
+    assert solid.parts(0.0, [FLOOR], [], []) == []
+
+
+def test_a_flat_piece_of_a_surface_is_no_part() -> None:
+    board = box_surface([-0.6, 0.0, 0.0], [0.6, 0.0, 1.0])  # a sheet facing the camera
+    assert drive_past([board, floor_points()], unnamed=[0]).parts(0.0, [FLOOR], [], []) == []
+    frame, seen = render([board], pose_looking_at([0.0, -3.0, 1.2], [0.0, 0.0, 0.4]), 0.0)
+    cam = (seen[0] - frame.T_map_cam[:3, 3]) @ frame.T_map_cam[:3, :3]
+    assert not is_solid(cam)
+
+
+def test_a_thing_afloat_is_no_part_and_one_an_instance_holds_is_that_instance() -> None:
+    lamp = box_surface([-0.3, -0.3, 1.0], [0.3, 0.3, 1.5])
+    assert drive_past([lamp, floor_points()], unnamed=[0]).parts(0.0, [FLOOR], [], []) == []
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    solid = drive_past([crate, floor_points()], unnamed=[0])
+    chair = Box3D(np.array([0.0, 0.0, 0.35]), np.array([0.8, 0.6, 0.7]))
+    assert solid.parts(0.0, [FLOOR], [chair], []) == []
+    wall = Box3D(np.array([0.0, 0.0, 0.35]), np.array([1.0, 1.0, 1.0]))
+    assert solid.parts(0.0, [FLOOR], [], [wall]) == []  # the background's
+
+
+def test_keyframes_come_every_half_second() -> None:
+    solid = SolidMap()
+    frame, _ = render([floor_points()], pose_looking_at([0.0, -3.0, 1.2], [0.0, 0.0, 0.4]), 5.0)
+    assert solid.due(5.0)
+    solid.add(frame, [])
+    assert not solid.due(5.0 + KEYFRAME_S / 2) and solid.due(5.0 + KEYFRAME_S)
+
+
+def test_a_part_from_the_floor_to_the_ceiling_is_the_buildings() -> None:
+    column = box_surface([-0.3, -0.3, 0.0], [0.3, 0.3, 2.5])
+    solid = drive_past([column, floor_points()], unnamed=[0])
+    assert len(solid.parts(0.0, [FLOOR], [], [])) == 1  # no ceiling mapped: a tall thing
+    assert solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=2.6) == []
+    assert len(solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=4.0)) == 1
