@@ -41,7 +41,7 @@ def room() -> list[SceneBox]:
 
 def person(id_: int, x: float, y: float) -> SceneBox:
     """A standing person: a 0.3 x 0.5 x 1.7 m box whose middle (the chest) stands 0.1 m before
-    its sides (a person is no flat panel: ``solid.is_flat``)."""
+    its sides (a person is no flat panel)."""
     return SceneBox(id_, np.array([x, y, 0.85]), np.array([0.3, 0.5, 1.7]), "person", relief_m=0.1)
 
 

@@ -16,8 +16,8 @@ options by the same names:
 4. **track** (``motion.py``, ``moving.py``, ``smoother.py``): a Kalman filter per track; an object
    moves only with evidence (its blobs left where they were), so a static object keeps speed 0.
 5. **classify** (``match.py`` names blobs with detections, Algorithm 4; ``class_vote.py`` gives a
-   track its class from its votes): ``classes.py``, ``plausible.py``, ``solid.py`` and
-   ``priors.py`` say which names a blob can take at all.
+   track its class from its votes): ``classes.py``, ``plausible.py`` and ``priors.py`` say
+   which names a blob can take at all.
 
 At the end of a session ``reidentify.py`` and ``vacated.py`` join this session's objects to
 earlier sessions' instances. Values nobody should tune are named constants beside their code.

@@ -54,7 +54,6 @@ from hiper_cli.perceive.foreground.reidentify import (
     still_seen,
 )
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.solid import DETECTION_NEAREST, WALKER_SOLID, detected_blobs, is_flat
 from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
@@ -196,17 +195,13 @@ class ForegroundStage:
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
 
-    def _stands(self, class_name: str, blob: Blob, flat: bool = False) -> bool:
-        """False for a walker-class blob whose lowest point is more than ``walker_max_base_m``
+    def _stands(self, class_name: str, blob: Blob) -> bool:
+        """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
         above the floor: people stand on it, and even behind a counter their visible part
-        reaches below that (a person detection on a poster, a shelf's top or a reflection);
-        and for a ``flat`` one (``walker_solid``, ``solid.is_flat``: a picture or a screen showing
-        people, a wall piece)."""
+        reaches below that (a person detection on a poster, a shelf's top or a reflection)."""
         cfg = self.config
         if class_name not in cfg.walker_classes:
             return True
-        if flat:
-            return False
         if WALKER_MAX_BASE_M <= 0:
             return True
         return float(blob.bounds_map[0][2]) - self._floor_z_m <= WALKER_MAX_BASE_M
@@ -358,16 +353,13 @@ class ForegroundStage:
             min_score=cfg.min_detection_score,
             unknown=UNKNOWN,
         )
-        if DETECTION_NEAREST:
-            matches = detected_blobs(matches, [b.points_cam[:, 2] for b in blobs], cfg)
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
         keyframe = self._solid.due(frame.stamp_s)
         unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
-            flat = WALKER_SOLID and is_flat(blob.points_cam, cfg)
-            match, longest = self._judged(frame, scene, blob, match, flat)
+            match, longest = self._judged(frame, scene, blob, match)
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
@@ -375,7 +367,7 @@ class ForegroundStage:
             if keyframe and match.detection_index is None and is_solid(blob.points_cam):
                 unnamed.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
-            measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
+            measurements.append(self._measurement(frame, blob, match, dets, (obs, longest)))
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
@@ -387,7 +379,7 @@ class ForegroundStage:
         return observations, measurements, surfaces
 
     def _judged(
-        self, frame: Frame, scene: _Background, blob: Blob, match: Match, flat: bool
+        self, frame: Frame, scene: _Background, blob: Blob, match: Match
     ) -> tuple[Match, float | None]:
         """``match`` as the checks of a named class leave it (``unknown`` when the class's
         learned priors, standing, size or attachment rule the blob out), and
@@ -398,7 +390,7 @@ class ForegroundStage:
         longest = longest_m(blob.points_map, float(blob.extent_map_m[2])) if cfg.class_sizes else None
         if not (
             self._priors.fits(match.class_name, blob, frame)
-            and self._stands(match.class_name, blob, flat)
+            and self._stands(match.class_name, blob)
             and (longest is None or longest <= max_longest_m(match.class_name, CLASS_SIZE_TOLERANCE))
             and (match.class_name not in FIXTURE_CLASSES
                  or attached(blob.points_map, self._walls, scene.tops, FIXTURE_REACH_M))
@@ -413,12 +405,12 @@ class ForegroundStage:
 
     def _measurement(
         self, frame: Frame, blob: Blob, match: Match, dets: Detections,
-        seen: tuple[Observation, float | None, bool],
+        seen: tuple[Observation, float | None],
     ) -> Measurement:
-        """The tracker's measurement of a blob; ``seen``: its observation, its longest side
-        (``_judged``) and whether it is flat (``solid.is_flat``)."""
+        """The tracker's measurement of a blob; ``seen``: its observation and its longest side
+        (``_judged``)."""
         cfg = self.config
-        obs, longest, flat = seen
+        obs, longest = seen
         full = cfg.refused_min_views > 0 and in_full_view(
             blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, FULL_VIEW_MIN_PX2
         )
@@ -431,7 +423,6 @@ class ForegroundStage:
             standing=self._standing_box(blob),  # a walking track takes any blob as standing
             bounds_map_m=_corners(blob),
             longest_m=longest,
-            solid=not flat,
             detection_index=match.detection_index,
             detection_xyxy_px=None if match.detection_index is None else dets.xyxy[match.detection_index],
             viewpoint_map_m=frame.T_map_cam[:3, 3],

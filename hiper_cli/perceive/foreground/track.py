@@ -56,8 +56,6 @@ class Measurement:
     """The longest dimension of a named blob seen whole (``plausible.longest_m``): what the view
     shows of the object's size; None: cut by the image's border, hidden in part by something
     nearer (``whole.occluded``), of a class without a lower size bound, or not named."""
-    solid: bool = True
-    """Not flat (``solid.is_flat``): a walker's track takes only solid blobs (``walker_solid``)."""
     detection_index: int | None = None
     """Which detection of its frame named the blob (None: none): two tracks named by different
     detections side by side in one frame are two objects (``same_object.seen_apart``)."""

@@ -517,7 +517,6 @@ class Tracker:
         classes = np.array([m.class_name for m in measurements], dtype=object)
         unknown = classes == UNKNOWN
         sizes = np.array([_size_m(m.extent_map_m) for m in measurements])
-        solid = np.array([m.solid for m in measurements], dtype=bool)
         extents = np.array([m.extent_map_m for m in measurements])
         half_extents = extents / 2.0
         footprints = np.hypot(extents[:, 0], extents[:, 1])  # diagonal seen from above
@@ -531,7 +530,7 @@ class Tracker:
             if cls != UNKNOWN:  # two different known classes cost more; unknown is neutral
                 cost[i, ~unknown & (classes != cls)] += CLASS_MISMATCH_M
             if cls in cfg.walker_classes:
-                allowed[i] &= (sizes >= WALKER_MIN_SIZE_RATIO * t.max_size_m) & solid
+                allowed[i] &= sizes >= WALKER_MIN_SIZE_RATIO * t.max_size_m
             if cls in SEARCH_SAME_CLASS and stamp_s - t.last_update_s > grace:
                 # Lost and searching: another class only when it is an unmatched blob as big as
                 # the person (the person cut by the border).
