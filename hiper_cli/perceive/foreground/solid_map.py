@@ -32,7 +32,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.whole import thickness_m
 from hiper_cli.types import Frame
 
-__all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid"]
+__all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid", "overlap_share"]
 
 FloatArray = NDArray[np.float64]
 KEYFRAME_S = 0.5  # the static map is refined at most this often (s of log)
@@ -233,7 +233,7 @@ class SolidMap:
         if _thinnest_spread_m(centres) < MIN_THICKNESS_M:
             return None
         box = Box3D((lo + hi) / 2.0, extent)
-        if any(_overlap_share(box, other) >= COVERED_SHARE for other in taken):
+        if any(overlap_share(box, other) >= COVERED_SHARE for other in taken):
             return None
         told = self._seen[members] + self._free[members]
         return SolidPart(box, float(self._first_s[members].min()), float(self._last_s[members].max()),
@@ -262,7 +262,7 @@ def _thinnest_spread_m(points: FloatArray) -> float:
     return float(np.sqrt(max(float(np.linalg.eigvalsh(cov)[0]), 0.0)))
 
 
-def _overlap_share(a: Box3D, b: Box3D) -> float:
+def overlap_share(a: Box3D, b: Box3D) -> float:
     """The volume the boxes share, as a share of ``a``'s."""
     alo, ahi = a.aabb()
     blo, bhi = b.aabb()

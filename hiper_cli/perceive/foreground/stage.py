@@ -48,7 +48,7 @@ from hiper_cli.perceive.foreground.refine import refine_blobs
 from hiper_cli.perceive.foreground.reidentify import cosighted_pairs, fold, fold_mover, moved_pairs, pairs
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid import detected_blobs, is_flat
-from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
+from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_pieces import join_hidden_pieces, join_hidden_tracks
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
@@ -82,6 +82,7 @@ MIN_ALTITUDE_SPAN_M = 0.2  # the altitude prior's slack grows with at least this
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
+PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
 STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
 
@@ -537,6 +538,10 @@ class ForegroundStage:
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
         self._walls = _wall_boxes(world)
         instances = [self._instance(t) for t in closed]
+        folded, grown = self._fold_pieces()
+        instances = [i for i in instances if i.uuid not in folded]
+        instances += [i for i in grown if all(i is not j for j in instances)]
+        gone += folded
         counts: dict[str, int] = {}
         if self.config.reidentify:
             static = {t.uuid for t in tracks if t.confirmed and is_static(t, self.tracker.config)}
@@ -545,6 +550,29 @@ class ForegroundStage:
             gone += absorbed
         instances += self._geometry_only(world, instances)
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
+
+    def _fold_pieces(self) -> tuple[list[str], list[Instance]]:
+        """One place, one object: a static named instance whose box lies for ``PIECE_SHARE``
+        inside the box of a static instance of another named class seen in more views is a
+        piece of it (a couch's end taken for a chair); its views join that one's. Returns the
+        uuids folded away and the instances that took their views."""
+        walkers = self.tracker.config.walker_classes
+        named = [i for i in self._instances.values()
+                 if i.state == "static" and i.class_name != UNKNOWN and i.class_name not in walkers]
+        folded: list[str] = []
+        grown: list[Instance] = []
+        for piece in sorted(named, key=lambda i: len(i.observation_uuids)):
+            wholes = [i for i in named if i.class_name != piece.class_name and i.uuid not in folded
+                      and len(i.observation_uuids) > len(piece.observation_uuids)
+                      and overlap_share(piece.box, i.box) >= PIECE_SHARE]
+            if wholes:
+                whole = max(wholes, key=lambda i: len(i.observation_uuids))
+                whole.observation_uuids = [*whole.observation_uuids, *piece.observation_uuids]
+                folded.append(piece.uuid)
+                grown.append(whole)
+        for uuid in folded:
+            del self._instances[uuid]
+        return folded, [i for i in grown if i.uuid not in folded]
 
     def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
         """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
