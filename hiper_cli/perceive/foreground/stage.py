@@ -166,7 +166,7 @@ class ForegroundStage:
         self._walls: list[Box3D] = []  # the background's walls, as of the latest frame
         self._empty: EmptyPlaces | None = None  # earlier sessions' static objects, seen empty?
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
-        self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
+        self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
 
     # --- learned priors ---------------------------------------------------------------------
     def _refresh_priors(self, world: World) -> None:
@@ -410,7 +410,7 @@ class ForegroundStage:
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
         keyframe = self._solid.due(frame.stamp_s)
-        unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
+        held: list[tuple[str, FloatArray]] = []  # a keyframe's solid blobs but walkers' (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
             flat = cfg.walker_solid and is_flat(blob.points_cam, cfg)
             match, longest = self._judged(frame, scene, blob, match, flat)
@@ -418,8 +418,8 @@ class ForegroundStage:
                 continue
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
-            if keyframe and match.detection_index is None and is_solid(blob.points_cam):
-                unnamed.append((obs.uuid, blob.points_map))
+            if keyframe and match.class_name not in cfg.walker_classes and is_solid(blob.points_cam):
+                held.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
             measurements.append(self._measurement(frame, blob, match, dets, (obs, longest, flat)))
         for blob in found_tables if cfg.unseen_table_instances else []:
@@ -429,7 +429,7 @@ class ForegroundStage:
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
         if keyframe:
-            self._solid.add(frame, unnamed)
+            self._solid.add(frame, held)
         return observations, measurements, surfaces
 
     def _judged(
