@@ -1,10 +1,11 @@
-"""Geometry-only objects: solid things the depth shows that no detector names (a pallet, a box
+"""Geometry-only objects: solid things the depth shows that no instance holds (a pallet, a box
 stack, a bucket, a shelf), fused over views in a voxel map and kept as ``unknown`` instances.
 
 A track of unnamed blobs becomes an instance only when the camera saw the whole object
 (``whole.py``), which a stack longer than a metre, or one always cut by the image's border,
-never is. This map asks instead whether a surface is *there*. At keyframes (every
-``KEYFRAME_S``) the points of the unnamed, not flat blobs add their voxels (``VOXEL_M``), and
+never is; nor does a track that detections named once or twice. This map asks instead
+whether a surface is *there*. At keyframes (every ``KEYFRAME_S``) the points of the not flat
+blobs of every class but the walkers' add their voxels (``VOXEL_M``), and
 every voxel kept so far is projected into the depth image: measured at its depth, the surface
 is seen there again; measured well behind it, the camera looked through it (expected, not
 seen). A voxel found there in ``MIN_SEEN_SHARE`` of the keyframes that could tell is evidence;
@@ -32,7 +33,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.whole import thickness_m
 from hiper_cli.types import Frame
 
-__all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid"]
+__all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid", "overlap_share"]
 
 FloatArray = NDArray[np.float64]
 KEYFRAME_S = 0.5  # the static map is refined at most this often (s of log)
@@ -91,7 +92,7 @@ class SolidPart:
 
 
 class SolidMap:
-    """The voxel map of unnamed solid surfaces (see the module docstring)."""
+    """The voxel map of solid surfaces (see the module docstring)."""
 
     def __init__(self) -> None:
         self._keys = np.zeros(0, dtype=np.int64)  # sorted
@@ -109,7 +110,8 @@ class SolidMap:
         return self._last_keyframe_s is None or stamp_s - self._last_keyframe_s >= KEYFRAME_S
 
     def add(self, frame: Frame, blobs: Sequence[tuple[str, FloatArray]]) -> None:
-        """One keyframe: ``blobs`` are (observation uuid, map points) of its unnamed solid blobs."""
+        """One keyframe: ``blobs`` are (observation uuid, map points) of its solid blobs (walkers'
+        left out: what walks is no part of the static map)."""
         self._last_keyframe_s = frame.stamp_s
         self._keyframes += 1
         self._look(frame)  # the voxels kept so far: there, or seen through
@@ -233,7 +235,7 @@ class SolidMap:
         if _thinnest_spread_m(centres) < MIN_THICKNESS_M:
             return None
         box = Box3D((lo + hi) / 2.0, extent)
-        if any(_overlap_share(box, other) >= COVERED_SHARE for other in taken):
+        if any(overlap_share(box, other) >= COVERED_SHARE for other in taken):
             return None
         told = self._seen[members] + self._free[members]
         return SolidPart(box, float(self._first_s[members].min()), float(self._last_s[members].max()),
@@ -262,7 +264,7 @@ def _thinnest_spread_m(points: FloatArray) -> float:
     return float(np.sqrt(max(float(np.linalg.eigvalsh(cov)[0]), 0.0)))
 
 
-def _overlap_share(a: Box3D, b: Box3D) -> float:
+def overlap_share(a: Box3D, b: Box3D) -> float:
     """The volume the boxes share, as a share of ``a``'s."""
     alo, ahi = a.aabb()
     blo, bhi = b.aabb()

@@ -54,7 +54,7 @@ from hiper_cli.perceive.foreground.reidentify import (
     still_seen,
 )
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid
+from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
@@ -108,6 +108,7 @@ SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far belo
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
+PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
 STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
 
@@ -193,7 +194,7 @@ class ForegroundStage:
         # the place's cloud): an object found there was not moved there (``_reidentify``)
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
-        self._solid = SolidMap()  # unnamed solid surfaces, fused at keyframes: geometry-only objects
+        self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
@@ -357,15 +358,15 @@ class ForegroundStage:
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
         keyframe = self._solid.due(frame.stamp_s)
-        unnamed: list[tuple[str, FloatArray]] = []  # a keyframe's unnamed solid blobs (``SolidMap``)
+        held: list[tuple[str, FloatArray]] = []  # a keyframe's solid blobs but walkers' (``SolidMap``)
         for blob, match in zip(blobs, matches, strict=True):
             match, longest = self._judged(frame, scene, blob, match)
             if match.detection_index is None and not cfg.keep_unknown:
                 continue
             obs = self._observation(frame, blob, match, dets)
             observations.append(obs)
-            if keyframe and match.detection_index is None and is_solid(blob.points_cam):
-                unnamed.append((obs.uuid, blob.points_map))
+            if keyframe and match.class_name not in cfg.walker_classes and is_solid(blob.points_cam):
+                held.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
             measurements.append(self._measurement(frame, blob, match, dets, (obs, longest)))
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
@@ -375,7 +376,7 @@ class ForegroundStage:
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
         if keyframe:
-            self._solid.add(frame, unnamed)
+            self._solid.add(frame, held)
         return observations, measurements, surfaces
 
     def _judged(
@@ -473,6 +474,10 @@ class ForegroundStage:
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
         self._walls = _wall_boxes(world)
         instances = [self._instance(t) for t in closed]
+        folded, grown = self._fold_pieces()
+        instances = [i for i in instances if i.uuid not in folded]
+        instances += [i for i in grown if all(i is not j for j in instances)]
+        gone += folded
         counts: dict[str, int] = {}
         if self.config.reidentify:
             static = {t.uuid for t in tracks if t.confirmed and is_static(t, self.tracker.config)}
@@ -481,6 +486,29 @@ class ForegroundStage:
             gone += absorbed
         instances += self._geometry_only(world, instances)
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
+
+    def _fold_pieces(self) -> tuple[list[str], list[Instance]]:
+        """One place, one object: a static named instance whose box lies for ``PIECE_SHARE``
+        inside the box of a static instance of another named class seen in more views is a
+        piece of it (a couch's end taken for a chair); its views join that one's. Returns the
+        uuids folded away and the instances that took their views."""
+        walkers = self.tracker.config.walker_classes
+        named = [i for i in self._instances.values()
+                 if i.state == "static" and i.class_name != UNKNOWN and i.class_name not in walkers]
+        folded: list[str] = []
+        grown: list[Instance] = []
+        for piece in sorted(named, key=lambda i: len(i.observation_uuids)):
+            wholes = [i for i in named if i.class_name != piece.class_name and i.uuid not in folded
+                      and len(i.observation_uuids) > len(piece.observation_uuids)
+                      and overlap_share(piece.box, i.box) >= PIECE_SHARE]
+            if wholes:
+                whole = max(wholes, key=lambda i: len(i.observation_uuids))
+                whole.observation_uuids = [*whole.observation_uuids, *piece.observation_uuids]
+                folded.append(piece.uuid)
+                grown.append(whole)
+        for uuid in folded:
+            del self._instances[uuid]
+        return folded, [i for i in grown if i.uuid not in folded]
 
     def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
         """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
