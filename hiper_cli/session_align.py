@@ -23,14 +23,12 @@ from hiper_cli.errors import ConfigError, KnowledgeBaseError
 from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.sessions import Alignment
 from hiper_cli.model import Environment
-from hiper_cli.perceive.align import BackgroundCloud, refine, register
+from hiper_cli.perceive.align import BackgroundCloud, register
 from hiper_cli.types import Frame
 
-__all__ = ["ALIGN_FRAMES", "FIRST_S", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment",
-           "first_seconds_cloud"]
+__all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment"]
 
 ALIGN_FRAMES = 40  # frames spread over the log make its cloud
-FIRST_S = 10.0  # ... and over its first seconds, where its odometry has not drifted yet
 MIN_FITNESS = 0.4  # below this share of the log's background on the map, the log is refused
 CLOUD_EVERY_S = 0.5  # the place's cloud takes a frame this often
 
@@ -63,20 +61,6 @@ def log_cloud(reader: Any, n: int = ALIGN_FRAMES) -> np.ndarray:
     return cloud.points()
 
 
-def first_seconds_cloud(reader: Any, seconds: float = FIRST_S, n: int = ALIGN_FRAMES) -> np.ndarray | None:
-    """The log's background cloud from ``n`` frames spread over its first ``seconds``; None for
-    a reader that does not list its stamps."""
-    entries = getattr(reader, "entries", None)
-    if not entries:
-        return None
-    stamps = np.array([e.stamp_s for e in entries], dtype=np.float64)
-    last = int(np.searchsorted(stamps, stamps[0] + seconds, side="right"))
-    cloud = BackgroundCloud()
-    for k in np.unique(np.linspace(0, max(last - 1, 0), min(n, last)).astype(int)):
-        cloud.add_frame(reader.read_frame(int(k)))
-    return cloud.points()
-
-
 def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: str,
                      log_name: str) -> Alignment:
     """The transform this session's log gets (see the module docstring); refuses a poor fit."""
@@ -94,15 +78,7 @@ def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: st
             f"{found.fitness:.2f} < {MIN_FITNESS}: too little of its background matches the map); pass "
             "--env NEW if it shows another place, or --align FILE with its transform, or --align none if "
             "its poses are in the map frame")
-    # Odometry drifts from where the log starts: the whole log finds the transform, its first
-    # seconds fix it at the log's origin (structured-light sim: 0.10 -> 0.04 m, 0.6 -> 0.4 deg)
-    start = first_seconds_cloud(reader)
-    T_map_log = found.T_map_log
-    if start is not None and len(start) >= 100:
-        near = refine(start, place, found.T_map_log)
-        if near.fitness >= MIN_FITNESS:
-            T_map_log = near.T_map_log
-    return Alignment(T_map_log, "registration", found.fitness, found.rmse_m)
+    return Alignment(found.T_map_log, "registration", found.fitness, found.rmse_m)
 
 
 def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.types import Frame
 
-__all__ = ["BackgroundCloud", "Registration", "refine", "register"]
+__all__ = ["BackgroundCloud", "Registration", "register"]
 
 FloatArray = NDArray[np.float64]
 
@@ -147,9 +147,3 @@ def register(log_points: FloatArray, map_points: FloatArray, *, tries: int = 3,
         if found.fitness > best.fitness:
             best = found
     return best
-
-
-def refine(log_points: FloatArray, map_points: FloatArray, T0: FloatArray) -> Registration:
-    """Point-to-plane ICP of the log's points to the map's from ``T0`` (``_refine``): a
-    transform found from the whole log, refined on a part of it."""
-    return _refine(_cloud(log_points, VOXEL_M), _cloud(map_points, VOXEL_M), T0)
