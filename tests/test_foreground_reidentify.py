@@ -252,7 +252,14 @@ def _edit_earlier(kb_path: Path, shift_chair_m: tuple[float, float], add: str,
             moved["data"]["vacated_s"] = vacated_s
         other = Instance(layer="foreground", class_name=add, box=Box3D.from_dict(moved["box"]),
                          first_seen_s=chair.first_seen_s, last_seen_s=chair.last_seen_s)
-        kb.put_documents([moved, other.to_dict()], env_uuid=kb.environment("house_small").uuid)
+        env = kb.environment("house_small")
+        kb.put_documents([moved, other.to_dict()], env_uuid=env.uuid)
+        # the place's cloud saw it there too: its points above the floor go with it
+        cloud = np.array(kb.map_cloud(env), dtype=np.float64)
+        lo, hi = chair.box.aabb()
+        inside = np.all((cloud >= lo - 0.05) & (cloud <= hi + 0.05), axis=1) & (cloud[:, 2] > lo[2] + 0.08)
+        cloud[inside, :2] += shift_chair_m
+        kb.store_map_cloud(env, cloud)
         kb.sync_graph()
     return chair.uuid, other.uuid
 

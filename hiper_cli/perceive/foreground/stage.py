@@ -548,9 +548,16 @@ class ForegroundStage:
         vacated = self._empty.vacated() if self._empty is not None else {}
         # seen empty now, or by an earlier session: gone from where it was
         gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
+        # what was present until now left in the gap before this session: not for a place the
+        # earlier sessions saw occupied (``occupied_before``); one an earlier session already
+        # found gone may have gone anywhere then
         occupied = self.occupied_before or (lambda _: False)
-        movers = [n for n in new if n.uuid not in paired and not occupied(n)]
-        moved = moved_pairs(movers, gone, max_m=REIDENTIFY_MOVED_M)
+        free = [n for n in new if n.uuid not in paired and not occupied(n)]
+        moved = moved_pairs([n for n in new if n.uuid not in paired],
+                            [i for i in gone if "vacated_s" in i.data], max_m=REIDENTIFY_MOVED_M)
+        taken = {u for e, n in moved for u in (e.uuid, n.uuid)}
+        moved += moved_pairs([n for n in free if n.uuid not in taken],
+                             [i for i in gone if "vacated_s" not in i.data], max_m=REIDENTIFY_MOVED_M)
         found += moved
         for old, absorbed in found:
             fold(old, absorbed)
