@@ -22,7 +22,7 @@ import typer
 __all__ = ["LOG_FLAGS", "with_log_flags"]
 
 # LogOptions field -> (type, default, flags, help), in --help order. Typer needs them when the
-# CLI starts, before the library is imported; tests/test_cli_common.py checks they match LogOptions.
+# CLI starts, before the library is imported; tests/commands/test_cli_common.py checks they match LogOptions.
 LOG_FLAGS: dict[str, tuple[Any, Any, tuple[str, ...], str]] = {
     "poses": (Path | None, None, ("--poses",),
               "TUM trajectory (stamp tx ty tz qx qy qz qw) replacing the log's poses."),

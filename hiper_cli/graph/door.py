@@ -3,7 +3,7 @@
 Only ``graph/`` touches SQLite, Oxigraph or the store's files; the interpretation, the viewer,
 re-anchoring and the live runner ask ``KnowledgeBase`` through these methods (with those of
 ``reads.py`` and ``kb.py``), so a change of storage stays inside this package. docs/kb.md
-shows each in use; tests/test_kb_door.py runs those examples and fails on a store reached
+shows each in use; tests/graph/test_kb_door.py runs those examples and fails on a store reached
 around the door.
 """
 
