@@ -107,8 +107,9 @@ def build_cache(repo: Path, cache: Path) -> dict[str, Any]:
     cache.mkdir(parents=True, exist_ok=True)
     shutil.copytree(FIXTURE, cache / "log", dirs_exist_ok=True)
     steps = [
+        # every observation kept: the export must outgrow the small disk of the disk-full cases
         ["perceive", str(cache / "log"), "--kb", str(cache / "template.hiper"), "--detector", "truth",
-         "--json"],
+         "--keep-observations", "all", "--json"],
         ["export", str(cache / "export.json"), "--kb", str(cache / "template.hiper"), "--format", "json"],
         ["convert", str(cache / "log"), str(cache / "log.mcap"), "--to", "mcap", "--json"],
         ["convert", str(cache / "log"), str(cache / "log.bag"), "--to", "rosbag1", "--json"],

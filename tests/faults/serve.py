@@ -84,12 +84,20 @@ def _parse(raw: bytes, seconds: float) -> Reply:
     return Reply(int(match.group(1)) if match else 0, headers, body.decode("utf-8", "replace"), seconds)
 
 
+def _ctrl_c_as_in_a_shell() -> None:
+    """The server starts as a terminal would start it: SIGINT neither ignored nor blocked,
+    whatever the test process (or a library it loaded) did to its own signals."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def _serve_probe(talk: Callable[[Server, Workspace], None], *flags: str) -> Callable[[Workspace], Result]:
     def probe(ws: Workspace) -> Result:
         start = time.monotonic()
         proc = subprocess.Popen(hiper_argv(ws.repo, ["serve", "--kb", str(ws.kb), "--port", "0", *flags]),
                                 cwd=ws.root, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                env={**os.environ, "COLUMNS": "300", "NO_COLOR": "1"})
+                                env={**os.environ, "COLUMNS": "300", "NO_COLOR": "1"},
+                                preexec_fn=_ctrl_c_as_in_a_shell)
         assert proc.stdout is not None
         line = proc.stdout.readline()  # "serving KB read-only at http://127.0.0.1:PORT/query ..."
         found = re.search(r"http://127\.0\.0\.1:(\d+)/query", line)

@@ -178,7 +178,8 @@ class NeedsModel:
 def test_default_stages_that_cannot_build_are_reported_not_fatal(tmp_path, monkeypatch):
     import hiper_cli.pipeline as pipeline
 
-    registry = {"probe": "tests.kb_helpers:ProbeStage", "needs_model": "tests.test_kb_pipeline:NeedsModel"}
+    registry = {"probe": "tests.kb_helpers:ProbeStage",
+                "needs_model": "tests.graph.test_kb_pipeline:NeedsModel"}
     monkeypatch.setattr(stage_module, "STAGES", registry)
     monkeypatch.setattr(pipeline, "STAGES", registry)
     stages, unavailable = build_stages(None, tmp_path / "log")
