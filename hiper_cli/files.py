@@ -18,7 +18,7 @@ from pathlib import Path
 
 from hiper_cli.errors import DataError
 
-__all__ = ["atomic_output", "os_error", "output_folder", "refuse_inside"]
+__all__ = ["atomic_output", "folder_bytes", "os_error", "output_folder", "refuse_inside"]
 
 KB_MARKER = "documents.sqlite"
 
@@ -37,6 +37,17 @@ def os_error(path: Path | str, err: OSError, what: str = "write") -> DataError:
     else:
         fix = "check the path and the disk"
     return DataError(f"{path}: cannot {what} it ({reason}); {fix}")
+
+
+def folder_bytes(root: Path) -> int:
+    """Bytes of the files under ``root`` (0 when it is absent). A file removed while it is
+    counted (the graph store compacts its tables in the background) counts as gone."""
+    total = 0
+    for path in root.rglob("*") if root.exists() else ():
+        with contextlib.suppress(FileNotFoundError):
+            if path.is_file():
+                total += path.stat().st_size
+    return total
 
 
 def refuse_inside(path: Path, what: str) -> None:

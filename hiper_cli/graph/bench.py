@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from hiper_cli.errors import ConfigError
+from hiper_cli.files import folder_bytes
 
 __all__ = ["BenchConfig", "parse_sizes", "run_bench", "run_size"]
 
@@ -192,7 +193,7 @@ def run_size(n_obs: int, root: str, config: BenchConfig) -> dict[str, Any]:
         "sparql_instances_of_class": _percentiles(_time(sparql_class, max(10, q // 4))),
     }
     check = kb.check(repair=False)
-    size = sum(p.stat().st_size for p in (Path(root) / "bench.hiper").rglob("*") if p.is_file())
+    size = folder_bytes(Path(root) / "bench.hiper")
     kb.close()
     return {
         "observations": written,

@@ -28,6 +28,7 @@ import numpy as np
 
 from hiper_cli import DEFAULT_KB
 from hiper_cli.errors import ConfigError, GraphDamagedError, KnowledgeBaseError
+from hiper_cli.files import folder_bytes
 from hiper_cli.graph.documents import DocumentStore, Session
 from hiper_cli.graph.door import DOCUMENTS_FILE, KbDoor, is_knowledge_base
 from hiper_cli.graph.location import kb_location
@@ -509,7 +510,7 @@ class KnowledgeBase(KbReads, KbDoor):
         counts = [
             {"type": t, "layer": layer, "class": cls, "count": n} for t, layer, cls, n in self.docs.counts()
         ]
-        size = sum(p.stat().st_size for p in self.root.rglob("*") if p.is_file()) if self.root.exists() else 0
+        size = folder_bytes(self.root)
         return {
             "kb": self.location,
             "documents_path": str(self.docs.path),
