@@ -33,6 +33,7 @@ from hiper_cli.graph.codec import dumps, loads
 from hiper_cli.graph.grid import GRID_CELL_M, cell_index, cell_key, grid_rows
 from hiper_cli.graph.lookups import Lookups
 from hiper_cli.graph.poserows import pose_at
+from hiper_cli.graph.schema import DOCUMENTS_SCHEMA
 from hiper_cli.graph.sqlite_guard import (
     GuardedConnection,
     connect_read_only,
@@ -54,75 +55,6 @@ STAGED_ROWS = 4000
 # The R*Tree row of a moving document (an instance) is its box grown by this much; updates
 # inside it leave the index alone.
 BOX_SLACK_M = 0.25
-
-_SCHEMA = """
-CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE IF NOT EXISTS docs (
-    id INTEGER PRIMARY KEY,
-    uuid TEXT NOT NULL UNIQUE,
-    type TEXT NOT NULL,
-    layer TEXT,
-    class TEXT,
-    stamp_s REAL,
-    instance_uuid TEXT,
-    session_id INTEGER,
-    env_uuid TEXT,
-    seq INTEGER NOT NULL,
-    body TEXT NOT NULL,
-    created_seq INTEGER
-);
-DROP INDEX IF EXISTS docs_type_class_stamp;
-CREATE INDEX IF NOT EXISTS docs_type_stamp_class ON docs (type, stamp_s, class);
-CREATE INDEX IF NOT EXISTS docs_seq ON docs (seq);
-CREATE VIRTUAL TABLE IF NOT EXISTS docs_box USING rtree(id, min_x, max_x, min_y, max_y, min_z, max_z);
-CREATE TABLE IF NOT EXISTS obs_cells (
-    cell INTEGER NOT NULL, id INTEGER NOT NULL,
-    min_x REAL, max_x REAL, min_y REAL, max_y REAL, min_z REAL, max_z REAL,
-    PRIMARY KEY (cell, id)
-) WITHOUT ROWID;
-CREATE INDEX IF NOT EXISTS obs_cells_id ON obs_cells (id);
-CREATE TABLE IF NOT EXISTS links (
-    instance_uuid TEXT NOT NULL,
-    observation_uuid TEXT NOT NULL,
-    seq INTEGER NOT NULL,
-    PRIMARY KEY (instance_uuid, observation_uuid)
-) WITHOUT ROWID;
-CREATE INDEX IF NOT EXISTS links_seq ON links (seq);
-CREATE TABLE IF NOT EXISTS obs_cells_new (
-    id INTEGER PRIMARY KEY, cell INTEGER NOT NULL,
-    min_x REAL, max_x REAL, min_y REAL, max_y REAL, min_z REAL, max_z REAL
-);
-CREATE TABLE IF NOT EXISTS links_new (instance_uuid TEXT NOT NULL, observation_uuid TEXT NOT NULL,
-                                      seq INTEGER NOT NULL);
-CREATE VIEW IF NOT EXISTS all_links AS
-    SELECT instance_uuid, observation_uuid, seq FROM links
-    UNION ALL SELECT instance_uuid, observation_uuid, seq FROM links_new;
-CREATE TABLE IF NOT EXISTS tombstones (
-    uuid TEXT PRIMARY KEY, type TEXT NOT NULL, layer TEXT, seq INTEGER NOT NULL
-) WITHOUT ROWID;
-CREATE INDEX IF NOT EXISTS tombstones_seq ON tombstones (seq);
-CREATE TABLE IF NOT EXISTS sessions (
-    id INTEGER PRIMARY KEY,
-    env_uuid TEXT NOT NULL,
-    log_path TEXT NOT NULL,
-    stages TEXT NOT NULL,
-    started_s REAL NOT NULL,
-    ended_s REAL,
-    frames INTEGER NOT NULL DEFAULT 0,
-    last_pose_id INTEGER,
-    last_stamp_s REAL,
-    seq INTEGER NOT NULL
-);
-CREATE INDEX IF NOT EXISTS sessions_seq ON sessions (seq);
-CREATE TABLE IF NOT EXISTS poses (
-    session_id INTEGER NOT NULL,
-    pose_id INTEGER NOT NULL,
-    stamp_s REAL NOT NULL,
-    T_map_cam TEXT NOT NULL,
-    PRIMARY KEY (session_id, pose_id)
-) WITHOUT ROWID;
-"""
-
 
 def pose_text(T_map_cam: Any) -> str:
     """A pose row's 4×4 matrix as compact JSON: rotation to 1e-6, translation to 10 µm (a
@@ -249,7 +181,7 @@ class DocumentStore(ChangeFeed, Lookups):
                 # creating the store leaves an empty file (which the next open initialises), never
                 # tables without a version (which would read as another program's database)
                 self._db.executescript(
-                    "BEGIN IMMEDIATE;\n" + _SCHEMA + TRAJECTORIES_SCHEMA
+                    "BEGIN IMMEDIATE;\n" + DOCUMENTS_SCHEMA + TRAJECTORIES_SCHEMA
                     + f"\nINSERT OR IGNORE INTO meta VALUES ('schema_version', '{SCHEMA_VERSION}');"
                     "\nINSERT OR IGNORE INTO meta VALUES ('seq', '0');\nCOMMIT;"
                 )
