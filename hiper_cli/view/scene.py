@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.graph import KnowledgeBase
+from hiper_cli.graph.door import SessionPoses
 from hiper_cli.model import Box3D, Instance
 from hiper_cli.view.floor import FloorImage, floor_images
 from hiper_cli.view.window import TimeWindow
@@ -72,14 +73,8 @@ class TrackItem:
         return np.diff(self.stamps_s) <= gap_s
 
 
-@dataclass(frozen=True)
-class RobotPath:
-    """The camera poses of one session: ``stamps_s`` (N,), ``T_map_cam`` (N, 4, 4)."""
-
-    session_id: int
-    log_path: str
-    stamps_s: NDArray[np.float64]
-    T_map_cam: NDArray[np.float64]
+# the camera poses of one session, within the window: the knowledge base's own record
+RobotPath = SessionPoses
 
 
 @dataclass(frozen=True)
