@@ -141,23 +141,30 @@ class SeenBox:
             self._moved = (n, self._moved_now())
         return self._moved[1]
 
-    def shift_m(self) -> float:
+    def shift_m(self, every_blob: bool = False) -> float:
         """How far the object went, horizontally: between the (median) box of its first quarter
         of blobs and that of its last, the lesser move of the two sides along each axis when
         both moved the same way (0 otherwise). A blob that grew as more of it came into view
-        moved one side only; a walker moves both (0 with fewer than ``MIN_MOVED_BOXES``)."""
+        moved one side only; a walker moves both (0 with fewer than ``MIN_MOVED_BOXES``).
+        ``every_blob``: of all the latest blobs, not the named ones alone (``_used``): the
+        path of a walker, whom a detector names in some frames only."""
         if len(self.lower_m) < MIN_MOVED_BOXES:
             return 0.0
-        (first_lo, first_hi), (last_lo, last_hi) = self._quarters()[2:]
+        (first_lo, first_hi), (last_lo, last_hi) = self._quarters(every_blob)[2:]
         d_lower, d_upper = last_lo - first_lo, last_hi - first_hi
         both = np.where(d_lower * d_upper > 0, np.minimum(np.abs(d_lower), np.abs(d_upper)), 0.0)
         return float(np.hypot(*both))
 
-    def _quarters(self) -> tuple[FloatArray, FloatArray, tuple[FloatArray, FloatArray],
-                                 tuple[FloatArray, FloatArray]]:
-        """The blobs' (lower, upper) corners (``_boxes``), then the horizontal (lower, upper)
-        corners of the median box of the first quarter of them and of the last quarter."""
-        lower, upper = self._boxes()
+    def _quarters(self, every_blob: bool = False) -> tuple[
+        FloatArray, FloatArray, tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]
+    ]:
+        """The blobs' (lower, upper) corners (``_boxes``; ``every_blob``: of all the latest), then
+        the horizontal (lower, upper) corners of the median box of the first quarter of them and
+        of the last quarter."""
+        if every_blob:
+            lower, upper = np.array(self._latest(self.lower_m)), np.array(self._latest(self.upper_m))
+        else:
+            lower, upper = self._boxes()
         k = max(len(lower) // 4, 1)
         first = (np.median(lower[:k, :2], axis=0), np.median(upper[:k, :2], axis=0))
         last = (np.median(lower[-k:, :2], axis=0), np.median(upper[-k:, :2], axis=0))

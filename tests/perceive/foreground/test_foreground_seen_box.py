@@ -137,3 +137,18 @@ def test_a_table_with_bottles_named_on_it_is_the_table_the_background_mapped():
     mapped = Box3D(np.array([1.86, 0.41, 0.76]), np.array([1.09, 0.8, 0.02]))
     assert withdraw_mapped(tracker, [mapped], 0.1) == [track.uuid]
     assert tracker.tracks == []
+
+
+def test_a_walker_named_in_a_few_frames_only_went_its_way():
+    """Degraded bookstore: a person named in 11 of the 25 frames of a walk (blur, JPEG), then
+    followed as unnamed blobs of a person's size. The named blobs alone straddle the turn at
+    the walk's end and went nowhere; all of its blobs went 1.4 m: a walker who walked, whose
+    stored speed is its pace, not a static person at speed 0."""
+    xs = [0.04 * k for k in range(6)] + [0.2 - 0.04 * k for k in range(1, 45)]  # 0.6 m/s, one turn
+    names = ["person"] * 11 + ["unknown"] * (len(xs) - 11)
+    frames = [[([x, 0.0, 0.0], [x + 0.4, 0.3, 1.7], name)] for x, name in zip(xs, names, strict=True)]
+    tracker = _static_run(frames)
+    (track,) = tracker.tracks
+    assert track.class_name == "person"
+    assert track.seen.shift_m() < 0.5 < track.seen.shift_m(every_blob=True)
+    assert is_dynamic(track, tracker.config)
