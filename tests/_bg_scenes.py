@@ -100,3 +100,14 @@ def make_frame(boxes, T_map_cam, pose_id=0, stamp_s=None, noise_m=0.0, camera=CA
     rgb = np.zeros((camera.height, camera.width, 3), np.uint8)
     stamp = float(pose_id) * 0.5 if stamp_s is None else stamp_s
     return Frame(stamp, rgb, depth, camera, T_map_cam, pose_id, extras={"gt_ids": ids})
+
+
+def with_dropouts(frame, share, seed=0):
+    """``frame`` with ``share`` of its 4×4-pixel blocks returning no depth, as a real camera's
+    dark and glossy patches and grazing surfaces do (docs/sensors.md)."""
+    import dataclasses
+
+    rng = np.random.default_rng(seed)
+    h, w = frame.depth_m.shape
+    lost = np.repeat(np.repeat(rng.random((h // 4, w // 4)) < share, 4, axis=0), 4, axis=1)
+    return dataclasses.replace(frame, depth_m=np.where(lost, 0.0, frame.depth_m).astype(np.float32))

@@ -7,7 +7,7 @@ from hiper_cli.perceive.background import BackgroundConfig, BackgroundStage
 from hiper_cli.perceive.background.bounds import edge_evidence, is_open
 from hiper_cli.perceive.background.planes import extract_planes
 from hiper_cli.perceive.runner import run_stages
-from tests._bg_scenes import SceneBox, box_room, look_at, make_frame
+from tests._bg_scenes import SceneBox, box_room, look_at, make_frame, with_dropouts
 
 # a wardrobe 1.2 m wide, 2.0 m tall, 0.6 m deep, 1.4 m in front of the wall at y = 5
 WARDROBE = SceneBox(40, "cabinet", (2.4, 3.0, 0.0), (3.6, 3.6, 2.0))
@@ -80,3 +80,32 @@ def test_a_far_wall_over_shelves_is_as_tall_as_the_view_shows_it():
 
     assert len(far_walls()) == 1
     assert far_walls(wall_view_bounded=False) == []
+
+
+def _wall_edges(frame, offset_m):
+    """The edges of the largest vertical plane at y = ``offset_m``."""
+    cfg = BackgroundConfig()
+    grid, segments = extract_planes(frame.depth_m, frame.camera, cfg)
+    for seg in sorted(segments, key=lambda s: -s.n_points):
+        normal = frame.T_map_cam[:3, :3] @ seg.plane_cam[:3]
+        if abs(normal[2]) < 0.2:
+            centre = frame.T_map_cam[:3, :3] @ grid.points_cam[seg.mask].mean(axis=0) + frame.T_map_cam[:3, 3]
+            if abs(centre[1] - offset_m) < 0.1:
+                return edge_evidence(grid, frame.camera, seg, cfg)
+    raise AssertionError(f"no vertical plane at y = {offset_m}")
+
+
+def test_dropouts_on_a_wall_and_its_floor_do_not_open_it():
+    """A tenth of the returns lost in patches (the degraded bookstore's wall 1.9 m away lost
+    a quarter of its probes below its foot): a probe line that sees the floor go on at the
+    wall's foot, or nearer things, is no view of the room beyond (with any missing probe
+    opening its line, this wall was open at its foot); a line with no return at all still is."""
+    pose = look_at((3.0, 2.0, 1.2), (3.0, 5.0, 0.6))
+    frame = with_dropouts(make_frame(box_room(), pose), 0.1)
+    edges = _wall_edges(frame, 5.0)
+    assert edges["top"] != "open" and edges["bottom"] != "open"
+    assert not is_open(edges)
+    # the wardrobe seen from 2.7 m, patchy too: past its top the wall behind is farther
+    far = look_at((3.0, 0.3, 1.2), (3.0, 5.0, 1.4))
+    front = _wall_edges(with_dropouts(make_frame([*box_room(), WARDROBE], far), 0.1), 3.0)
+    assert front["top"] == "open"
