@@ -40,7 +40,6 @@ __all__ = [
 EdgeEvidence = Literal["open", "closed", "unknown", "front"]
 _OPEN, _CLOSED, _UNKNOWN, _MISSING = 1, 0, -1, 2
 OPEN, UNKNOWN = _OPEN, _UNKNOWN  # a probe or line that sees beyond the plane; no evidence
-MISSING = _MISSING  # a probe with no return where the plane would be within range
 
 
 def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.float64],
@@ -71,14 +70,15 @@ def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.flo
 @dataclass(frozen=True)
 class EdgeProbes:
     """The probes beyond one edge of a plane's mask, one row per image line across the edge
-    and one column per step out from it: ``cat`` open / closed / unknown (the image's edge is
-    closed), ``rows`` and ``cols`` their samples on the grid, ``inside`` whether the sample
-    is in the image."""
+    and one column per step out from it: ``cat`` open / closed / unknown / missing (the
+    image's edge is closed), ``rows`` and ``cols`` their samples on the grid, ``inside``
+    whether the sample is in the image, ``returned`` whether it has a depth."""
 
     cat: NDArray[np.int64]
     rows: NDArray[np.int64]
     cols: NDArray[np.int64]
     inside: NDArray[np.bool_]
+    returned: NDArray[np.bool_]
 
 
 def edge_probes(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, cfg: BackgroundConfig,
@@ -108,20 +108,21 @@ def edge_probes(grid: SampleGrid, camera: CameraIntrinsics, seg: PlaneSegment, c
     rows, cols = (along, line_idx) if side in ("top", "bottom") else (line_idx, along)
     rows, cols = np.ascontiguousarray(rows), np.ascontiguousarray(cols)
     cat[inside] = _probe(grid, camera, seg.plane_cam, rows[inside], cols[inside], cfg)
-    return EdgeProbes(cat, rows, cols, inside)
+    return EdgeProbes(cat, rows, cols, inside, inside & grid.valid[rows, cols])
 
 
 def line_verdicts(probes: EdgeProbes) -> NDArray[np.int64]:
     """Per image line: open when one of its probes sees beyond the plane (past a furniture
     front's convex corner the side bends away; past a room's concave corner the next wall is
-    nearer, an occluder), or when more of its probes have no return than lie on the plane
-    (nothing there within range); else closed when one lies on the plane or outside the
-    image, else unknown. A real sensor loses returns on dark or glossy patches and at grazing
-    incidence (docs/sensors.md): a few missing samples on a surface seen going on are such
-    dropouts, not the room beyond (with any missing probe opening its line, a wall 1.9 m away
-    on the degraded bookstore was open at its foot in 73 of 148 lines)."""
+    nearer, an occluder), or when none of its probes has a return where the plane would be
+    within range (nothing there); else closed when one lies on the plane or outside the
+    image, else unknown. A real sensor loses returns on dark or glossy patches, in the
+    projector's shadow and at grazing incidence (docs/sensors.md): missing samples in a line
+    that sees the surface go on, or nearer things, are such dropouts, not the room beyond
+    (with any missing probe opening its line, a wall 1.9 m away on the degraded bookstore was
+    open at its foot in 73 of 148 lines)."""
     cat = probes.cat
-    seen = ((cat != _MISSING) & probes.inside).any(axis=1)  # a return in the image past the edge
+    seen = probes.returned.any(axis=1)  # a return in the image past the edge
     open_ = (cat == _OPEN).any(axis=1) | ((cat == _MISSING).any(axis=1) & ~seen)
     return np.where(open_, _OPEN, np.where((cat == _CLOSED).any(axis=1), _CLOSED, _UNKNOWN))
 
