@@ -1,0 +1,55 @@
+"""Reading a log at a lower rate than it was recorded (``IndexedLog.max_rate_hz``, ``--max-hz``)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from hiper_cli.errors import ConfigError
+from hiper_cli.perceive.logs import open_log
+from hiper_cli.pipeline import PerceiveOptions
+from tests.logs_scene import make_frames
+from tests.perceive.logs.test_logs_bags import FORMATS, write_log
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    root = tmp_path_factory.mktemp("rate")
+    frames = make_frames(n=9)  # 10 Hz
+    return frames, {kind: write_log(root, kind, frames) for kind in FORMATS}
+
+
+@pytest.mark.parametrize("kind", FORMATS)
+def test_a_third_of_the_rate_keeps_every_third_frame_with_its_own_pose_id(scene, kind):
+    frames, paths = scene
+    reader = open_log(paths[kind])
+    reader.max_rate_hz = 10.0 / 3.0  # type: ignore[attr-defined]
+    got = list(reader)
+    assert [f.pose_id for f in got] == [0, 3, 6]
+    assert len(reader) == 3
+    for f in got:  # the kept frames are the log's own, images and all
+        np.testing.assert_array_equal(f.rgb, frames[f.pose_id].rgb)
+        assert f.stamp_s == pytest.approx(frames[f.pose_id].stamp_s, abs=1e-6)
+
+
+def test_jittered_stamps_keep_an_even_rate(tmp_path):
+    # frames 2 and 6 come 15 % of a step late: 4 and 8 are then 0.185 s after the frame kept before
+    frames = [replace(f, stamp_s=f.stamp_s + (0.015 if k % 4 == 2 else 0.0))
+              for k, f in enumerate(make_frames(n=9))]
+    reader = open_log(write_log(tmp_path, "tum", frames))
+    reader.max_rate_hz = 5.0  # type: ignore[attr-defined]
+    assert [f.pose_id for f in reader] == [0, 2, 4, 6, 8]
+
+
+def test_a_rate_above_the_logs_keeps_every_frame(scene):
+    _, paths = scene
+    reader = open_log(paths["tum"])
+    reader.max_rate_hz = 100.0  # type: ignore[attr-defined]
+    assert [f.pose_id for f in reader] == list(range(9))
+
+
+def test_a_rate_of_zero_is_refused():
+    with pytest.raises(ConfigError, match="--max-hz 0"):
+        PerceiveOptions.from_text(max_rate_hz=0.0)
