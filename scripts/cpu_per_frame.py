@@ -2,7 +2,9 @@
 
 Usage: python scripts/cpu_per_frame.py OUTDIR LOG [LOG ...] [--runs N] [--code DIR] [-- perceive options]
 
-Runs ``hiper perceive LOG --kb OUTDIR/NAME.hiper --replace`` ``--runs`` times (default 3) per log,
+Runs ``hiper perceive LOG --kb OUTDIR/NAME.hiper`` ``--runs`` times (default 3) per log, each into a
+new knowledge base (a log perceived again into a place the knowledge base holds is first registered
+to its map: seconds of work that are not the per-frame cost),
 with the checkout at ``--code`` (default this one) on ``PYTHONPATH``, and prints per log the median
 (and range) of the command's CPU time per frame (user + system, all its threads: what the command
 costs a machine, far less sensitive to other load than wall time) and of its frames per second
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -34,10 +37,11 @@ def one_run(code: Path, log: Path, kb: Path, extra: list[str]) -> tuple[float, f
     """CPU seconds (user + system of the child and its threads) and wall seconds of one perceive."""
     env = dict(os.environ, PYTHONPATH=str(code))
     env.setdefault("HIPER_MODELS", str(SHARED / "models"))
+    shutil.rmtree(kb, ignore_errors=True)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
     run = subprocess.run([sys.executable, "-m", "hiper_cli", "perceive", str(log), "--kb", str(kb),
-                          "--replace", "--json", *extra],
+                          "--json", *extra],
                          capture_output=True, text=True, env=env, check=False)
     wall_s = time.monotonic() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
