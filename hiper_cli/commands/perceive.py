@@ -22,8 +22,7 @@ def perceive_command(
     align: o.Align = "auto", keep_observations: o.Keep = "0", view: o.View = False,
     timings: o.Timings = False, idle_timeout: o.IdleTimeout = None, queue: o.Queue = 1,
     look_ahead: o.LookAhead = False, stats: o.Stats = False, as_json: Json = False,
-    max_hz: o.MaxHz = None, *,
-    log_options: LogOptions) -> None:
+    max_hz: o.MaxHz = None, *, log_options: LogOptions) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
     Each frame's results are written atomically; an interrupted run continues with --resume.

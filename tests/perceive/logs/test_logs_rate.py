@@ -9,7 +9,8 @@ import pytest
 
 from hiper_cli.errors import ConfigError
 from hiper_cli.perceive.logs import open_log
-from hiper_cli.pipeline import PerceiveOptions
+from hiper_cli.pipeline import PerceiveOptions, perceive_log
+from tests import REPO_ROOT
 from tests.logs_scene import make_frames
 from tests.perceive.logs.test_logs_bags import FORMATS, write_log
 
@@ -53,3 +54,11 @@ def test_a_rate_above_the_logs_keeps_every_frame(scene):
 def test_a_rate_of_zero_is_refused():
     with pytest.raises(ConfigError, match="--max-hz 0"):
         PerceiveOptions.from_text(max_rate_hz=0.0)
+
+
+def test_perceive_at_half_the_rate_reads_half_the_frames(tmp_path):
+    log = REPO_ROOT / "fixtures" / "house_small"  # 4 Hz
+    options = PerceiveOptions(stages=("background",), max_rate_hz=2.0)
+    summary = perceive_log(log, str(tmp_path / "kb.hiper"), options=options)
+    every = len(open_log(log))
+    assert summary.frames_total == summary.frames_read == (every + 1) // 2
