@@ -90,7 +90,7 @@ def check_source_flags(live: bool, source: Any, **given: Any) -> None:
     live_only = {"--idle-timeout": given["idle_timeout"] is not None, "--queue": given["queue"] != 1,
                  "--look-ahead": given["look_ahead"], "--stats": given["stats"]}
     log_only = {"--resume": given["resume"], "--replace": given["replace"], "--again": given["again"],
-                "--view": given["view"]}
+                "--view": given["view"], "--max-hz": given.get("max_hz") is not None}
     wrong = [flag for flag, on in (log_only if live else live_only).items() if on]
     if wrong:
         kind, where = ("a recorded log", "a zenoh:// source") if live else ("a zenoh:// source", source)

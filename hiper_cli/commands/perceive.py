@@ -43,7 +43,7 @@ def perceive_command(
         keep_observations=keep_observations, detector=detector, no_background_filter=no_background_filter,
         classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz, max_hz=max_hz)
     o.check_source_flags(is_live(log), log, idle_timeout=idle_timeout, queue=queue, look_ahead=look_ahead,
-                         stats=stats, resume=resume, replace=replace, again=again, view=view)
+                         stats=stats, resume=resume, replace=replace, again=again, view=view, max_hz=max_hz)
     if is_live(log):
         return perceive_live_command(str(log), kb, kb_docs, log_options, options, queue=queue, stats=stats,
                                      idle_timeout_s=idle_timeout, look_ahead=look_ahead, as_json=as_json)

@@ -62,3 +62,14 @@ def test_perceive_at_half_the_rate_reads_half_the_frames(tmp_path):
     summary = perceive_log(log, str(tmp_path / "kb.hiper"), options=options)
     every = len(open_log(log))
     assert summary.frames_total == summary.frames_read == (every + 1) // 2
+
+
+def test_a_live_source_refuses_max_hz(tmp_path):
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+
+    result = CliRunner().invoke(app, ["perceive", "zenoh://tcp/127.0.0.1:7447", "--kb", str(tmp_path / "kb"),
+                                      "--max-hz", "10"])
+    assert result.exit_code != 0 and "--max-hz is for a recorded log" in result.output
+    assert not (tmp_path / "kb").exists()
