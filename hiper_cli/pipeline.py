@@ -194,7 +194,7 @@ def perceive_log(
         options = replace(options, log_path=log)
     with open_kb(kb, docs_dir=kb_docs) as knowledge:
         if on_start is not None:
-            on_start(len(reader))
+            on_start(_frames_to_read(reader))
         return perceive(reader, knowledge, stages, options, progress=progress, on_frame=on_frame)
 
 
@@ -385,7 +385,7 @@ def perceive(
             stage.occupied_before = FreeBefore(grower.before).occupied
     world = kb.load_world(env)
     before = snapshot(world.foreground.values())
-    total = len(reader)
+    total = _frames_to_read(reader)
     summary = PerceiveSummary(
         log=log_name, kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=None, frames_total=total,
@@ -456,6 +456,12 @@ def perceive(
 
 
 ON_EXISTING = ("refuse", "replace", "again", "resume")
+
+
+def _frames_to_read(reader: LogReader) -> int:
+    """How many frames iterating ``reader`` reads: those its rate keeps (``IndexedLog.kept_ids``)."""
+    kept = getattr(reader, "kept_ids", None)
+    return len(kept()) if callable(kept) else len(reader)
 
 
 def _at_rate(reader: LogReader, max_rate_hz: float | None) -> LogReader:

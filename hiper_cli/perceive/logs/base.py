@@ -146,7 +146,7 @@ class IndexedLog:
     """Iterate at most this many frames per second of log time (``kept_ids``); None: all."""
 
     def __len__(self) -> int:
-        return len(self.kept_ids())
+        return len(self.entries)
 
     def kept_ids(self) -> list[int]:
         """The pose ids that iterating reads: every frame, or with ``max_rate_hz`` the first
@@ -240,5 +240,5 @@ class IndexedLog:
             yielded += 1
             yield frame
         if yielded == 0 and self.entries:
-            raise LogError(f"{self.path}: none of the {len(self)} frames can be read; first "
+            raise LogError(f"{self.path}: none of the {len(self.kept_ids())} frames can be read; first "
                            f"problem: {first_reason}")
