@@ -101,6 +101,9 @@ class PerceiveOptions:
     # summarised at the end of the session (``graph/compact.py``); None (the library's default;
     # ``hiper perceive`` summarises unless told otherwise) keeps every observation
     keep_observations_s: float | None = None
+    # perceive at most this many frames per second of log time; the others are not decoded
+    # (``IndexedLog.kept_ids``; a live source drops frames by itself); None: every frame
+    max_rate_hz: float | None = None
 
     @classmethod
     def from_text(
@@ -114,6 +117,7 @@ class PerceiveOptions:
         on_existing: str = "refuse",
         align: str = "auto",
         keep_observations_s: float | None = None,
+        max_rate_hz: float | None = None,
     ) -> PerceiveOptions:
         """From command-line text: ``stages`` comma-separated, ``options`` as ``STAGE.KEY=VALUE``.
 
@@ -128,9 +132,12 @@ class PerceiveOptions:
             for key, value in values.items():
                 if value is not None:
                     merged.setdefault(stage, {})[key] = value
+        if max_rate_hz is not None and not max_rate_hz > 0:
+            raise ConfigError(f"--max-hz {max_rate_hz}: expected a rate above 0 frames per second")
         names = None if stages is None else tuple(s.strip() for s in stages.split(",") if s.strip())
         return cls(stages=names, stage_options=merged, env_name=env_name, resume=resume,
-                   on_existing=on_existing, align=align, keep_observations_s=keep_observations_s)
+                   on_existing=on_existing, align=align, keep_observations_s=keep_observations_s,
+                   max_rate_hz=max_rate_hz)
 
 
 @dataclass(frozen=True)
@@ -181,13 +188,13 @@ def perceive_log(
     from hiper_cli.graph import open_kb
 
     options = options or PerceiveOptions()
-    reader = open_log(log, log_options or LogOptions())
+    reader = _at_rate(open_log(log, log_options or LogOptions()), options.max_rate_hz)
     stages = select_stages(log.resolve(), options)
     if options.log_path is None:
         options = replace(options, log_path=log)
     with open_kb(kb, docs_dir=kb_docs) as knowledge:
         if on_start is not None:
-            on_start(len(reader))
+            on_start(_frames_to_read(reader))
         return perceive(reader, knowledge, stages, options, progress=progress, on_frame=on_frame)
 
 
@@ -361,6 +368,7 @@ def perceive(
         stage_list, unavailable_stages = list(stages), {}
     env_name, resume, graph_sync_s = options.env_name, options.resume, options.graph_sync_s
     live = bool(getattr(reader, "live", False))  # a running robot: no read-ahead, its URL names it
+    reader = _at_rate(reader, options.max_rate_hz)
     source = options.log_path if options.log_path is not None else reader.info().path
     path = Path(source) if live else Path(source).resolve()
     log_name = str(source) if live else str(path)
@@ -377,7 +385,7 @@ def perceive(
             stage.occupied_before = FreeBefore(grower.before).occupied
     world = kb.load_world(env)
     before = snapshot(world.foreground.values())
-    total = len(reader)
+    total = _frames_to_read(reader)
     summary = PerceiveSummary(
         log=log_name, kb=kb.location, environment=env.name, session_id=session.id, stages=names,
         resumed_after_pose_id=None, frames_total=total,
@@ -448,6 +456,20 @@ def perceive(
 
 
 ON_EXISTING = ("refuse", "replace", "again", "resume")
+
+
+def _frames_to_read(reader: LogReader) -> int:
+    """How many frames iterating ``reader`` reads: those its rate keeps (``IndexedLog.kept_ids``)."""
+    kept = getattr(reader, "kept_ids", None)
+    return len(kept()) if callable(kept) else len(reader)
+
+
+def _at_rate(reader: LogReader, max_rate_hz: float | None) -> LogReader:
+    """``reader`` reading at most ``max_rate_hz`` frames per second of log time, where it can
+    skip frames before decoding them (a recorded log); as it is otherwise."""
+    if max_rate_hz is not None and hasattr(reader, "max_rate_hz"):
+        setattr(reader, "max_rate_hz", max_rate_hz)  # noqa: B010 (not part of the LogReader protocol)
+    return reader
 
 
 def _environment_for(kb: KnowledgeBase, env_name: str | None, path: Path) -> Any:

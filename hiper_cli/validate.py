@@ -69,6 +69,7 @@ OPTION_RANGES: dict[str, Range] = {
     "max_dt_s": Range(0.0, 60.0),
     "pose_drift": Range(0.0, 1.0),  # hiper convert --degrade: metres of drift per metre travelled
     "mapping_hz": Range(0.0, 1000.0, lo_open=True), "keyframe_hz": Range(0.0, 1000.0, lo_open=True),
+    "max_hz": Range(0.0, 1000.0, lo_open=True),  # hiper perceive --max-hz
     # hiper analyze
     "hours": Range(0.0, 1000.0, lo_open=True), "resolution_m": Range(0.001, 10.0),
     # hiper sim

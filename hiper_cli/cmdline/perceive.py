@@ -27,6 +27,9 @@ Exclude = Annotated[Text, typer.Option("--exclude-classes", help=(
     "Foreground: detector classes to drop, comma-separated (default: outdoor COCO classes and dining "
     'table; "" drops none).'))]
 MappingHz = Annotated[float | None, typer.Option("--mapping-hz", help="Background keyframe rate in Hz.")]
+MaxHz = Annotated[float | None, typer.Option("--max-hz", help=(
+    "Perceive at most this many frames per second of log time; the others are skipped unread "
+    "(default: every frame)."))]
 Options = Annotated[list[str] | None, typer.Option(
     "-o", "--option", help="Stage option STAGE.KEY=VALUE (repeatable).")]
 Resume = Annotated[bool, typer.Option(
@@ -66,7 +69,7 @@ Stats = Annotated[bool, typer.Option(
 def perceive_options(*, stages: str | None, option: list[str] | None, env: str | None, resume: bool,
                      replace: bool, again: bool, align: str, keep_observations: str, detector: str | None,
                      no_background_filter: bool, classes: str | None, exclude_classes: str | None,
-                     mapping_hz: float | None) -> PerceiveOptions:
+                     mapping_hz: float | None, max_hz: float | None = None) -> PerceiveOptions:
     """The flags as ``PerceiveOptions`` (each checked by ``PerceiveOptions.from_text``)."""
     from hiper_cli.pipeline import PerceiveOptions
 
@@ -77,7 +80,7 @@ def perceive_options(*, stages: str | None, option: list[str] | None, env: str |
     return PerceiveOptions.from_text(
         stages=stages, options=option or [], env_name=env, resume=resume,
         on_existing="replace" if replace else "again" if again else "refuse", align=align,
-        keep_observations_s=keep_duration_s(keep_observations),
+        keep_observations_s=keep_duration_s(keep_observations), max_rate_hz=max_hz,
         overrides={"foreground": foreground, "background": {"keyframe_hz": mapping_hz}})
 
 
@@ -87,7 +90,7 @@ def check_source_flags(live: bool, source: Any, **given: Any) -> None:
     live_only = {"--idle-timeout": given["idle_timeout"] is not None, "--queue": given["queue"] != 1,
                  "--look-ahead": given["look_ahead"], "--stats": given["stats"]}
     log_only = {"--resume": given["resume"], "--replace": given["replace"], "--again": given["again"],
-                "--view": given["view"]}
+                "--view": given["view"], "--max-hz": given.get("max_hz") is not None}
     wrong = [flag for flag, on in (log_only if live else live_only).items() if on]
     if wrong:
         kind, where = ("a recorded log", "a zenoh:// source") if live else ("a zenoh:// source", source)

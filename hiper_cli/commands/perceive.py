@@ -21,8 +21,8 @@ def perceive_command(
     resume: o.Resume = False, replace: o.Replace = False, again: o.Again = False, env: o.Env = None,
     align: o.Align = "auto", keep_observations: o.Keep = "0", view: o.View = False,
     timings: o.Timings = False, idle_timeout: o.IdleTimeout = None, queue: o.Queue = 1,
-    look_ahead: o.LookAhead = False, stats: o.Stats = False, as_json: Json = False, *,
-    log_options: LogOptions) -> None:
+    look_ahead: o.LookAhead = False, stats: o.Stats = False, as_json: Json = False,
+    max_hz: o.MaxHz = None, *, log_options: LogOptions) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
     Each frame's results are written atomically; an interrupted run continues with --resume.
@@ -41,9 +41,9 @@ def perceive_command(
     options = o.perceive_options(
         stages=stages, option=option, env=env, resume=resume, replace=replace, again=again, align=align,
         keep_observations=keep_observations, detector=detector, no_background_filter=no_background_filter,
-        classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz)
+        classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz, max_hz=max_hz)
     o.check_source_flags(is_live(log), log, idle_timeout=idle_timeout, queue=queue, look_ahead=look_ahead,
-                         stats=stats, resume=resume, replace=replace, again=again, view=view)
+                         stats=stats, resume=resume, replace=replace, again=again, view=view, max_hz=max_hz)
     if is_live(log):
         return perceive_live_command(str(log), kb, kb_docs, log_options, options, queue=queue, stats=stats,
                                      idle_timeout_s=idle_timeout, look_ahead=look_ahead, as_json=as_json)

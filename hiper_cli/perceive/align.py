@@ -34,29 +34,50 @@ ICP_COARSE_M = 0.3
 ICP_FINE_M = 0.05
 
 
+_KEY_BITS = 21  # voxel indices within +-2**20 (80 km at 8 cm) pack into one int64
+
+
+def _unique_rows(keys: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.intp]]:
+    """``np.unique(keys, axis=0, return_inverse=True)`` for (N, 3) integer voxel indices: the
+    same sorted rows and inverse, from one packed int64 per row (a 1-D sort, not a sort of
+    rows: some ten times faster)."""
+    half = 1 << (_KEY_BITS - 1)
+    if len(keys) == 0 or int(keys.min()) < -half or int(keys.max()) >= half:
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+        return uniq, inverse.reshape(-1)
+    shifted = keys + half
+    packed = (shifted[:, 0] << (2 * _KEY_BITS)) | (shifted[:, 1] << _KEY_BITS) | shifted[:, 2]
+    codes, inverse = np.unique(packed, return_inverse=True)
+    mask = (1 << _KEY_BITS) - 1
+    uniq = np.stack([codes >> (2 * _KEY_BITS), (codes >> _KEY_BITS) & mask, codes & mask], axis=1) - half
+    return uniq, inverse.reshape(-1)
+
+
 class BackgroundCloud:
     """A voxel-downsampled cloud (voxel centroids, map or log frame) grown frame by frame."""
 
     def __init__(self, voxel_m: float = VOXEL_M) -> None:
         self.voxel_m = voxel_m
-        self._sum: dict[tuple[int, int, int], FloatArray] = {}
+        self._sum: dict[tuple[int, int, int], list[float]] = {}  # x, y, z sums of the voxel's points
         self._n: dict[tuple[int, int, int], int] = {}
 
     def add_points(self, points: FloatArray) -> None:
         if len(points) == 0:
             return
         keys = np.floor(points / self.voxel_m).astype(np.int64)
-        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-        sums = np.zeros((len(uniq), 3))
-        np.add.at(sums, inverse.reshape(-1), points)
-        counts = np.bincount(inverse.reshape(-1), minlength=len(uniq))
-        for key, s, n in zip(map(tuple, uniq.tolist()), sums, counts, strict=True):
-            if key in self._sum:
-                self._sum[key] = self._sum[key] + s
-                self._n[key] += int(n)
+        uniq, inverse = _unique_rows(keys)
+        # per voxel, the sums of its points in input order (as ``np.add.at``), one pass per axis
+        sums = np.stack([np.bincount(inverse, weights=points[:, k], minlength=len(uniq)) for k in range(3)],
+                        axis=1)
+        counts = np.bincount(inverse, minlength=len(uniq))
+        for key, s, n in zip(map(tuple, uniq.tolist()), sums.tolist(), counts.tolist(), strict=True):
+            old = self._sum.get(key)
+            if old is not None:
+                self._sum[key] = [old[0] + s[0], old[1] + s[1], old[2] + s[2]]
+                self._n[key] += n
             else:
                 self._sum[key] = s
-                self._n[key] = int(n)
+                self._n[key] = n
 
     def add_frame(self, frame: Frame, T_map_cam: FloatArray | None = None) -> None:
         """The frame's depth returns (sparse pixels, up to ``MAX_DEPTH_M``) in the frame of
@@ -75,8 +96,8 @@ class BackgroundCloud:
     def points(self) -> FloatArray:
         if not self._sum:
             return np.zeros((0, 3))
-        keys = list(self._sum)
-        return np.array([self._sum[k] / self._n[k] for k in keys])
+        sums = np.array(list(self._sum.values()), dtype=np.float64)
+        return sums / np.array(list(self._n.values()), dtype=np.float64)[:, None]
 
     def __len__(self) -> int:
         return len(self._sum)

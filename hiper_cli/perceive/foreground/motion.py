@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import lru_cache
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -77,50 +77,59 @@ def transition(dt: float) -> FloatArray:
     return F
 
 
+_H = np.hstack([np.eye(3), np.zeros((3, 3))])  # a centre is observed: the first three states
+_I6 = np.eye(6)
+
+
 class ConstantVelocityKF:
-    """The default model: a constant-velocity Kalman filter (filterpy) observing position.
+    """The default model: a constant-velocity Kalman filter observing position.
 
     ``measurement_noise_m``: σ of an observed centre; the initial velocity variance is
-    ``INITIAL_VELOCITY_VAR`` (m/s)² until a second observation gives the velocity.
+    ``INITIAL_VELOCITY_VAR`` (m/s)² until a second observation gives the velocity. The
+    equations are filterpy's ``KalmanFilter`` (Joseph-form update), written out: the same
+    numbers, without importing filterpy (which imports scipy.stats: a second of CPU per run).
     """
 
     INITIAL_VELOCITY_VAR = 1.0
 
     def __init__(self, center_map_m: FloatArray, measurement_noise_m: float) -> None:
-        from filterpy.kalman import KalmanFilter
-
-        kf: Any = KalmanFilter(dim_x=6, dim_z=3)
-        kf.x = np.r_[center_map_m, np.zeros(3)].reshape(6, 1)
-        kf.H = np.hstack([np.eye(3), np.zeros((3, 3))])
+        self._x: FloatArray = np.r_[center_map_m, np.zeros(3)].reshape(6, 1)
         r = measurement_noise_m**2
-        kf.R = np.eye(3) * r
+        self._R: FloatArray = np.eye(3) * r
         v = self.INITIAL_VELOCITY_VAR
-        kf.P = np.diag([r, r, r, v, v, v])
-        self._kf = kf
+        self._P: FloatArray = np.diag([r, r, r, v, v, v])
 
     @property
     def x(self) -> FloatArray:
-        state: FloatArray = self._kf.x[:, 0]
+        state: FloatArray = self._x[:, 0]
         return state
 
     @property
     def P(self) -> FloatArray:
-        covariance: FloatArray = self._kf.P
-        return covariance
+        return self._P
 
     def predict(self, dt_s: float, q: float, q_vertical: float) -> None:
-        self._kf.predict(F=transition(dt_s), Q=process_noise(dt_s, q, q_vertical))
+        F = transition(dt_s)
+        self._x = np.dot(F, self._x)
+        self._P = np.dot(np.dot(F, self._P), F.T) + process_noise(dt_s, q, q_vertical)
 
     def update(self, center_map_m: FloatArray) -> None:
-        self._kf.update(center_map_m.reshape(3, 1))
+        z = np.asarray(center_map_m, dtype=np.float64).reshape(3, 1)
+        y = z - np.dot(_H, self._x)
+        PHT = np.dot(self._P, _H.T)
+        S = np.dot(_H, PHT) + self._R
+        K = np.dot(PHT, np.linalg.inv(S))
+        self._x = self._x + np.dot(K, y)
+        I_KH = _I6 - np.dot(K, _H)
+        self._P = np.dot(np.dot(I_KH, self._P), I_KH.T) + np.dot(np.dot(K, self._R), K.T)
 
     def reset(self, x: FloatArray, P: FloatArray) -> None:
-        self._kf.x = np.asarray(x, dtype=np.float64).reshape(6, 1)
-        self._kf.P = P
+        self._x = np.asarray(x, dtype=np.float64).reshape(6, 1)
+        self._P = P
 
     def decay_velocity(self, factor: float, P_scale: FloatArray, P_add: FloatArray) -> None:
-        self._kf.x[3:, 0] *= factor
-        self._kf.P = self._kf.P * P_scale + P_add
+        self._x[3:, 0] *= factor
+        self._P = self._P * P_scale + P_add
 
 
 # name -> factory(center_map_m, measurement_noise_m)

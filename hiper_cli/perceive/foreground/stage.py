@@ -173,7 +173,6 @@ class ForegroundStage:
         self.config = ForegroundConfig.from_options(**options)
         cfg = self.config
         # Import the heavy modules now, not inside the first frame's timing.
-        import filterpy.kalman  # noqa: F401
         import scipy.optimize
         import scipy.sparse.csgraph  # noqa: F401
 

@@ -197,8 +197,9 @@ class BagReader(IndexedLog):
 
     def _decoded(self) -> Iterator[tuple[int, ImagePair | LogError]]:
         need: dict[tuple[str, int], list[tuple[int, str]]] = {}
-        for k, entry in enumerate(self.entries):
-            for role, (topic, index, _, _) in zip(("rgb", "depth"), entry.locator, strict=True):
+        kept = self.kept_ids()
+        for k in kept:
+            for role, (topic, index, _, _) in zip(("rgb", "depth"), self.entries[k].locator, strict=True):
                 need.setdefault((topic, index), []).append((k, role))
         ready: dict[int, dict[str, Any]] = {}
         counters = {self.rgb_topic: 0, self.depth_topic: 0}
@@ -214,15 +215,15 @@ class BagReader(IndexedLog):
                         ready.setdefault(k, {})[role] = self._decode(reader, conn, raw, role, index)
                     except LogError as err:
                         ready.setdefault(k, {})[role] = err
-                while next_k < len(self.entries) and len(ready.get(next_k, {})) == 2:
-                    yield next_k, self._pair(ready.pop(next_k))
+                while next_k < len(kept) and len(ready.get(kept[next_k], {})) == 2:
+                    yield kept[next_k], self._pair(ready.pop(kept[next_k]))
                     next_k += 1
         except _bag_errors() as err:
             raise LogError(f"{self.bag}: the bag breaks off while reading ({err}); the frames before were "
                            "read") from err
         finally:
             reader.close()
-        for k in range(next_k, len(self.entries)):
+        for k in kept[next_k:]:
             parts = ready.pop(k, {})
             if len(parts) == 2:
                 yield k, self._pair(parts)

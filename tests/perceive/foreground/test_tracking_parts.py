@@ -29,6 +29,18 @@ def test_constant_velocity_model_moves_by_its_velocity():
     np.testing.assert_allclose(model.x[3:], [0.25, -0.5, 0.0])
 
 
+def test_constant_velocity_model_learns_a_steady_walk_from_its_centres():
+    model = ConstantVelocityKF(np.zeros(3), measurement_noise_m=0.03)
+    for k in range(1, 61):  # 0.5 m/s along x, seen at 15 Hz
+        model.predict(1.0 / 15.0, q=0.5, q_vertical=0.1)
+        model.update(np.array([0.5 * k / 15.0, 0.0, 0.0]))
+    np.testing.assert_allclose(model.x[3:], [0.5, 0.0, 0.0], atol=0.01)
+    np.testing.assert_allclose(model.x[:3], [2.0, 0.0, 0.0], atol=0.01)
+    np.testing.assert_allclose(model.P, model.P.T, atol=1e-15)  # the Joseph form keeps P symmetric
+    assert np.all(np.linalg.eigvalsh(model.P) > 0)
+    assert model.P[0, 0] < 0.03**2  # the fused centre is surer than one measurement
+
+
 def test_hungarian_minimises_the_total_greedy_takes_the_cheapest_first():
     cost = np.array([[1.0, 2.0], [1.1, 9.0]])
     allowed = np.ones_like(cost, dtype=bool)
