@@ -303,6 +303,9 @@ class DocumentStore(ChangeFeed, Lookups):
     def set_meta(self, key: str, value: str) -> None:
         self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (key, value))
 
+    def drop_meta(self, key: str) -> None:
+        self._db.execute("DELETE FROM meta WHERE key = ?", (key,))
+
     @property
     def seq(self) -> int:
         """The sequence number of the last committed write."""

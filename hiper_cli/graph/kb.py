@@ -245,8 +245,14 @@ class KnowledgeBase(KbReads, KbDoor):
     def restart_session(self, session: Session) -> Session:
         """Drop what ``session`` wrote, in one transaction, and hand it back empty and unfinished
         (for perceiving its log again in its place); the graph is rebuilt from the documents."""
+        from hiper_cli.graph.mapcloud import drop_map_cloud
+
         with self.docs.transaction():
             self.docs.clear_session(session.id)
+            if not any(s.id != session.id for s in self.sessions(session.env_uuid)):
+                # the place's cloud is this session's alone: perceived again, the log must
+                # not be registered to its own earlier run
+                drop_map_cloud(self.docs, session.env_uuid)
         self.sync_graph(rebuild=True)
         restarted = self.docs.session(session.id)
         assert restarted is not None

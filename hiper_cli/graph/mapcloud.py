@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.graph.documents import DocumentStore
 
-__all__ = ["QUANTUM_M", "load_map_cloud", "store_map_cloud"]
+__all__ = ["QUANTUM_M", "drop_map_cloud", "load_map_cloud", "store_map_cloud"]
 
 QUANTUM_M = 0.005  # int16 steps: ±163 m around the map origin
 _KEY = "map_cloud:{}"
@@ -36,3 +36,8 @@ def load_map_cloud(docs: DocumentStore, env_uuid: str) -> NDArray[np.float64] | 
         return None
     raw = np.frombuffer(zlib.decompress(base64.b64decode(text)), dtype="<i2")
     return raw.reshape(-1, 3).astype(np.float64) * QUANTUM_M
+
+
+def drop_map_cloud(docs: DocumentStore, env_uuid: str) -> None:
+    """Forget the environment's cloud (inside a transaction): its only session was dropped."""
+    docs.drop_meta(_KEY.format(env_uuid))

@@ -275,3 +275,20 @@ def test_cli_kb_bench_reports_every_figure():
     assert 0 < row["peak_rss_before_final_sync_mb"] <= row["peak_rss_mb"]
     result = runner.invoke(app, ["kb", "bench", "--sizes", "ten"])
     assert result.exit_code == 2 and "comma-separated integers" in _text(result)
+
+
+def test_a_replaced_session_takes_the_place_cloud_only_it_built_with_it(tmp_path):
+    """Perceived again with --replace, a log must not be registered to its own earlier run."""
+    import numpy as np
+
+    with open_kb(tmp_path / "kb") as kb:
+        perceive(_log(), kb, [ProbeStage()])
+        (session,) = kb.docs.sessions()
+        env = next(e for e in kb.environments() if e.uuid == session.env_uuid)
+        kb.store_map_cloud(env, np.zeros((10, 3)))
+        kb.restart_session(session)
+        assert kb.map_cloud(env) is None
+        other = kb.start_session(env, "another.log", ["probe"])
+        kb.store_map_cloud(env, np.zeros((10, 3)))
+        kb.restart_session(other)
+        assert kb.map_cloud(env) is not None, "another session's cloud stays"
