@@ -8,11 +8,15 @@ Each observation votes for its class with its detection score (``unknown`` with
   ``unknown``;
 - not too short for the class (``class_sizes``): some view that named it, with its blob seen
   whole, showed an object at least as long as the class's smallest instance;
-- not refused (``refused_min_views``): once the track has enough *full views* (the whole object
-  in the image, large enough to name: ``whole.in_full_view``), a class a detection gave it must
-  have been named in more than ``refused_max_share`` of them, for the blob or inside its box. A
+- not refused (``refused_min_views``): a view that shows the whole object, large enough to name
+  (a *full view*, ``whole.in_full_view``), is one where a detector that gave the class would be
+  expected to give it again, for the blob or inside its box. A detector names an object it can
+  name in at least ``REFUSED_NAMING_RATE`` of its full views; a class named so rarely in them
+  that such a detector would do it by chance less often than ``REFUSED_CHANCE`` (binomial: none
+  of 5, one of 8, two of 11) is contradicted by the views, whatever the cut views said. A
   detector that names a class only where the border cut the object or something hid a part was
-  naming a part that looks like something else (a shelf's side taken for a chair's back).
+  naming a part that looks like something else (a shelf's side taken for a chair's back; a
+  walker's shoulders taken for a refrigerator).
 
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
@@ -21,13 +25,20 @@ record, merge and read them. ``Track._class_name`` caches the winner; ``record``
 
 from __future__ import annotations
 
+import math
 from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 
-__all__ = ["UNKNOWN", "absorb_votes", "record", "search_class", "winner"]
+__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "winner"]
 
 UNKNOWN = "unknown"
+REFUSED_NAMING_RATE: float = 0.5
+"""A detector names an object of a class it can name in at least this share of the views that
+show all of it (``whole.in_full_view``) ..."""
+REFUSED_CHANCE: float = 0.05
+"""... so a class named in so few of a track's full views that such a detector would name it
+that rarely with at most this probability is refused (``_refused``)."""
 
 
 class Vote(Protocol):
@@ -61,7 +72,6 @@ class Track(Protocol):
     min_class_share: float
     size_tolerance: float | None
     refused_min_views: int
-    refused_max_share: float
     _class_name: str | None
 
     @property
@@ -101,13 +111,14 @@ def absorb_votes(old: Track, new: Track) -> None:
     old._class_name = None
 
 
-def winner(track: Track) -> str:
-    """The vote's winner, or ``unknown`` without the evidence (see the module docstring)."""
+def winner(track: Track, judged: bool = True) -> str:
+    """The vote's winner, or ``unknown`` without the evidence (see the module docstring);
+    ``judged`` False: without asking the full views (``refused_min_views``)."""
     known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
     eligible = [
         k for k in sorted(known)
         if track.class_counts.get(k, 0) >= track.min_class_observations and _long_enough(track, k)
-        and not _refused(track, k)
+        and not (judged and _refused(track, k))
     ]
     if not eligible:
         return UNKNOWN
@@ -117,6 +128,13 @@ def winner(track: Track) -> str:
     if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
         return UNKNOWN
     return best
+
+
+def named_object(track: Track) -> bool:
+    """Whether detections named the track enough to give it a class, one its full views may
+    have refused since: they tell what it is not, not that nothing is there (the track is an
+    object, ``unknown``, as a walker named ``refrigerator`` still walks there)."""
+    return track.class_name != UNKNOWN or winner(track, judged=False) != UNKNOWN
 
 
 def search_class(track: Track) -> str:
@@ -140,11 +158,24 @@ def _long_enough(track: Track, class_name: str) -> bool:
 
 
 def _refused(track: Track, class_name: str) -> bool:
-    """Whether detections named ``class_name`` in at most ``refused_max_share`` of the track's
-    full views, once it has ``refused_min_views`` of them. A class found by its shape (a table
-    top), not by a detector that could decline it, is not judged."""
+    """Whether the track's full views contradict ``class_name`` (see the module docstring), once
+    it has ``refused_min_views`` of them. A class found by its shape (a table top), not by a
+    detector that could decline it, is not judged."""
     if track.refused_min_views <= 0 or track.full_views < track.refused_min_views:
         return False
     if class_name not in track.detected_classes:
         return False
-    return track.full_named.get(class_name, 0) <= track.refused_max_share * track.full_views
+    named = track.full_named.get(class_name, 0)
+    return at_most(named, track.full_views, REFUSED_NAMING_RATE) < REFUSED_CHANCE
+
+
+def at_most(k: int, n: int, rate: float) -> float:
+    """The probability of at most ``k`` successes in ``n`` trials that each succeed with
+    ``rate`` (binomial; in logs, so that hundreds of views neither overflow nor underflow)."""
+    if k >= n:
+        return 1.0
+    log_p, log_q = math.log(rate), math.log1p(-rate)
+    ways = math.lgamma(n + 1)
+    terms = (ways - math.lgamma(i + 1) - math.lgamma(n - i + 1) + i * log_p + (n - i) * log_q
+             for i in range(k + 1))
+    return min(1.0, sum(math.exp(t) for t in terms))

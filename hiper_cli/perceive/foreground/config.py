@@ -160,9 +160,10 @@ class TrackerConfig(_Part):
     known-class votes ..."""
     unknown_vote_weight: float = 0.15
     """... where an ``unknown`` observation weighs this much ..."""
-    refused_min_views: int = 8
-    """... and not a class no detection gave it in its full views once it has this many
-    (``whole.in_full_view``; 0: off)."""
+    refused_min_views: int = 5
+    """... and not a class its full views contradict (``whole.in_full_view``: named in so few
+    that a detector right about it would do so by chance under 5 %, ``class_vote._refused``)
+    once it has this many (0: off)."""
     class_sizes: bool = True
     """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): a blob longer
     than the largest instance of its class is ``unknown``; a track whose whole views were all

@@ -8,6 +8,7 @@ import pytest
 from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.carried import drop_carried
+from hiper_cli.perceive.foreground.class_vote import at_most
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.match import named_within
 from hiper_cli.perceive.foreground.plausible import attached, longest_m, max_longest_m, min_longest_m
@@ -190,7 +191,7 @@ def test_only_views_of_the_whole_object_show_it_too_short(doorway, expected):
 
 
 def _refused_track(full_named: int, full_views: int = 10, within: frozenset[str] = frozenset(),
-                   detected: bool = True, **options):
+                   detected: bool = True, whole: bool = True, **options):
     """A track named ``chair`` in 12 views cut by the border (by a detection, or by its shape
     when not ``detected``), then seen in ``full_views`` full views of which the first
     ``full_named`` were named ``chair`` too, and the others held detections of the classes
@@ -202,7 +203,7 @@ def _refused_track(full_named: int, full_views: int = 10, within: frozenset[str]
             full = k >= 12
             named = not full or k - 12 < full_named
             m = Measurement(centre, extent, "chair" if named else "unknown", 0.6 if named else 0.0, f"o{k}",
-                            full_view=full, named_within=frozenset() if named else within,
+                            full_view=full, named_within=frozenset() if named else within, whole=whole,
                             detection_index=0 if named and detected else None)
             tracker.step(k / RATE_HZ, [m])
     return tracker.tracks[0]
@@ -214,16 +215,33 @@ def test_a_class_named_only_on_cut_views_and_declined_in_full_view_is_refused():
     views to judge."""
     assert _refused_track(0).class_name == "unknown"
     assert _refused_track(0).search_class == "chair"  # it still says what it was taken for
-    assert _refused_track(1).class_name == "chair"
-    assert _refused_track(0, full_views=7).class_name == "chair"
+    assert _refused_track(4).class_name == "chair"  # 4 of 10: a detector right about it does that
+    assert _refused_track(0, full_views=4).class_name == "chair"  # too few to tell (6 % by chance)
+    assert _refused_track(0, full_views=5).class_name == "unknown"  # none of 5: 3 % by chance
     assert _refused_track(0, refused_min_views=0).class_name == "chair"
-    assert _refused_track(2, refused_max_share=0.25).class_name == "unknown"
+    assert _refused_track(1).class_name == "unknown"  # one of 10: 1 % by chance
+    assert _refused_track(1, refused_naming_rate=0.2).class_name == "chair"  # a detector that rarely names
     # a chair's box inside a blob that took no class (joined with the table beside it) is a
     # view that named the chair; a book's box on the shelf is not
     assert _refused_track(0, within=frozenset({"chair"})).class_name == "chair"
     assert _refused_track(0, within=frozenset({"book"})).class_name == "unknown"
     # a class its shape gave it (a table top found without a detector) is not the detector's to refuse
     assert _refused_track(0, detected=False).class_name == "chair"
+
+
+def test_a_refused_class_leaves_an_unknown_object_not_nothing():
+    """The full views tell what the object is not, not that nothing stands there: the track
+    the detections named stays an instance, ``unknown`` (located, not named wrongly)."""
+    track = _refused_track(0, whole=False)  # no whole view: only the detections tell it is there
+    assert track.class_name == "unknown" and track.confirmed
+
+
+def test_the_chance_of_so_few_namings():
+    assert at_most(0, 5, 0.5) == pytest.approx(1 / 32)
+    assert at_most(1, 8, 0.5) == pytest.approx(9 / 256)
+    assert at_most(3, 3, 0.5) == 1.0
+    assert at_most(500, 1000, 0.5) == pytest.approx(0.5126, abs=1e-4)  # no overflow in many views
+    assert at_most(10, 3000, 0.5) == 0.0
 
 
 def test_the_classes_of_detections_inside_a_blobs_box():
