@@ -161,9 +161,8 @@ class TrackerConfig(_Part):
     unknown_vote_weight: float = 0.15
     """... where an ``unknown`` observation weighs this much ..."""
     refused_min_views: int = 5
-    """... and not a class its full views contradict (``whole.in_full_view``: named in so few
-    that a detector right about it would do so by chance under 5 %, ``class_vote._refused``)
-    once it has this many (0: off)."""
+    """... and not a class none of its full views gave once it has this many
+    (``whole.in_full_view``, ``class_vote._refused``; 0: off)."""
     class_sizes: bool = True
     """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): a blob longer
     than the largest instance of its class is ``unknown``; a track whose whole views were all
