@@ -11,15 +11,17 @@ Each observation votes for its class with its detection score (``unknown`` with
   of 176) is too weakly supported to name it;
 - not too short for the class (``class_sizes``): some view that named it, with its blob seen
   whole, showed an object at least as long as the class's smallest instance;
-- not refused (``refused_min_views``): a view that shows the whole object, large enough to name
-  (a *full view*, ``whole.in_full_view``), is one where a detector that gave the class would be
-  expected to give it again, for the blob or inside its box. A class none of
-  ``refused_min_views`` full views gave is contradicted by the views, whatever the cut views
-  said: a detector that names a class only where the border cut the object or something hid a
-  part was naming a part that looks like something else (a shelf's side taken for a chair's
-  back; a walker's shoulders, ``person`` in full view, taken for a refrigerator while cut).
-  Only none: detectors name true objects in as few as a quarter of their full views (a
-  patient in a hospital bed, 29 of 106).
+- not refused: a view that shows the whole object, large enough to name (a *full view*,
+  ``whole.in_full_view``), is one where a detector that gave the class would be expected to
+  give it again, for the blob or inside its box. A class that none of the track's full views
+  gave while ``refused_min_views`` of them named nothing, or while ``CONTRADICTED_VIEWS`` of
+  them named another class, is contradicted by the views, whatever the cut views said: a
+  detector that names a class only where the border cut the object or something hid a part
+  was naming a part that looks like something else (a shelf's side taken for a chair's back; a
+  walker's shoulders taken for a refrigerator while cut, ``person`` in full view). A full view
+  that names nothing is weak evidence (detectors name true objects in as few as a quarter of
+  their full views: a patient in a hospital bed, 29 of 106), one that names another class is
+  strong.
 
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
@@ -35,6 +37,8 @@ from hiper_cli.perceive.foreground.plausible import min_longest_m
 __all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "winner"]
 
 UNKNOWN = "unknown"
+CONTRADICTED_VIEWS: int = 2
+"""Full views that named another class and none this one refuse a class (``_refused``)."""
 SUPPORT_MARGIN: float = 1.5
 """A class names a track only when its score-weighted votes outweigh the ``unknown`` votes
 (views that saw the object and named nothing) this many times over; 1: a bare majority."""
@@ -158,11 +162,12 @@ def _long_enough(track: Track, class_name: str) -> bool:
 
 
 def _refused(track: Track, class_name: str) -> bool:
-    """Whether none of the track's full views named ``class_name``, once it has
-    ``refused_min_views`` of them. A class found by its shape (a table top), not by a detector
-    that could decline it, is not judged."""
-    if track.refused_min_views <= 0 or track.full_views < track.refused_min_views:
+    """Whether the track's full views contradict ``class_name``: none named it, and they are
+    ``refused_min_views`` or ``CONTRADICTED_VIEWS`` named another class (0 views: off). A class
+    found by its shape (a table top), not by a detector that could decline it, is not judged."""
+    if track.refused_min_views <= 0 or class_name not in track.detected_classes:
         return False
-    if class_name not in track.detected_classes:
+    if track.full_named.get(class_name, 0) > 0:
         return False
-    return track.full_named.get(class_name, 0) == 0
+    other = max((n for k, n in track.full_named.items() if k != class_name), default=0)
+    return track.full_views >= track.refused_min_views or other >= CONTRADICTED_VIEWS

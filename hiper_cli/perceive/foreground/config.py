@@ -160,9 +160,9 @@ class TrackerConfig(_Part):
     known-class votes ..."""
     unknown_vote_weight: float = 0.15
     """... where an ``unknown`` observation weighs this much ..."""
-    refused_min_views: int = 5
-    """... and not a class none of its full views gave once it has this many
-    (``whole.in_full_view``, ``class_vote._refused``; 0: off)."""
+    refused_min_views: int = 8
+    """... and not a class none of its full views gave once it has this many, or two named
+    another class (``whole.in_full_view``, ``class_vote._refused``; 0: off)."""
     class_sizes: bool = True
     """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): a blob longer
     than the largest instance of its class is ``unknown``; a track whose whole views were all
