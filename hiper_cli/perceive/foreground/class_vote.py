@@ -5,10 +5,7 @@ Each observation votes for its class with its detection score (``unknown`` with
 
 - at least ``min_class_observations`` observations of it, and ``min_class_share`` of the
   known-class votes (two classes that keep swapping leave the track ``unknown``), outweighing
-  ``unknown`` by ``SUPPORT_MARGIN``: the views that saw the object and named nothing are
-  evidence too, and a class the detector gave in a few views among many silent ones (a
-  person's shoulders called ``refrigerator`` in 7 of 24 views, a couch called ``bed`` in 55
-  of 176) is too weakly supported to name it;
+  ``unknown``;
 - not too short for the class (``class_sizes``): some view that named it, with its blob seen
   whole, showed an object at least as long as the class's smallest instance;
 - not refused: a view that shows the whole object, large enough to name (a *full view*,
@@ -23,6 +20,14 @@ Each observation votes for its class with its detection score (``unknown`` with
   their full views: a patient in a hospital bed, 29 of 106), one that names another class is
   strong.
 
+The class an instance shows (``shown_class``) asks more: the track's class must outweigh the
+``unknown`` votes ``SUPPORT_MARGIN`` times over. The views that saw the object and named
+nothing are evidence too, and a class the detector gave in a few views among many silent ones
+(a person's shoulders called ``refrigerator`` in 7 of 24 views, a couch called ``bed`` in 55
+of 176, a desk called ``bench`` in 5 of 21) is too weakly supported to name the object. The
+tracker keeps the class as its working hypothesis (how it associates and moves the track, its
+box), so the object stays where it was found, ``unknown``.
+
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
 ``absorb_votes`` clear it.
@@ -34,14 +39,15 @@ from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 
-__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "winner"]
+__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "shown_class", "winner"]
 
 UNKNOWN = "unknown"
 CONTRADICTED_VIEWS: int = 2
 """Full views that named another class and none this one refuse a class (``_refused``)."""
 SUPPORT_MARGIN: float = 1.5
-"""A class names a track only when its score-weighted votes outweigh the ``unknown`` votes
-(views that saw the object and named nothing) this many times over; 1: a bare majority."""
+"""A class names an instance only when its score-weighted votes outweigh the ``unknown`` votes
+(views that saw the object and named nothing) this many times over (``shown_class``; 1: as
+the vote)."""
 
 
 class Vote(Protocol):
@@ -116,8 +122,8 @@ def absorb_votes(old: Track, new: Track) -> None:
 
 def winner(track: Track, judged: bool = True) -> str:
     """The vote's winner, or ``unknown`` without the evidence (see the module docstring);
-    ``judged`` False: the bare vote, without the full views' judgement (``refused_min_views``)
-    and the support margin: whether detections saw an object there (``named_object``)."""
+    ``judged`` False: without the full views' judgement (``refused_min_views``): whether
+    detections saw an object there (``named_object``)."""
     known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
     eligible = [
         k for k in sorted(known)
@@ -129,9 +135,18 @@ def winner(track: Track, judged: bool = True) -> str:
     best = max(eligible, key=lambda k: known[k])
     if known[best] < track.min_class_share * sum(known.values()):
         return UNKNOWN
-    if track.class_votes.get(UNKNOWN, 0.0) * (SUPPORT_MARGIN if judged else 1.0) > known[best]:
+    if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
         return UNKNOWN
     return best
+
+
+def shown_class(track: Track) -> str:
+    """The class the track's instance shows: its class when its votes outweigh the ``unknown``
+    ones ``SUPPORT_MARGIN`` times over, else ``unknown`` (see the module docstring)."""
+    name, votes = track.class_name, track.class_votes
+    if name == UNKNOWN or votes.get(name, 0.0) >= SUPPORT_MARGIN * votes.get(UNKNOWN, 0.0):
+        return name
+    return UNKNOWN
 
 
 def named_object(track: Track) -> bool:
