@@ -8,11 +8,25 @@ Each observation votes for its class with its detection score (``unknown`` with
   ``unknown``;
 - not too short for the class (``class_sizes``): some view that named it, with its blob seen
   whole, showed an object at least as long as the class's smallest instance;
-- not refused (``refused_min_views``): once the track has enough *full views* (the whole object
-  in the image, large enough to name: ``whole.in_full_view``), a class a detection gave it must
-  have been named in more than ``refused_max_share`` of them, for the blob or inside its box. A
-  detector that names a class only where the border cut the object or something hid a part was
-  naming a part that looks like something else (a shelf's side taken for a chair's back).
+- not refused: a view that shows the whole object, large enough to name (a *full view*,
+  ``whole.in_full_view``), is one where a detector that gave the class would be expected to
+  give it again, for the blob or inside its box. A class that none of the track's full views
+  gave while ``refused_min_views`` of them named nothing, or while ``CONTRADICTED_VIEWS`` of
+  them named another class, is contradicted by the views, whatever the cut views said: a
+  detector that names a class only where the border cut the object or something hid a part
+  was naming a part that looks like something else (a shelf's side taken for a chair's back; a
+  walker's shoulders taken for a refrigerator while cut, ``person`` in full view). A full view
+  that names nothing is weak evidence (detectors name true objects in as few as a quarter of
+  their full views: a patient in a hospital bed, 29 of 106), one that names another class is
+  strong.
+
+The class an instance shows (``shown_class``) asks more: the track's class must outweigh the
+``unknown`` votes ``SUPPORT_MARGIN`` times over. The views that saw the object and named
+nothing are evidence too, and a class the detector gave in a few views among many silent ones
+(a person's shoulders called ``refrigerator`` in 7 of 24 views, a couch called ``bed`` in 55
+of 176, a desk called ``bench`` in 5 of 21) is too weakly supported to name the object. The
+tracker keeps the class as its working hypothesis (how it associates and moves the track, its
+box), so the object stays where it was found, ``unknown``.
 
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
@@ -25,9 +39,15 @@ from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 
-__all__ = ["UNKNOWN", "absorb_votes", "record", "search_class", "winner"]
+__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "shown_class", "winner"]
 
 UNKNOWN = "unknown"
+CONTRADICTED_VIEWS: int = 2
+"""Full views that named another class and none this one refuse a class (``_refused``)."""
+SUPPORT_MARGIN: float = 1.5
+"""A class names an instance only when its score-weighted votes outweigh the ``unknown`` votes
+(views that saw the object and named nothing) this many times over (``shown_class``; 1: as
+the vote)."""
 
 
 class Vote(Protocol):
@@ -61,7 +81,6 @@ class Track(Protocol):
     min_class_share: float
     size_tolerance: float | None
     refused_min_views: int
-    refused_max_share: float
     _class_name: str | None
 
     @property
@@ -101,13 +120,15 @@ def absorb_votes(old: Track, new: Track) -> None:
     old._class_name = None
 
 
-def winner(track: Track) -> str:
-    """The vote's winner, or ``unknown`` without the evidence (see the module docstring)."""
+def winner(track: Track, judged: bool = True) -> str:
+    """The vote's winner, or ``unknown`` without the evidence (see the module docstring);
+    ``judged`` False: without the full views' judgement (``refused_min_views``): whether
+    detections saw an object there (``named_object``)."""
     known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
     eligible = [
         k for k in sorted(known)
         if track.class_counts.get(k, 0) >= track.min_class_observations and _long_enough(track, k)
-        and not _refused(track, k)
+        and not (judged and _refused(track, k))
     ]
     if not eligible:
         return UNKNOWN
@@ -117,6 +138,22 @@ def winner(track: Track) -> str:
     if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
         return UNKNOWN
     return best
+
+
+def shown_class(track: Track) -> str:
+    """The class the track's instance shows: its class when its votes outweigh the ``unknown``
+    ones ``SUPPORT_MARGIN`` times over, else ``unknown`` (see the module docstring)."""
+    name, votes = track.class_name, track.class_votes
+    if name == UNKNOWN or votes.get(name, 0.0) >= SUPPORT_MARGIN * votes.get(UNKNOWN, 0.0):
+        return name
+    return UNKNOWN
+
+
+def named_object(track: Track) -> bool:
+    """Whether detections named the track enough to give it a class, one its full views may
+    have refused since: they tell what it is not, not that nothing is there (the track is an
+    object, ``unknown``, as a walker named ``refrigerator`` still walks there)."""
+    return track.class_name != UNKNOWN or winner(track, judged=False) != UNKNOWN
 
 
 def search_class(track: Track) -> str:
@@ -140,11 +177,12 @@ def _long_enough(track: Track, class_name: str) -> bool:
 
 
 def _refused(track: Track, class_name: str) -> bool:
-    """Whether detections named ``class_name`` in at most ``refused_max_share`` of the track's
-    full views, once it has ``refused_min_views`` of them. A class found by its shape (a table
-    top), not by a detector that could decline it, is not judged."""
-    if track.refused_min_views <= 0 or track.full_views < track.refused_min_views:
+    """Whether the track's full views contradict ``class_name``: none named it, and they are
+    ``refused_min_views`` or ``CONTRADICTED_VIEWS`` named another class (0 views: off). A class
+    found by its shape (a table top), not by a detector that could decline it, is not judged."""
+    if track.refused_min_views <= 0 or class_name not in track.detected_classes:
         return False
-    if class_name not in track.detected_classes:
+    if track.full_named.get(class_name, 0) > 0:
         return False
-    return track.full_named.get(class_name, 0) <= track.refused_max_share * track.full_views
+    other = max((n for k, n in track.full_named.items() if k != class_name), default=0)
+    return track.full_views >= track.refused_min_views or other >= CONTRADICTED_VIEWS

@@ -161,8 +161,8 @@ class TrackerConfig(_Part):
     unknown_vote_weight: float = 0.15
     """... where an ``unknown`` observation weighs this much ..."""
     refused_min_views: int = 8
-    """... and not a class no detection gave it in its full views once it has this many
-    (``whole.in_full_view``; 0: off)."""
+    """... and not a class none of its full views gave once it has this many, or two named
+    another class (``whole.in_full_view``, ``class_vote._refused``; 0: off)."""
     class_sizes: bool = True
     """Common-sense sizes of the detector's classes (``plausible.CLASS_SIZES``): a blob longer
     than the largest instance of its class is ``unknown``; a track whose whole views were all

@@ -27,7 +27,7 @@ from hiper_cli.perceive.foreground.amodal import (
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import TABLE_LEG_BAND_M, table_leg_boxes
 from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTAINMENT, drop_carried
-from hiper_cli.perceive.foreground.class_vote import UNKNOWN
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
@@ -621,7 +621,7 @@ class ForegroundStage:
         if inst is None:
             inst = Instance(
                 layer="foreground",
-                class_name=track.class_name,
+                class_name=shown_class(track),
                 box=box,
                 first_seen_s=track.first_seen_s,
                 last_seen_s=track.last_update_s,
@@ -630,7 +630,7 @@ class ForegroundStage:
                 data={"trajectory": track.trajectory},
             )
             self._instances[track.uuid] = inst
-        inst.class_name = track.class_name
+        inst.class_name = shown_class(track)  # the tracker's class, when the views support it
         inst.box = box
         inst.last_seen_s = track.last_update_s
         inst.state = state  # type: ignore[assignment]

@@ -139,7 +139,6 @@ class Track:
     full_named: dict[str, int] = field(default_factory=dict)
     detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
     refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
-    refused_max_share: float = 0.0
     min_class_observations: int = 1
     min_class_share: float = 0.0
     size_tolerance: float | None = None  # ``class_size_tolerance`` when ``class_sizes`` is on

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import ROW_POSITION, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
-from hiper_cli.perceive.foreground.class_vote import UNKNOWN, record
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, named_object, record
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, make_motion_model
 from hiper_cli.perceive.foreground.moving import MOVING_SPEED_MPS, is_static, note_travel, was_moving
@@ -101,7 +101,6 @@ GATE_SIGMAS: float = 4.0
 MIN_GATE_M: float = 0.5
 """... and a settled track gates at gate_sigmas times its predicted position σ, at least
 min_gate_m (a chair does not take the bottle on the table beside it)."""
-REFUSED_MAX_SHARE: float = 0.0
 CLASS_MISMATCH_M: float = 0.5
 """Association cost added (inside the gate) when a track and an observation have
 different known classes: same-class pairs win, a confused detection still joins."""
@@ -414,8 +413,8 @@ class Tracker:
             return True
         named = sum(n for k, n in track.class_counts.items() if k != UNKNOWN)
         if UNKNOWN_EVIDENCE_HELD:
-            if track.class_name != UNKNOWN:
-                return True  # detections gave it its class
+            if named_object(track):
+                return True  # detections gave it a class (its full views may refuse that class)
             lasted = track.last_update_s - track.first_seen_s >= UNKNOWN_MIN_SPAN_S
             if named >= cfg.min_class_share * track.hits and (lasted or not closing):
                 return True  # detections name it most of the time
@@ -705,7 +704,6 @@ class Tracker:
             min_class_share=self.config.min_class_share,
             size_tolerance=CLASS_SIZE_TOLERANCE if self.config.class_sizes else None,
             refused_min_views=self.config.refused_min_views,
-            refused_max_share=REFUSED_MAX_SHARE,
         )
         track.seen.add(*m.corners(), m.class_name != UNKNOWN, m.viewpoint_map_m, m.top_hidden,
                        m.bottom_hidden, m.class_name)
