@@ -41,6 +41,15 @@ class BackgroundCloud:
         self.voxel_m = voxel_m
         self._sum: dict[tuple[int, int, int], FloatArray] = {}
         self._n: dict[tuple[int, int, int], int] = {}
+        self._fixed: set[tuple[int, int, int]] = set()
+
+    def add_fixed(self, points: FloatArray) -> None:
+        """Voxels whose centroid later points do not move: the place as the sessions before saw
+        it. A later session, aligned with its own error and drifting in its own way, adds new
+        space to the map but does not pull the map toward itself (the map frame is the first
+        session's)."""
+        self.add_points(points)
+        self._fixed.update(self._sum)
 
     def add_points(self, points: FloatArray) -> None:
         if len(points) == 0:
@@ -51,6 +60,8 @@ class BackgroundCloud:
         np.add.at(sums, inverse.reshape(-1), points)
         counts = np.bincount(inverse.reshape(-1), minlength=len(uniq))
         for key, s, n in zip(map(tuple, uniq.tolist()), sums, counts, strict=True):
+            if key in self._fixed:
+                continue
             if key in self._sum:
                 self._sum[key] = self._sum[key] + s
                 self._n[key] += int(n)
