@@ -63,7 +63,8 @@ def _rotation(rotvec: FloatArray) -> FloatArray:
         return np.eye(3)
     k = rotvec / angle
     K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    R: FloatArray = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    return R
 
 
 def _step(p: FloatArray, q: FloatArray, n: FloatArray) -> tuple[FloatArray, int, float]:
