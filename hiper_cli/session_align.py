@@ -2,7 +2,10 @@
 
 ``perceive --align auto`` (the default): the first session of a place defines its map frame;
 every later one is registered to the place's background cloud (``perceive.align``) from frames
-spread over its log, and refused when it does not fit. ``--align none`` takes the log's poses
+spread over its log, and refused when it does not fit; that transform is then refined on the
+log's first metres, where its odometry has not drifted yet (``perceive.align_start``), in the
+directions the start constrains, and kept as it was when the refinement finds too little or
+moves it too far. ``--align none`` takes the log's poses
 as map-frame poses; ``--align FILE`` reads ``T_map_log`` (a 4×4 matrix, JSON or 16 numbers).
 Frames are then handed to the stages with ``T_map_cam = T_map_log · T_log_cam``, so everything
 stored is in the place's one map frame; and during the run the session's own background adds
@@ -24,6 +27,7 @@ from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.sessions import Alignment
 from hiper_cli.model import Environment
 from hiper_cli.perceive.align import BackgroundCloud, register
+from hiper_cli.perceive.align_start import refine_at_start
 from hiper_cli.types import Frame
 
 __all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment"]
@@ -31,6 +35,11 @@ __all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_a
 ALIGN_FRAMES = 40  # frames spread over the log make its cloud
 MIN_FITNESS = 0.4  # below this share of the log's background on the map, the log is refused
 CLOUD_EVERY_S = 0.5  # the place's cloud takes a frame this often
+START_MOTION_M = 3.0  # the start's cloud: frames until the log moved this far (0.5 m a radian turned)
+START_STEP_M = 0.1  # ... one frame per this much motion
+START_MIN_INLIERS = 0.3  # below this share of the start's points on the map, the start is not used
+START_MAX_CHANGE = (0.25, 3.0)  # metres, degrees: a larger correction of the whole-log fit is refused
+METRES_PER_RADIAN = 0.5
 
 
 def _read_matrix(path: Path) -> np.ndarray:
@@ -61,6 +70,47 @@ def log_cloud(reader: Any, n: int = ALIGN_FRAMES) -> np.ndarray:
     return cloud.points()
 
 
+def _motion_m(T_a: np.ndarray, T_b: np.ndarray) -> float:
+    step = np.linalg.inv(T_a) @ T_b
+    angle = float(np.arccos(np.clip((np.trace(step[:3, :3]) - 1) / 2, -1.0, 1.0)))
+    return float(np.linalg.norm(step[:3, 3])) + METRES_PER_RADIAN * angle
+
+
+def start_cloud(reader: Any) -> np.ndarray:
+    """The background cloud (log frame) of the log's first ``START_MOTION_M`` of motion, one
+    frame per ``START_STEP_M``: where the log's poses have drifted least."""
+    poses = reader.info().T_map_cam if hasattr(reader, "info") else None
+    cloud = BackgroundCloud()
+    travelled, since, last = 0.0, np.inf, None
+    for k in range(len(reader)):
+        if poses is not None and last is not None:
+            moved = _motion_m(poses[last], poses[k])
+            travelled, since = travelled + moved, since + moved
+        if travelled > START_MOTION_M:
+            break
+        if since >= START_STEP_M or poses is None:
+            cloud.add_frame(reader.read_frame(k))
+            since = 0.0
+        last = k
+    return cloud.points()
+
+
+def _refined(reader: Any, place: np.ndarray, found: Any) -> tuple[np.ndarray, str]:
+    """The whole-log transform refined at the log's start, or kept, and why."""
+    fit = refine_at_start(start_cloud(reader), place, found.T_map_log)
+    change = np.linalg.inv(found.T_map_log) @ fit.T_map_log
+    metres = float(np.linalg.norm(change[:3, 3]))
+    degrees = float(np.degrees(np.arccos(np.clip((np.trace(change[:3, :3]) - 1) / 2, -1.0, 1.0))))
+    if fit.inliers < START_MIN_INLIERS or fit.constrained == 0:
+        return found.T_map_log, (f"kept the whole log's fit: its first {START_MOTION_M:g} m show too little "
+                                 f"of the map ({fit.inliers:.0%} of their points on it)")
+    if metres > START_MAX_CHANGE[0] or degrees > START_MAX_CHANGE[1]:
+        return found.T_map_log, (f"kept the whole log's fit: its first {START_MOTION_M:g} m would move it "
+                                 f"{metres:.2f} m, {degrees:.1f} deg")
+    return fit.T_map_log, (f"refined on its first {START_MOTION_M:g} m ({fit.constrained} of 6 directions "
+                           f"constrained there; {metres:.3f} m, {degrees:.2f} deg from the whole log's fit)")
+
+
 def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: str,
                      log_name: str) -> Alignment:
     """The transform this session's log gets (see the module docstring); refuses a poor fit."""
@@ -78,7 +128,8 @@ def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: st
             f"{found.fitness:.2f} < {MIN_FITNESS}: too little of its background matches the map); pass "
             "--env NEW if it shows another place, or --align FILE with its transform, or --align none if "
             "its poses are in the map frame")
-    return Alignment(found.T_map_log, "registration", found.fitness, found.rmse_m)
+    T_map_log, how = _refined(reader, place, found)
+    return Alignment(T_map_log, "registration", found.fitness, found.rmse_m, how)
 
 
 def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:
@@ -92,8 +143,8 @@ def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:
 
 
 class MapCloudGrower:
-    """The place's background cloud, grown by this session's frames (map frame) and stored at
-    the end of the session."""
+    """The place's background cloud, grown by this session's frames (map frame) where they see
+    new space, and stored at the end of the session."""
 
     def __init__(self, kb: KnowledgeBase, env: Environment) -> None:
         self.kb, self.env = kb, env
@@ -101,7 +152,7 @@ class MapCloudGrower:
         stored = kb.map_cloud(env)
         self.before = stored  # the place as the earlier sessions saw it (for ``FreeBefore``)
         if stored is not None:
-            self.cloud.add_points(stored)
+            self.cloud.add_fixed(stored)
         self._last_s = -np.inf
 
     def add(self, frame: Frame) -> None:

@@ -31,21 +31,23 @@ class Alignment:
     ``method``: ``identity`` (first session of a place, or ``--align none``), ``file`` (given by
     the user), ``registration`` (found from the static background). ``fitness``: share of the
     log's background points within the ICP distance of the map (1.0 for identity or a file);
-    ``rmse_m``: their mean distance."""
+    ``rmse_m``: their mean distance; ``note``: how a registration was refined (or why not)."""
 
     T_map_log: np.ndarray
     method: str
     fitness: float = 1.0
     rmse_m: float = 0.0
+    note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"T_map_log": np.asarray(self.T_map_log, dtype=float).round(6).tolist(), "method": self.method,
-                "fitness": round(float(self.fitness), 4), "rmse_m": round(float(self.rmse_m), 4)}
+        out = {"T_map_log": np.asarray(self.T_map_log, dtype=float).round(6).tolist(), "method": self.method,
+               "fitness": round(float(self.fitness), 4), "rmse_m": round(float(self.rmse_m), 4)}
+        return out | ({"note": self.note} if self.note else {})
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Alignment:
         return cls(np.asarray(d["T_map_log"], dtype=np.float64), str(d["method"]),
-                   float(d.get("fitness", 1.0)), float(d.get("rmse_m", 0.0)))
+                   float(d.get("fitness", 1.0)), float(d.get("rmse_m", 0.0)), str(d.get("note", "")))
 
     @classmethod
     def identity(cls) -> Alignment:

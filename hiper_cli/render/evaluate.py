@@ -222,8 +222,10 @@ def show_changes(out: Any, r: dict[str, Any]) -> None:
     out.print(f"re-identification precision {reid} ({r['reid_merged']} instances over sessions); ghost rate "
               f"{ghost} ({r['ghosts']} of {r['present_real']} present objects)")
     for a in r["alignment"]:
+        at_start = (f" (at its start {a['error_start_m']:.3f} m, along its path <= "
+                    f"{a['error_path_max_m']:.3f} m)" if "error_start_m" in a else "")
         out.print(f"session {a['session']} ({a['log']}): {a['method']}, fitness {a['fitness']:.2f}, error "
-                  f"{a['error_m']:.3f} m / {a['error_deg']:.2f} deg")
+                  f"{a['error_m']:.3f} m / {a['error_deg']:.2f} deg{at_start}")
     counts = Table("class", "stored", "true", "error")
     for cls, v in r["counts"].items():
         counts.add_row(cls, str(v["stored"]), str(v["true"]), f"{v['error']:+d}")

@@ -26,7 +26,8 @@ def show_perceive(out: Any, data: dict[str, Any]) -> None:
     )
     align = data.get("alignment")
     if align and align["method"] == "registration":
-        out.print(f"aligned to the place's map: fitness {align['fitness']:.2f}, rmse {align['rmse_m']:.3f} m")
+        out.print(f"aligned to the place's map: fitness {align['fitness']:.2f}, rmse {align['rmse_m']:.3f} m"
+                  + (f"; {safe_text(align['note'])}" if align.get("note") else ""))
     again = data.get("earlier_sessions", {})
     if any(again.values()):
         out.print(f"earlier sessions' objects: {again['found_again']} found again "

@@ -45,3 +45,22 @@ def test_changes_match_by_kind_class_session_and_place():
     assert got["moved"]["f1"] == 1.0
     assert (got["removed"]["precision"], got["removed"]["recall"]) == (0.0, 0.0)  # the wrong session
     assert (got["added"]["stored"], got["added"]["true"], got["added"]["precision"]) == (1, 0, 0.0)
+
+
+def test_the_alignment_error_is_also_measured_where_the_robot_was(tmp_path):
+    from hiper_cli.evaluate.changes import _alignment_errors
+
+    log = tmp_path / "session_2"
+    (log / "gt").mkdir(parents=True)
+    # the true path in the log's frame: from 6 m to 8 m along x
+    (log / "gt" / "groundtruth.txt").write_text("0.0 6 0 1.2 0 0 0 1\n1.0 8 0 1.2 0 0 0 1\n")
+    a = np.radians(0.5)  # the stored transform is turned 0.5 deg about the log's origin
+    T = np.eye(4)
+    T[:2, :2] = [[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]
+    aligned = {"T_map_log": T.tolist(), "method": "registration", "fitness": 0.8}
+    sessions = [{"id": 2, "log_path": str(log), "alignment": aligned}]
+    (row,) = _alignment_errors(sessions, {"session_2": {"log": "session_2", "T_log_map": np.eye(4).tolist()}})
+    assert row["error_m"] == 0.0  # at the origin, nothing
+    assert abs(row["error_start_m"] - 6 * a) < 1e-3  # 5 cm at the start, 6 m from the origin
+    assert abs(row["error_path_max_m"] - 8 * a) < 1e-3
+    assert abs(row["error_deg"] - 0.5) < 1e-3

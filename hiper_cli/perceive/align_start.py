@@ -1,0 +1,111 @@
+"""Refining a session's alignment where drift is smallest: the log's first metres.
+
+A pose source drifts with motion (a visual odometry front end: some 0.5 % of the distance and
+0.1°/m), in every session, the map's own included. Registering a whole log to the map averages
+the drift of both and is off by a decimetre and a degree at the log's start; its first metres
+have barely drifted, and a robot that starts a session where it started the last (a dock) sees
+there the map's least drifted part too. So the whole-log transform is refined by point-to-plane
+ICP of the first metres' cloud against the map, with a Cauchy kernel (people, moved objects).
+
+A start that shows little (a floor and one wall) leaves some directions unconstrained, and ICP
+slides along them. The Gauss-Newton normal matrix (rotation about the cloud's centre, scaled
+by its radius, so its eigenvalues compare with the translations') says which directions the
+start constrains: each step moves only along those whose eigenvalue, a share of the weighted
+points, is at least ``MIN_CONSTRAINT``; along the others the whole-log transform stays. A floor
+fixes height, roll and pitch, a wall yaw and its normal's offset.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["MIN_CONSTRAINT", "StartFit", "refine_at_start"]
+
+FloatArray = NDArray[np.float64]
+
+MIN_CONSTRAINT = 0.03  # eigenvalue share of the weighted points under which a direction is left alone
+KERNEL_M = 0.03  # Cauchy scale of the point-to-plane residuals
+DISTANCES_M = (0.2, 0.1, 0.05)  # correspondence gates, coarse to fine
+ITERATIONS = 15
+NORMAL_NEIGHBOURS = 12
+MAX_CURVATURE = 0.1  # map points whose neighbourhood is not planar give no normal
+
+
+@dataclass(frozen=True)
+class StartFit:
+    """The refined ``T_map_log``; ``constrained``: how many of the 6 directions the start fixed
+    (the rest kept the whole-log value); ``inliers``: share of the start's points within the
+    last gate; ``rmse_m``: their weighted point-to-plane residual."""
+
+    T_map_log: FloatArray
+    constrained: int
+    inliers: float
+    rmse_m: float
+
+
+def _normals(points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Per point: the unit normal of its neighbourhood and how far from planar it is."""
+    from scipy.spatial import cKDTree
+
+    k = min(NORMAL_NEIGHBOURS, len(points))
+    _, nn = cKDTree(points).query(points, k)
+    nb = points[nn] - points[nn].mean(axis=1, keepdims=True)
+    eigval, eigvec = np.linalg.eigh(np.einsum("nki,nkj->nij", nb, nb))
+    return eigvec[:, :, 0], eigval[:, 0] / np.maximum(eigval.sum(axis=1), 1e-12)
+
+
+def _rotation(rotvec: FloatArray) -> FloatArray:
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-12:
+        return np.eye(3)
+    k = rotvec / angle
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    R: FloatArray = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    return R
+
+
+def _step(p: FloatArray, q: FloatArray, n: FloatArray) -> tuple[FloatArray, int, float]:
+    """One Gauss-Newton step (4x4, applied on the left) in the constrained directions."""
+    centre = p.mean(axis=0)
+    radius = max(float(np.sqrt(((p - centre) ** 2).sum(axis=1).mean())), 1e-6)
+    r = ((p - q) * n).sum(axis=1)
+    w = 1.0 / (1.0 + (r / KERNEL_M) ** 2)
+    J = np.hstack([np.cross(p - centre, n) / radius, n])
+    H = (J * w[:, None]).T @ J / w.sum()
+    g = (J * w[:, None]).T @ r / w.sum()
+    eigval, eigvec = np.linalg.eigh(H)
+    keep = eigval >= MIN_CONSTRAINT
+    x = -(eigvec[:, keep] @ ((eigvec[:, keep].T @ g) / eigval[keep]))
+    R = _rotation(x[:3] / radius)
+    D = np.eye(4)
+    D[:3, :3] = R
+    D[:3, 3] = centre - R @ centre + x[3:]
+    return D, int(keep.sum()), float(np.sqrt((w * r * r).sum() / w.sum()))
+
+
+def refine_at_start(start_points: FloatArray, map_points: FloatArray, T0: FloatArray) -> StartFit:
+    """``T0`` (the whole log's registration) refined on the start's cloud (log frame) against
+    the map (see the module docstring)."""
+    from scipy.spatial import cKDTree
+
+    normals, curvature = _normals(map_points)
+    tree = cKDTree(map_points)
+    T = np.asarray(T0, dtype=np.float64).copy()
+    constrained, inliers, rmse = 0, 0.0, float("inf")
+    for gate in DISTANCES_M:
+        for _ in range(ITERATIONS):
+            p = start_points @ T[:3, :3].T + T[:3, 3]
+            d, j = tree.query(p, distance_upper_bound=gate)
+            ok = np.isfinite(d)
+            ok[ok] = curvature[j[ok]] < MAX_CURVATURE
+            inliers = float(ok.mean()) if len(ok) else 0.0
+            if ok.sum() < 20:
+                return StartFit(np.asarray(T0, dtype=np.float64), 0, inliers, rmse)
+            D, constrained, rmse = _step(p[ok], map_points[j[ok]], normals[j[ok]])
+            T = D @ T
+            if np.abs(D - np.eye(4)).max() < 1e-5:
+                break
+    return StartFit(T, constrained, inliers, rmse)
