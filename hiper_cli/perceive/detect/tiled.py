@@ -24,7 +24,9 @@ from hiper_cli.perceive.detect import Detector
 from hiper_cli.perceive.detect._onnx import nms
 from hiper_cli.types import Detections, Frame
 
-__all__ = ["TILE_EDGE_PX", "TiledDetector", "merge_detections", "tile_boxes", "tile_detections"]
+__all__ = [
+    "TILE_EDGE_PX", "TiledDetector", "merge_detections", "tile_boxes", "tile_detections", "whole_in_tile",
+]
 
 TILE_EDGE_PX = 4.0
 """A tile's detection whose box lies this close to an inner edge of the tile (one the image
@@ -59,7 +61,7 @@ def _crop(frame: Frame, box: Box) -> Frame:
                    depth_m=np.ascontiguousarray(frame.depth_m[y0:y1, x0:x1]), camera=cam, detections=None)
 
 
-def _whole_in_tile(xyxy: NDArray[np.float64], box: Box, width: int,
+def whole_in_tile(xyxy: NDArray[np.float64], box: Box, width: int,
                    height: int) -> NDArray[np.bool_]:
     """Which boxes (image pixels) keep clear of the tile's inner edges (those not on the image's)."""
     x0, y0, x1, y1 = box
@@ -82,7 +84,7 @@ def tile_detections(detector: Detector, frame: Frame, box: Box) -> Detections:
     if not len(found):
         return found
     xyxy = found.xyxy + np.array([box[0], box[1], box[0], box[1]], dtype=np.float64)
-    whole = _whole_in_tile(xyxy, box, frame.width, frame.height)
+    whole = whole_in_tile(xyxy, box, frame.width, frame.height)
     return Detections(xyxy, found.class_names, found.scores).subset(whole)
 
 

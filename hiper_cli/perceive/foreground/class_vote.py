@@ -14,6 +14,12 @@ Each observation votes for its class with its detection score (``unknown`` with
   detector that names a class only where the border cut the object or something hid a part was
   naming a part that looks like something else (a shelf's side taken for a chair's back).
 
+Two rates (``keyframes.py``): a keyframe's closer look sees small and distant things that the
+every-frame look cannot name, whose ``unknown`` from every frame would outvote any name. The
+observations a closer look saw whole (``closer_look``) also count in a vote of their own, with
+the same rules but ``CLOSER_MIN_LOOKS`` observations; a track the every-frame vote leaves
+``unknown`` takes that vote's winner.
+
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
 ``absorb_votes`` clear it.
@@ -45,6 +51,8 @@ class Vote(Protocol):
     def named_within(self) -> frozenset[str]: ...
     @property
     def detection_index(self) -> int | None: ...
+    @property
+    def closer_look(self) -> bool: ...
 
 
 class Track(Protocol):
@@ -57,6 +65,8 @@ class Track(Protocol):
     full_views: int
     full_named: dict[str, int]
     detected_classes: set[str]
+    closer_votes: dict[str, float]
+    closer_counts: dict[str, int]
     min_class_observations: int
     min_class_share: float
     size_tolerance: float | None
@@ -67,6 +77,9 @@ class Track(Protocol):
     @property
     def class_name(self) -> str: ...
 MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
+CLOSER_MIN_LOOKS = 3
+"""Closer looks (keyframes, ``keyframes.py``) that named a class before it wins the closer look's
+vote: keyframes are seconds apart, so three are three views, where frames at 30 Hz are one."""
 
 
 def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
@@ -74,6 +87,9 @@ def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
     weight = unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
     track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
     track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
+    if m.closer_look:
+        track.closer_votes[m.class_name] = track.closer_votes.get(m.class_name, 0.0) + weight
+        track.closer_counts[m.class_name] = track.closer_counts.get(m.class_name, 0) + 1
     if m.longest_m is not None and m.class_name != UNKNOWN:
         seen = track.class_longest_m.get(m.class_name, 0.0)
         track.class_longest_m[m.class_name] = max(seen, m.longest_m)
@@ -98,23 +114,38 @@ def absorb_votes(old: Track, new: Track) -> None:
     for cls, count in new.full_named.items():
         old.full_named[cls] = old.full_named.get(cls, 0) + count
     old.detected_classes |= new.detected_classes
+    for cls, votes in new.closer_votes.items():
+        old.closer_votes[cls] = old.closer_votes.get(cls, 0.0) + votes
+    for cls, count in new.closer_counts.items():
+        old.closer_counts[cls] = old.closer_counts.get(cls, 0) + count
     old._class_name = None
 
 
 def winner(track: Track) -> str:
-    """The vote's winner, or ``unknown`` without the evidence (see the module docstring)."""
-    known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
+    """The vote's winner, or ``unknown`` without the evidence (see the module docstring); the
+    closer looks' winner when every frame's vote has none."""
+    best = _winner(track, track.class_votes, track.class_counts, track.min_class_observations, refuse=True)
+    if best == UNKNOWN and track.closer_counts:
+        best = _winner(track, track.closer_votes, track.closer_counts, CLOSER_MIN_LOOKS, refuse=False)
+    return best
+
+
+def _winner(track: Track, votes: dict[str, float], counts: dict[str, int], min_count: int,
+            refuse: bool) -> str:
+    """The winner of one vote (``votes`` and ``counts`` per class): a known class named at least
+    ``min_count`` times, long enough, not ``refuse``d, with ``min_class_share`` of the known
+    votes, outweighing ``unknown``."""
+    known = {k: v for k, v in votes.items() if k != UNKNOWN}
     eligible = [
         k for k in sorted(known)
-        if track.class_counts.get(k, 0) >= track.min_class_observations and _long_enough(track, k)
-        and not _refused(track, k)
+        if counts.get(k, 0) >= min_count and _long_enough(track, k) and not (refuse and _refused(track, k))
     ]
     if not eligible:
         return UNKNOWN
     best = max(eligible, key=lambda k: known[k])
     if known[best] < track.min_class_share * sum(known.values()):
         return UNKNOWN
-    if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
+    if votes.get(UNKNOWN, 0.0) > known[best]:
         return UNKNOWN
     return best
 

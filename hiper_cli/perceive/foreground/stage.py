@@ -30,6 +30,7 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import has_moved, is_static
@@ -195,6 +196,7 @@ class ForegroundStage:
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
+        self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
@@ -223,15 +225,18 @@ class ForegroundStage:
         return center, extent
 
     # --- the stage --------------------------------------------------------------------------
-    def _detect_timed(self, frame: Frame) -> tuple[Detections, float]:
+    def _detect_timed(self, frame: Frame, tile: int | None) -> tuple[Detections, float]:
+        """The frame's detections, with its ``tile`` of a keyframe's closer look (``keyframes.py``)."""
         t0 = time.perf_counter()
         dets = self.detector.detect(frame)
+        if tile is not None:
+            dets = self._keyframes.look(frame, dets, tile)
         return dets, time.perf_counter() - t0
 
     def _submit(self, frame: Frame) -> Future[tuple[Detections, float]]:
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
-        return self._pool.submit(self._detect_timed, frame)
+        return self._pool.submit(self._detect_timed, frame, self._keyframes.tile_for(frame))
 
     def prepare(self, frame: Frame) -> None:
         """Start the detector on the next frame (``run_stages`` hands it over before it
@@ -282,7 +287,7 @@ class ForegroundStage:
                 where = frame.source or f"frame {frame.pose_id}"
                 raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
         else:
-            dets, detect_s = self._detect_timed(frame)
+            dets, detect_s = self._detect_timed(frame, self._keyframes.tile_for(frame))
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
         dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
@@ -432,6 +437,7 @@ class ForegroundStage:
             bottom_hidden=COMPLETE_FOOTPRINTS and match.class_name in FLOOR_STANDING
             and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
             full_view=full,
+            closer_look=self._keyframes.covers(frame, blob.image_box_xyxy),
             named_within=named_within(
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),

@@ -74,6 +74,9 @@ class Measurement:
     counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
+    closer_look: bool = False
+    """A keyframe's closer look saw the blob whole (``keyframes.py``): its class, or ``unknown``,
+    also counts in the closer look's own vote (``class_vote``)."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -138,6 +141,9 @@ class Track:
     full_views: int = 0
     full_named: dict[str, int] = field(default_factory=dict)
     detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
+    # the vote of the keyframes' closer looks alone (``Measurement.closer_look``)
+    closer_votes: dict[str, float] = field(default_factory=dict)
+    closer_counts: dict[str, int] = field(default_factory=dict)
     refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
     refused_max_share: float = 0.0
     min_class_observations: int = 1

@@ -39,7 +39,7 @@ def _squares(mask):
     """Boxes of the connected red regions (4-connectivity), xyxy."""
     import cv2
 
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
+    n, _labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
     return [(x, y, x + w, y + h) for x, y, w, h, _ in stats[1:n].tolist()]
 
 
