@@ -16,9 +16,11 @@ Each observation votes for its class with its detection score (``unknown`` with
 
 Two rates (``keyframes.py``): a keyframe's closer look sees small and distant things that the
 every-frame look cannot name, whose ``unknown`` from every frame would outvote any name. The
-observations a closer look saw whole (``closer_look``) also count in a vote of their own, with
-the same rules but ``CLOSER_MIN_LOOKS`` observations; a track the every-frame vote leaves
-``unknown`` takes that vote's winner.
+observations a closer look saw whole (``closer_look``) also count in a vote of their own: a
+known class named in at least ``CLOSER_MIN_LOOKS`` of them and in ``min_class_share`` of them
+all (each look one vote: the closer look resolves the thing, so its ``unknown`` counts as much
+as a name), not too short for the class. A track the every-frame vote leaves ``unknown`` takes
+that vote's winner.
 
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
@@ -124,28 +126,30 @@ def absorb_votes(old: Track, new: Track) -> None:
 def winner(track: Track) -> str:
     """The vote's winner, or ``unknown`` without the evidence (see the module docstring); the
     closer looks' winner when every frame's vote has none."""
-    best = _winner(track, track.class_votes, track.class_counts, track.min_class_observations, refuse=True)
-    if best == UNKNOWN and track.closer_counts:
-        best = _winner(track, track.closer_votes, track.closer_counts, CLOSER_MIN_LOOKS, refuse=False)
+    known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
+    eligible = [
+        k for k in sorted(known)
+        if track.class_counts.get(k, 0) >= track.min_class_observations and _long_enough(track, k)
+        and not _refused(track, k)
+    ]
+    if not eligible:
+        return _closer_winner(track)
+    best = max(eligible, key=lambda k: known[k])
+    if known[best] < track.min_class_share * sum(known.values()):
+        return _closer_winner(track)
+    if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
+        return _closer_winner(track)
     return best
 
 
-def _winner(track: Track, votes: dict[str, float], counts: dict[str, int], min_count: int,
-            refuse: bool) -> str:
-    """The winner of one vote (``votes`` and ``counts`` per class): a known class named at least
-    ``min_count`` times, long enough, not ``refuse``d, with ``min_class_share`` of the known
-    votes, outweighing ``unknown``."""
-    known = {k: v for k, v in votes.items() if k != UNKNOWN}
-    eligible = [
-        k for k in sorted(known)
-        if counts.get(k, 0) >= min_count and _long_enough(track, k) and not (refuse and _refused(track, k))
-    ]
-    if not eligible:
+def _closer_winner(track: Track) -> str:
+    """The closer looks' winner (see the module docstring), or ``unknown``."""
+    known = {k: n for k, n in track.closer_counts.items() if k != UNKNOWN}
+    if not known:
         return UNKNOWN
-    best = max(eligible, key=lambda k: known[k])
-    if known[best] < track.min_class_share * sum(known.values()):
-        return UNKNOWN
-    if votes.get(UNKNOWN, 0.0) > known[best]:
+    best = max(sorted(known), key=lambda k: (known[k], track.closer_votes[k]))
+    looks = sum(track.closer_counts.values())
+    if known[best] < max(CLOSER_MIN_LOOKS, track.min_class_share * looks) or not _long_enough(track, best):
         return UNKNOWN
     return best
 

@@ -30,7 +30,7 @@ __all__ = [
     "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "KeyframeLook",
 ]
 
-CLOSER_LOOK_S: float = 1.0
+CLOSER_LOOK_S: float = 0.5
 """A keyframe at most this long (s of log) after the last one (0: no closer look)."""
 CLOSER_LOOK_MOVE_M: float = 0.5
 """... or sooner, once the camera moved this far from where the last one was taken (m)."""

@@ -115,3 +115,39 @@ def test_a_blob_counts_as_seen_closer_only_whole_inside_its_frames_tile(monkeypa
     assert not look.covers(frame, np.array([10.0, 10.0, x1 + 5.0, 40.0]))  # cut by the tile's edge
     later = make_frame(room(), pose_looking_x(), 0.5, 1)
     assert not look.covers(later, np.array([10.0, 10.0, 40.0, 40.0]))  # no tile on that frame
+
+
+def _tallies():
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        class_votes={}, class_counts={}, class_longest_m={}, full_views=0, full_named={},
+        detected_classes=set(),
+        closer_votes={}, closer_counts={}, min_class_observations=4, min_class_share=0.6, size_tolerance=None,
+        refused_min_views=0, refused_max_share=0.0, _class_name=None)
+
+
+def _look(class_name, closer, score=0.8):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(class_name=class_name, score=score if class_name != "unknown" else 0.0,
+                           longest_m=None, full_view=False, named_within=frozenset(),
+                           detection_index=None if class_name == "unknown" else 0, closer_look=closer)
+
+
+def test_the_closer_looks_name_a_thing_only_when_most_of_them_name_it():
+    from hiper_cli.perceive.foreground.class_vote import record, winner
+
+    def vote(looks):
+        track = _tallies()
+        for _ in range(150):  # five seconds at 30 Hz: the every-frame look never names it
+            record(track, _look("unknown", closer=False), 0.15)
+        for name in looks:
+            record(track, _look(name, closer=True), 0.15)
+        return winner(track)
+
+    assert vote(["cup", "cup", "cup", "unknown"]) == "cup"
+    assert vote(["cup", "cup", "unknown"]) == "unknown"  # three looks at least
+    assert vote(["cup"] * 4 + ["unknown"] * 4) == "unknown"  # half the looks: not most
+    assert vote(["cup"] * 5 + ["unknown"] * 3) == "cup"
+    assert vote(["cup", "cup", "cup", "bowl", "bowl", "unknown"]) == "unknown"  # 3 of 6
