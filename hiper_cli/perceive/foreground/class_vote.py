@@ -16,11 +16,11 @@ Each observation votes for its class with its detection score (``unknown`` with
 
 Two rates (``keyframes.py``): a keyframe's closer look sees small and distant things that the
 every-frame look cannot name, whose ``unknown`` from every frame would outvote any name. The
-observations a closer look saw whole (``closer_look``) also count in a vote of their own: a
-known class named in at least ``CLOSER_MIN_LOOKS`` of them and in ``min_class_share`` of them
-all (each look one vote: the closer look resolves the thing, so its ``unknown`` counts as much
-as a name), not too short for the class. A track the every-frame vote leaves ``unknown`` takes
-that vote's winner.
+observations a closer look saw whole carry the class it gave them (``closer_class``), which
+counts in a vote of its own: a known class named in at least ``CLOSER_MIN_LOOKS`` of them and in
+``min_class_share`` of them all (each look one vote: the closer look resolves the thing, so its
+``unknown`` counts as much as a name), not too short for the class. A track the every-frame vote
+leaves ``unknown`` takes that vote's winner; the every-frame vote never sees the closer look.
 
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
@@ -54,7 +54,7 @@ class Vote(Protocol):
     @property
     def detection_index(self) -> int | None: ...
     @property
-    def closer_look(self) -> bool: ...
+    def closer_class(self) -> str | None: ...
 
 
 class Track(Protocol):
@@ -67,7 +67,6 @@ class Track(Protocol):
     full_views: int
     full_named: dict[str, int]
     detected_classes: set[str]
-    closer_votes: dict[str, float]
     closer_counts: dict[str, int]
     min_class_observations: int
     min_class_share: float
@@ -89,9 +88,8 @@ def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
     weight = unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
     track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
     track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
-    if m.closer_look:
-        track.closer_votes[m.class_name] = track.closer_votes.get(m.class_name, 0.0) + weight
-        track.closer_counts[m.class_name] = track.closer_counts.get(m.class_name, 0) + 1
+    if m.closer_class is not None:
+        track.closer_counts[m.closer_class] = track.closer_counts.get(m.closer_class, 0) + 1
     if m.longest_m is not None and m.class_name != UNKNOWN:
         seen = track.class_longest_m.get(m.class_name, 0.0)
         track.class_longest_m[m.class_name] = max(seen, m.longest_m)
@@ -116,8 +114,6 @@ def absorb_votes(old: Track, new: Track) -> None:
     for cls, count in new.full_named.items():
         old.full_named[cls] = old.full_named.get(cls, 0) + count
     old.detected_classes |= new.detected_classes
-    for cls, votes in new.closer_votes.items():
-        old.closer_votes[cls] = old.closer_votes.get(cls, 0.0) + votes
     for cls, count in new.closer_counts.items():
         old.closer_counts[cls] = old.closer_counts.get(cls, 0) + count
     old._class_name = None
@@ -147,7 +143,7 @@ def _closer_winner(track: Track) -> str:
     known = {k: n for k, n in track.closer_counts.items() if k != UNKNOWN}
     if not known:
         return UNKNOWN
-    best = max(sorted(known), key=lambda k: (known[k], track.closer_votes[k]))
+    best = max(sorted(known), key=lambda k: known[k])
     looks = sum(track.closer_counts.values())
     if known[best] < max(CLOSER_MIN_LOOKS, track.min_class_share * looks) or not _long_enough(track, best):
         return UNKNOWN

@@ -8,11 +8,11 @@ new viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_T
 detector also looks at the image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8 times
 closer). One tile a frame, on the keyframe and the frames after it: the worker's time per frame
 grows by one detector run, not four, so the whole command keeps the sensor rate, and over those
-few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. A tile's
-detections join the frame's own (``tiled.merge_detections``) and feed the same class vote; a
-blob the tile saw whole is marked (``covers``) so that its class, or ``unknown``, also counts in
-the closer looks' own vote (``class_vote``): the every-frame look's ``unknown`` on a thing too
-small for it is no evidence against the closer look's name.
+few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. The tile's
+detections joined with the frame's own (``tiled.merge_detections``) name the blobs the tile held
+whole (``closer_detections``); those names count in the closer looks' own vote (``class_vote``):
+the every-frame look's ``unknown`` on a thing too small for it is no evidence against them. The
+every-frame look (segmentation, tracking, its vote) is left as it was.
 
 Only a detector that looks at the image gets the closer look: ``log`` and ``truth`` replay
 recorded detections of the whole frame.
@@ -59,6 +59,7 @@ class KeyframeLook:
         self._last_pose: np.ndarray | None = None
         self._pending: list[int] = []  # the tiles the frames after a keyframe still get
         self._given: dict[float, int] = {}  # stamp (s) -> the tile of that frame, the latest few
+        self._closer: dict[float, Detections] = {}  # stamp (s) -> its closer look's detections
         self.keyframes = 0
 
     def tile_for(self, frame: Frame) -> int | None:
@@ -75,7 +76,9 @@ class KeyframeLook:
         tile = self._pending.pop(0)
         self._given[frame.stamp_s] = tile
         while len(self._given) > GIVEN_KEPT:
-            del self._given[next(iter(self._given))]
+            stamp_s = next(iter(self._given))
+            del self._given[stamp_s]
+            self._closer.pop(stamp_s, None)
         return tile
 
     def covers(self, frame: Frame, xyxy: np.ndarray) -> bool:
@@ -99,8 +102,13 @@ class KeyframeLook:
         turned_deg = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
         return moved_m >= CLOSER_LOOK_MOVE_M or turned_deg >= CLOSER_LOOK_TURN_DEG
 
-    def look(self, frame: Frame, dets: Detections, tile: int) -> Detections:
-        """``dets`` (the frame's quick look) with the detections of its tile ``tile``."""
+    def look(self, frame: Frame, dets: Detections, tile: int) -> None:
+        """Run the closer look on ``frame``'s tile ``tile`` (in the detector's worker): its
+        detections with ``dets``, the frame's quick look, are kept for ``closer_detections``."""
         rows, cols, overlap = CLOSER_LOOK_TILES
         box = tile_boxes(frame.width, frame.height, rows, cols, overlap)[tile]
-        return merge_detections([dets, tile_detections(self.detector, frame, box)])
+        self._closer[frame.stamp_s] = merge_detections([dets, tile_detections(self.detector, frame, box)])
+
+    def closer_detections(self, frame: Frame, xyxy: np.ndarray) -> Detections | None:
+        """``frame``'s closer look when its tile held the image box ``xyxy`` whole, else None."""
+        return self._closer.get(frame.stamp_s) if self.covers(frame, xyxy) else None

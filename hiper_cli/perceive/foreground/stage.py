@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -226,11 +226,11 @@ class ForegroundStage:
 
     # --- the stage --------------------------------------------------------------------------
     def _detect_timed(self, frame: Frame, tile: int | None) -> tuple[Detections, float]:
-        """The frame's detections, with its ``tile`` of a keyframe's closer look (``keyframes.py``)."""
+        """The frame's detections; and the closer look at its ``tile`` of a keyframe (``keyframes.py``)."""
         t0 = time.perf_counter()
         dets = self.detector.detect(frame)
         if tile is not None:
-            dets = self._keyframes.look(frame, dets, tile)
+            self._keyframes.look(frame, dets, tile)
         return dets, time.perf_counter() - t0
 
     def _submit(self, frame: Frame) -> Future[tuple[Detections, float]]:
@@ -373,7 +373,9 @@ class ForegroundStage:
             if keyframe and match.class_name not in cfg.walker_classes and is_solid(blob.points_cam):
                 held.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
-            measurements.append(self._measurement(frame, blob, match, dets, (obs, longest)))
+            measurement = self._measurement(frame, blob, match, dets, (obs, longest))
+            closer = self._closer_class(frame, scene, blob)  # a keyframe's closer look (``keyframes.py``)
+            measurements.append(measurement if closer is None else replace(measurement, closer_class=closer))
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
@@ -437,11 +439,25 @@ class ForegroundStage:
             bottom_hidden=COMPLETE_FOOTPRINTS and match.class_name in FLOOR_STANDING
             and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
             full_view=full,
-            closer_look=self._keyframes.covers(frame, blob.image_box_xyxy),
             named_within=named_within(
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),
         )
+
+    def _closer_class(self, frame: Frame, scene: _Background, blob: Blob) -> str | None:
+        """The class a keyframe's closer look gives ``blob`` when its tile held it whole
+        (``keyframes.py``), by the same matching and checks as every frame's; None: no such look."""
+        dets = self._keyframes.closer_detections(frame, blob.image_box_xyxy)
+        if dets is None:
+            return None
+        cfg = self.config  # the classes the stage names, one name per box (as ``_detections``)
+        dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
+        dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
+        dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
+                            cfg.min_detection_score)
+        (match,) = assign_classes(blob.image_box_xyxy.reshape(1, 4), dets, iou_threshold=cfg.iou_threshold,
+                                  min_score=cfg.min_detection_score, unknown=UNKNOWN)
+        return self._judged(frame, scene, blob, match)[0].class_name
 
     def _track(
         self, frame: Frame, scene: _Background,

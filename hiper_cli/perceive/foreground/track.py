@@ -74,9 +74,10 @@ class Measurement:
     counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
-    closer_look: bool = False
-    """A keyframe's closer look saw the blob whole (``keyframes.py``): its class, or ``unknown``,
-    also counts in the closer look's own vote (``class_vote``)."""
+    closer_class: str | None = None
+    """The class a keyframe's closer look gave the blob, ``unknown`` included, when it saw the blob
+    whole (``keyframes.py``; None: no closer look): it counts in the closer looks' own vote
+    (``class_vote``), never in the every-frame one."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -141,8 +142,7 @@ class Track:
     full_views: int = 0
     full_named: dict[str, int] = field(default_factory=dict)
     detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
-    # the vote of the keyframes' closer looks alone (``Measurement.closer_look``)
-    closer_votes: dict[str, float] = field(default_factory=dict)
+    # the vote of the keyframes' closer looks alone (``Measurement.closer_class``)
     closer_counts: dict[str, int] = field(default_factory=dict)
     refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
     refused_max_share: float = 0.0

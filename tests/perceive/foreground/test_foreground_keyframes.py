@@ -123,16 +123,16 @@ def _tallies():
     return SimpleNamespace(
         class_votes={}, class_counts={}, class_longest_m={}, full_views=0, full_named={},
         detected_classes=set(),
-        closer_votes={}, closer_counts={}, min_class_observations=4, min_class_share=0.6, size_tolerance=None,
+        closer_counts={}, min_class_observations=4, min_class_share=0.6, size_tolerance=None,
         refused_min_views=0, refused_max_share=0.0, _class_name=None)
 
 
-def _look(class_name, closer, score=0.8):
+def _look(closer_class):
+    """A blob the every-frame look left unknown; ``closer_class``: what a closer look named it."""
     from types import SimpleNamespace
 
-    return SimpleNamespace(class_name=class_name, score=score if class_name != "unknown" else 0.0,
-                           longest_m=None, full_view=False, named_within=frozenset(),
-                           detection_index=None if class_name == "unknown" else 0, closer_look=closer)
+    return SimpleNamespace(class_name="unknown", score=0.0, longest_m=None, full_view=False,
+                           named_within=frozenset(), detection_index=None, closer_class=closer_class)
 
 
 def test_the_closer_looks_name_a_thing_only_when_most_of_them_name_it():
@@ -141,9 +141,9 @@ def test_the_closer_looks_name_a_thing_only_when_most_of_them_name_it():
     def vote(looks):
         track = _tallies()
         for _ in range(150):  # five seconds at 30 Hz: the every-frame look never names it
-            record(track, _look("unknown", closer=False), 0.15)
+            record(track, _look(None), 0.15)
         for name in looks:
-            record(track, _look(name, closer=True), 0.15)
+            record(track, _look(name), 0.15)
         return winner(track)
 
     assert vote(["cup", "cup", "cup", "unknown"]) == "cup"
