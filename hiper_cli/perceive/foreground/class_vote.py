@@ -28,6 +28,14 @@ of 176, a desk called ``bench`` in 5 of 21) is too weakly supported to name the 
 tracker keeps the class as its working hypothesis (how it associates and moves the track, its
 box), so the object stays where it was found, ``unknown``.
 
+Two rates (``keyframes.py``): a keyframe's closer look sees small and distant things that the
+every-frame look cannot name, whose ``unknown`` from every frame would outvote any name. The
+observations a closer look saw whole carry the class it gave them (``closer_class``), which
+counts in a vote of its own: a known class named in at least ``CLOSER_MIN_LOOKS`` of them and in
+``min_class_share`` of them all (each look one vote: the closer look resolves the thing, so its
+``unknown`` counts as much as a name), not too short for the class. A track the every-frame vote
+leaves ``unknown`` takes that vote's winner; the every-frame vote never sees the closer look.
+
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
 ``absorb_votes`` clear it.
@@ -65,6 +73,8 @@ class Vote(Protocol):
     def named_within(self) -> frozenset[str]: ...
     @property
     def detection_index(self) -> int | None: ...
+    @property
+    def closer_class(self) -> str | None: ...
 
 
 class Track(Protocol):
@@ -77,6 +87,7 @@ class Track(Protocol):
     full_views: int
     full_named: dict[str, int]
     detected_classes: set[str]
+    closer_counts: dict[str, int]
     min_class_observations: int
     min_class_share: float
     size_tolerance: float | None
@@ -86,6 +97,9 @@ class Track(Protocol):
     @property
     def class_name(self) -> str: ...
 MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a little
+CLOSER_MIN_LOOKS = 3
+"""Closer looks (keyframes, ``keyframes.py``) that named a class before it wins the closer look's
+vote: keyframes are seconds apart, so three are three views, where frames at 30 Hz are one."""
 
 
 def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
@@ -93,6 +107,8 @@ def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
     weight = unknown_vote_weight if m.class_name == UNKNOWN else max(m.score, MIN_VOTE_WEIGHT)
     track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
     track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
+    if m.closer_class is not None:
+        track.closer_counts[m.closer_class] = track.closer_counts.get(m.closer_class, 0) + 1
     if m.longest_m is not None and m.class_name != UNKNOWN:
         seen = track.class_longest_m.get(m.class_name, 0.0)
         track.class_longest_m[m.class_name] = max(seen, m.longest_m)
@@ -117,13 +133,16 @@ def absorb_votes(old: Track, new: Track) -> None:
     for cls, count in new.full_named.items():
         old.full_named[cls] = old.full_named.get(cls, 0) + count
     old.detected_classes |= new.detected_classes
+    for cls, count in new.closer_counts.items():
+        old.closer_counts[cls] = old.closer_counts.get(cls, 0) + count
     old._class_name = None
 
 
 def winner(track: Track, judged: bool = True) -> str:
-    """The vote's winner, or ``unknown`` without the evidence (see the module docstring);
-    ``judged`` False: without the full views' judgement (``refused_min_views``): whether
-    detections saw an object there (``named_object``)."""
+    """The vote's winner, or ``unknown`` without the evidence (see the module docstring), the
+    closer looks' winner when every frame's vote has none; ``judged`` False: without the full
+    views' judgement (``refused_min_views``): whether detections saw an object there
+    (``named_object``)."""
     known = {k: v for k, v in track.class_votes.items() if k != UNKNOWN}
     eligible = [
         k for k in sorted(known)
@@ -131,22 +150,36 @@ def winner(track: Track, judged: bool = True) -> str:
         and not (judged and _refused(track, k))
     ]
     if not eligible:
-        return UNKNOWN
+        return _closer_winner(track)
     best = max(eligible, key=lambda k: known[k])
     if known[best] < track.min_class_share * sum(known.values()):
-        return UNKNOWN
+        return _closer_winner(track)
     if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
+        return _closer_winner(track)
+    return best
+
+
+def _closer_winner(track: Track) -> str:
+    """The closer looks' winner (see the module docstring), or ``unknown``."""
+    known = {k: n for k, n in track.closer_counts.items() if k != UNKNOWN}
+    if not known:
+        return UNKNOWN
+    best = max(sorted(known), key=lambda k: known[k])
+    looks = sum(track.closer_counts.values())
+    if known[best] < max(CLOSER_MIN_LOOKS, track.min_class_share * looks) or not _long_enough(track, best):
         return UNKNOWN
     return best
 
 
 def shown_class(track: Track) -> str:
     """The class the track's instance shows: its class when its votes outweigh the ``unknown``
-    ones ``SUPPORT_MARGIN`` times over, else ``unknown`` (see the module docstring)."""
+    ones ``SUPPORT_MARGIN`` times over or the closer looks chose it, else ``unknown`` (see the
+    module docstring)."""
     name, votes = track.class_name, track.class_votes
     if name == UNKNOWN or votes.get(name, 0.0) >= SUPPORT_MARGIN * votes.get(UNKNOWN, 0.0):
         return name
-    return UNKNOWN
+    # a class the closer looks chose was weighed against their own ``unknown`` looks
+    return name if _closer_winner(track) == name else UNKNOWN
 
 
 def named_object(track: Track) -> bool:

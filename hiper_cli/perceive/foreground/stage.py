@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -30,6 +30,7 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import has_moved, is_static
@@ -194,6 +195,7 @@ class ForegroundStage:
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
+        self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
@@ -222,15 +224,18 @@ class ForegroundStage:
         return center, extent
 
     # --- the stage --------------------------------------------------------------------------
-    def _detect_timed(self, frame: Frame) -> tuple[Detections, float]:
+    def _detect_timed(self, frame: Frame, tile: int | None) -> tuple[Detections, float]:
+        """The frame's detections; and the closer look at its ``tile`` of a keyframe (``keyframes.py``)."""
         t0 = time.perf_counter()
         dets = self.detector.detect(frame)
+        if tile is not None:
+            self._keyframes.look(frame, dets, tile)
         return dets, time.perf_counter() - t0
 
     def _submit(self, frame: Frame) -> Future[tuple[Detections, float]]:
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
-        return self._pool.submit(self._detect_timed, frame)
+        return self._pool.submit(self._detect_timed, frame, self._keyframes.tile_for(frame))
 
     def prepare(self, frame: Frame) -> None:
         """Start the detector on the next frame (``run_stages`` hands it over before it
@@ -281,7 +286,7 @@ class ForegroundStage:
                 where = frame.source or f"frame {frame.pose_id}"
                 raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
         else:
-            dets, detect_s = self._detect_timed(frame)
+            dets, detect_s = self._detect_timed(frame, self._keyframes.tile_for(frame))
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
         dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
@@ -367,7 +372,9 @@ class ForegroundStage:
             if keyframe and match.class_name not in cfg.walker_classes and is_solid(blob.points_cam):
                 held.append((obs.uuid, blob.points_map))
             surfaces.append(None if match.class_name in cfg.walker_classes else blob.points_map)
-            measurements.append(self._measurement(frame, blob, match, dets, (obs, longest)))
+            measurement = self._measurement(frame, blob, match, dets, (obs, longest))
+            closer = self._closer_class(frame, scene, blob)  # a keyframe's closer look (``keyframes.py``)
+            measurements.append(measurement if closer is None else replace(measurement, closer_class=closer))
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
@@ -435,6 +442,21 @@ class ForegroundStage:
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),
         )
+
+    def _closer_class(self, frame: Frame, scene: _Background, blob: Blob) -> str | None:
+        """The class a keyframe's closer look gives ``blob`` when its tile held it whole
+        (``keyframes.py``), by the same matching and checks as every frame's; None: no such look."""
+        dets = self._keyframes.closer_detections(frame, blob.image_box_xyxy)
+        if dets is None:
+            return None
+        cfg = self.config  # the classes the stage names, one name per box (as ``_detections``)
+        dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
+        dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
+        dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
+                            cfg.min_detection_score)
+        (match,) = assign_classes(blob.image_box_xyxy.reshape(1, 4), dets, iou_threshold=cfg.iou_threshold,
+                                  min_score=cfg.min_detection_score, unknown=UNKNOWN)
+        return self._judged(frame, scene, blob, match)[0].class_name
 
     def _track(
         self, frame: Frame, scene: _Background,

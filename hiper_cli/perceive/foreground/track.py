@@ -74,6 +74,10 @@ class Measurement:
     counts against that class (``class_vote``)."""
     named_within: frozenset[str] = frozenset()
     """Classes of detections lying inside the blob's image box (``match.named_within``)."""
+    closer_class: str | None = None
+    """The class a keyframe's closer look gave the blob, ``unknown`` included, when it saw the blob
+    whole (``keyframes.py``; None: no closer look): it counts in the closer looks' own vote
+    (``class_vote``), never in the every-frame one."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -138,6 +142,8 @@ class Track:
     full_views: int = 0
     full_named: dict[str, int] = field(default_factory=dict)
     detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
+    # the vote of the keyframes' closer looks alone (``Measurement.closer_class``)
+    closer_counts: dict[str, int] = field(default_factory=dict)
     refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
     min_class_observations: int = 1
     min_class_share: float = 0.0

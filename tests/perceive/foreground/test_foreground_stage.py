@@ -252,7 +252,8 @@ def test_objects_rest_on_the_fitted_floor_plane_not_on_the_top_of_its_box():
 
 
 class _RecordingDetector:
-    """The ``log`` detector, recording which frames it saw and on which thread."""
+    """The ``log`` detector, recording which frames it saw whole and on which thread (and apart,
+    the tiles of a keyframe's closer look, ``keyframes.py``)."""
 
     name = "recording"
 
@@ -261,11 +262,13 @@ class _RecordingDetector:
 
         self.inner = LogDetector()
         self.seen = []
+        self.tiles = []
 
     def detect(self, frame):
         import threading
 
-        self.seen.append((frame.pose_id, threading.current_thread().name))
+        looks = self.seen if frame.width == CAMERA.width else self.tiles
+        looks.append((frame.pose_id, threading.current_thread().name))
         return self.inner.detect(frame)
 
 
@@ -284,7 +287,8 @@ def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker():
         ("prepare", 3), ("process", 2), ("process", 3),
     ]  # fmt: skip
     assert sorted(pose for pose, _ in detector.seen) == [0, 1, 2, 3]
-    assert all(name.startswith("hiper-detect") for _, name in detector.seen)
+    assert all(name.startswith("hiper-detect") for _, name in detector.seen + detector.tiles)
+    assert sorted(pose for pose, _ in detector.tiles) == [0, 1, 2, 3]  # a keyframe: one tile a frame
     # same result as detecting each frame when it is processed
     plain = ForegroundStage(detector="log", pixel_step=2, detector_threads=0)
     world_plain, _ = run_stages(walker_frames(n=4), [plain], World(background=background_instances(room())))
