@@ -195,6 +195,7 @@ class ForegroundStage:
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
+        self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
@@ -316,6 +317,7 @@ class ForegroundStage:
             blobs = drop_table_legs(
                 blobs, scene.tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
             )
+        self._large = seg.large  # too large for an object, not for the static map (``_measure``)
         return blobs, seg
 
     def _split_and_refine(
@@ -357,8 +359,9 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
-        keyframe = self._solid.due(frame.stamp_s)
-        held: list[tuple[str, FloatArray]] = []  # a keyframe's solid blobs but walkers' (``SolidMap``)
+        keyframe = self._solid.due(frame.stamp_s, frame.T_map_cam)
+        # a keyframe's solid blobs but walkers' (``SolidMap``), those too large for one object too
+        held = [("", b.points_map) for b in self._large if keyframe and is_solid(b.points_cam)]
         for blob, match in zip(blobs, matches, strict=True):
             match, longest = self._judged(frame, scene, blob, match)
             if match.detection_index is None and not cfg.keep_unknown:
