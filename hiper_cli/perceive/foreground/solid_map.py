@@ -59,6 +59,9 @@ _OFFSET = 1 << 20  # voxel indices are packed into one int64 key, 21 bits each
 _BITS = 21
 
 
+_Support = tuple[FloatArray, FloatArray, float]  # a support's footprint (lower, upper corner, m) and top
+
+
 def is_solid(points_cam: FloatArray) -> bool:
     """Whether a blob's points (camera frame) spread across their thinnest direction by more
     than the depth noise: a body, not a piece of a wall or a furniture side."""
@@ -192,12 +195,17 @@ class SolidMap:
                 local = (centres - box.center_m) @ box.R
                 inside |= np.all(np.abs(local) <= box.extent_m / 2.0, axis=1)
             idx = idx[~inside]
+        if ceiling_z_m is not None and len(idx):
+            idx = idx[~_building_columns(_unpack(self._keys[idx]), ceiling_z_m)]
         if not len(idx):
             return []
         labels = np.full(len(self._keys), -1, dtype=np.int64)
         labels[idx] = self._grouped(idx)
         held = self._held_by(labels)
-        tops = [float(b.aabb()[1][2]) for b in supports] + [floor_z_m]
+        # what a part may stand on: the supports' tops over their footprints; the floor's height
+        # anywhere while the background has mapped no support
+        tops = [(b.aabb()[0][:2], b.aabb()[1][:2], float(b.aabb()[1][2])) for b in supports] or [
+            (np.full(2, -np.inf), np.full(2, np.inf), floor_z_m)]
         out: list[SolidPart] = []
         for label in range(int(labels.max()) + 1):
             frames, uuids = held.get(label, (set(), []))
@@ -275,7 +283,7 @@ class SolidMap:
         return held
 
     def _part(
-        self, members: NDArray[np.int64], levels: tuple[Sequence[float], float | None],
+        self, members: NDArray[np.int64], levels: tuple[Sequence[_Support], float | None],
         taken: Sequence[Box3D], uuids: list[str],
     ) -> SolidPart | None:
         """The object of one connected part (``members``: voxel indices), or None when it is
@@ -290,7 +298,8 @@ class SolidMap:
         extent = hi - lo
         if extent[2] < MIN_HEIGHT_M or max(float(extent[0]), float(extent[1])) > MAX_EXTENT_M:
             return None
-        if not any(abs(float(lo[2]) - top) <= BASE_REACH_M for top in tops):
+        if not any(abs(float(lo[2]) - top) <= BASE_REACH_M and np.all(lo[:2] < s_hi) and np.all(hi[:2] > s_lo)
+                   for s_lo, s_hi, top in tops):  # stands on a support, over its footprint
             return None
         if ceiling_z_m is not None and float(hi[2]) >= ceiling_z_m - CEILING_REACH_M:
             return None  # from the floor to the ceiling: building structure, or run into it
@@ -336,6 +345,19 @@ def _compact(xy: FloatArray) -> bool:
         return False
     cells = len(np.unique(np.round(xy / VOXEL_M).astype(np.int64), axis=0))
     return cells * VOXEL_M * VOXEL_M >= MIN_PIECE_FILL * float(np.prod(extent))
+
+
+def _building_columns(ijk: NDArray[np.int64], ceiling_z_m: float) -> NDArray[np.bool_]:
+    """Per voxel ``ijk``, whether its column (the voxels above and below it) reaches up to the
+    ceiling: a wall or a pillar the background did not map, not the table or the shelf that
+    stands against it."""
+    columns = ijk[:, 0] * (1 << _BITS) + ijk[:, 1]
+    order = np.argsort(columns)
+    ordered = columns[order]
+    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
+    top_k = np.maximum.reduceat(ijk[order, 2], starts)
+    column_of = np.searchsorted(ordered[starts], columns)
+    return np.asarray((top_k[column_of] + 1) * VOXEL_M >= ceiling_z_m - CEILING_REACH_M, dtype=bool)
 
 
 def _labels(n: int, a: NDArray[np.int64], b: NDArray[np.int64], keep: NDArray[np.bool_]) -> NDArray[np.int64]:

@@ -361,7 +361,9 @@ class ForegroundStage:
         surfaces: list[FloatArray | None] = []
         keyframe = self._solid.due(frame.stamp_s, frame.T_map_cam)
         # a keyframe's solid blobs but walkers' (``SolidMap``), those too large for one object too
-        held = [("", b.points_map) for b in self._large if keyframe and is_solid(b.points_cam)]
+        # (their points within the sensor's range: the slack beyond is for objects across it)
+        held = [("", b.points_map[b.points_cam[:, 2] <= cfg.max_depth_m])
+                for b in self._large if keyframe and is_solid(b.points_cam)]
         for blob, match in zip(blobs, matches, strict=True):
             match, longest = self._judged(frame, scene, blob, match)
             if match.detection_index is None and not cfg.keep_unknown:

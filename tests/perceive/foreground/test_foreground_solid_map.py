@@ -197,3 +197,23 @@ def test_a_run_longer_than_one_object_is_parted_in_compact_pieces() -> None:
         lo, hi = part.box.aabb()
         assert max(hi[:2] - lo[:2]) <= MAX_EXTENT_M + 0.1
         assert min(hi[:2] - lo[:2]) < 1.0  # a piece of one leg, not the corner's square
+
+
+def test_a_table_against_an_unmapped_wall_is_kept_and_the_wall_is_not() -> None:
+    # the wall's columns reach the ceiling: the building's; the table before it stands on the floor
+    wall = box_surface([-1.5, 0.4, 0.0], [1.5, 0.5, 2.5])
+    table = box_surface([-0.6, -0.2, 0.0], [0.6, 0.4, 0.75])
+    solid = drive_past([wall, table, floor_points()], unnamed=[0, 1])
+    (part,) = solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=2.6)
+    lo, hi = part.box.aabb()
+    assert hi[2] < 1.0 and lo[1] > -0.35 and hi[1] < 0.55  # the table's box
+    (joined,) = solid.parts(0.0, [FLOOR], [], [])  # no ceiling mapped: the table joined to the wall
+    assert joined.box.aabb()[1][2] > 2.0
+
+
+def test_a_thing_beyond_the_supports_footprint_stands_on_nothing() -> None:
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    solid = drive_past([crate, floor_points()], unnamed=[0])
+    elsewhere = Box3D(np.array([5.0, 5.0, -0.05]), np.array([2.0, 2.0, 0.1]))  # a floor piece away from it
+    assert solid.parts(0.0, [elsewhere], [], []) == []
+    assert len(solid.parts(0.0, [FLOOR, elsewhere], [], [])) == 1
