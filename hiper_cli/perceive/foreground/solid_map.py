@@ -4,21 +4,25 @@ stack, a bucket, a shelf), fused over views in a voxel map and kept as ``unknown
 A track of unnamed blobs becomes an instance only when the camera saw the whole object
 (``whole.py``), which a stack longer than a metre, or one always cut by the image's border,
 never is; nor does a track that detections named once or twice. This map asks instead
-whether a surface is *there*. At keyframes (every ``KEYFRAME_S``) the points of the not flat
-blobs of every class but the walkers' add their voxels (``VOXEL_M``), and
-every voxel kept so far is projected into the depth image: measured at its depth, the surface
-is seen there again; measured well behind it, the camera looked through it (expected, not
-seen). A voxel found there in ``MIN_SEEN_SHARE`` of the keyframes that could tell is evidence;
-a passing person, flying pixels at a depth edge and a drifting fragment are seen through from
-the next viewpoint and are not.
+whether a surface is *there*. At keyframes (every ``KEYFRAME_S``, and whenever the camera
+turned ``KEYFRAME_TURN_RAD`` or moved ``KEYFRAME_MOVE_M``) the points of the not flat blobs of
+every class but the walkers', and of the clusters too long for one object (a rack seen along
+its length), add their voxels (``VOXEL_M``), and every voxel kept so far is projected into the
+depth image: measured at its depth, the surface is seen there again; measured well behind it,
+the camera looked through it (expected, not seen). A voxel found there in ``MIN_SEEN_SHARE``
+of the keyframes that could tell is evidence; a passing person, flying pixels at a depth edge
+and a drifting fragment are seen through from the next viewpoint and are not.
 
-At the end of the log the evidence voxels outside the background are grouped into connected
-parts (voxels one above the other across a gap of ``STACK_GAP_M`` join: a rack's boards, a
-stack whose middle was hidden). A part is an object when its voxels were found there at
-``MIN_SEEN_PART`` keyframes (median), it is solid (not one sheet of voxels: a wall or a
-furniture side the background left), large enough, stands on the floor or a support
-(``BASE_REACH_M``), is at most ``MAX_EXTENT_M`` long, and no instance of the session (any
-class) covers it. Its box is the box of its voxels.
+At the end of the log the evidence voxels outside the background, and outside the columns
+that reach the mapped ceiling (a wall or a pillar the background missed), are grouped into
+parts: neighbours (voxels one above the other across a gap of ``STACK_GAP_M`` too: a rack's
+boards) join unless the keyframes' blobs held them apart as often as together or more (a
+chair at a desk, two stacks side by side). A part longer than ``MAX_EXTENT_M`` is several
+things run together (a row of shelves): it is parted into compact pieces. A part is an
+object when its voxels were found there at ``MIN_SEEN_PART`` keyframes (median), it is solid
+(not one sheet of voxels), large enough, stands on the floor or a support over its footprint
+(``BASE_REACH_M``), and no instance of the session (any class) covers it. Its box is the box
+of its voxels.
 """
 
 from __future__ import annotations
