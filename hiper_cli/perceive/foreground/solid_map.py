@@ -52,6 +52,7 @@ MIN_VOXELS = 10  # a part with fewer is debris, not an object (0.01 m³ of surfa
 MIN_HEIGHT_M = 0.15  # ... or lower than this
 MIN_THICKNESS_M = 0.05  # the spread of a part's voxels across their thinnest direction: a sheet
 BASE_REACH_M = 0.25  # its lowest voxel this near the floor or a support top: it stands there
+SUNK_M = 0.15  # ... and not further below it (depth noise): deeper, it is the floor seen at range
 CEILING_REACH_M = 0.3  # its top this near the ceiling: it is the building's, or joined to it
 MAX_EXTENT_M = 4.5  # a longer part is several things run together: it is parted in pieces
 MAX_PIECES = 8  # ... at most this many
@@ -302,8 +303,8 @@ class SolidMap:
         extent = hi - lo
         if extent[2] < MIN_HEIGHT_M or max(float(extent[0]), float(extent[1])) > MAX_EXTENT_M:
             return None
-        if not any(abs(float(lo[2]) - top) <= BASE_REACH_M and np.all(lo[:2] < s_hi) and np.all(hi[:2] > s_lo)
-                   for s_lo, s_hi, top in tops):  # stands on a support, over its footprint
+        if not any(-SUNK_M <= float(lo[2]) - top <= BASE_REACH_M  # stands on a support, over its footprint
+                   and np.all(lo[:2] < s_hi) and np.all(hi[:2] > s_lo) for s_lo, s_hi, top in tops):
             return None
         if ceiling_z_m is not None and float(hi[2]) >= ceiling_z_m - CEILING_REACH_M:
             return None  # from the floor to the ceiling: building structure, or run into it

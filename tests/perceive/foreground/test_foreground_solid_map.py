@@ -217,3 +217,12 @@ def test_a_thing_beyond_the_supports_footprint_stands_on_nothing() -> None:
     elsewhere = Box3D(np.array([5.0, 5.0, -0.05]), np.array([2.0, 2.0, 0.1]))  # a floor piece away from it
     assert solid.parts(0.0, [elsewhere], [], []) == []
     assert len(solid.parts(0.0, [FLOOR, elsewhere], [], [])) == 1
+
+
+def test_a_thing_reaching_well_below_its_support_is_no_part() -> None:
+    # the floor seen at range with depth noise: its voxels reach 0.2 m below the mapped floor
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    solid = drive_past([crate, floor_points()], unnamed=[0])
+    higher = Box3D(np.array([0.0, 0.0, 0.15]), np.array([20.0, 20.0, 0.1]))  # its top 0.2 m above the base
+    assert solid.parts(0.2, [higher], [], []) == []
+    assert len(solid.parts(0.0, [FLOOR], [], [])) == 1
