@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.surface_samples import SAMPLE_POINTS
 from hiper_cli.perceive.foreground.whole import thickness_m
 from hiper_cli.types import Frame
 
@@ -101,6 +102,7 @@ class SolidPart:
     last_seen_s: float
     observation_uuids: list[str]
     seen_share: float
+    surface_m: list[list[float]]  # up to SAMPLE_POINTS of its voxel centres: a later session's sample
 
 
 class SolidMap:
@@ -314,8 +316,10 @@ class SolidMap:
         if any(overlap_share(box, other) >= COVERED_SHARE for other in taken):
             return None
         told = self._seen[members] + self._free[members]
+        sample = centres[np.linspace(0, len(centres) - 1, min(len(centres), SAMPLE_POINTS)).astype(np.int64)]
         return SolidPart(box, float(self._first_s[members].min()), float(self._last_s[members].max()),
-                         uuids, float(self._seen[members].sum() / max(int(told.sum()), 1)))
+                         uuids, float(self._seen[members].sum() / max(int(told.sum()), 1)),
+                         np.round(sample, 3).tolist())
 
 
 def _pieces(members: NDArray[np.int64], centres: FloatArray) -> list[NDArray[np.int64]]:

@@ -764,7 +764,8 @@ def _solid_instance(part: SolidPart) -> Instance:
     return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
                     last_seen_s=part.last_seen_s, confidence=part.seen_share,
                     observation_uuids=part.observation_uuids,
-                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True})
+                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True,
+                          "surface_map": part.surface_m})  # a later session's empty-place test
 
 
 def _wall_boxes(world: World) -> list[Box3D]:
