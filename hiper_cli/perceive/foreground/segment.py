@@ -180,6 +180,10 @@ class SegmentStats:
     clusters: int = 0
     rejected_clusters: int = 0
     timings_s: dict[str, float] = field(default_factory=dict)
+    large: list[Blob] = field(default_factory=list)
+    """The clusters rejected as too large for one object (``MAX_CLUSTER_POINTS``,
+    ``MAX_CLUSTER_EXTENT_M``): structure, or a rack or a row of shelves seen along its length.
+    The static map (``solid_map.py``) still takes their surface."""
 
 
 @lru_cache(maxsize=8)
@@ -427,19 +431,17 @@ def segment(
             fragment = size < config.min_cluster_points
             if fragment and not keep_fragments:
                 continue
-            if size > MAX_CLUSTER_POINTS:
-                stats.rejected_clusters += 1
-                continue
             if MAX_DEPTH_SLACK_M > 0 and np.median(P_flat[sel, 2]) > config.max_depth_m:
                 continue  # beyond the range: the slack only keeps the far side of nearer objects
             pm = map_full[sel]
             lo, hi = point_bounds(pm)
-            if np.any(hi - lo > MAX_CLUSTER_EXTENT_M):
-                stats.rejected_clusters += 1
-                continue
             uv = np.stack([U_flat[sel], V_flat[sel]], axis=1).astype(np.int32)
             box = image_box(uv, step, camera.width, camera.height)
             blob = Blob(P_flat[sel], pm, uv, box, fragment=fragment)
+            if size > MAX_CLUSTER_POINTS or np.any(hi - lo > MAX_CLUSTER_EXTENT_M):
+                stats.rejected_clusters += 1
+                stats.large.append(blob)
+                continue
             blob._bounds = (lo, hi)
             if config.background_filter and support_boxes_map:
                 blob.support_z_m = support_below(blob, support_boxes_map, config, camera.height)

@@ -4,21 +4,25 @@ stack, a bucket, a shelf), fused over views in a voxel map and kept as ``unknown
 A track of unnamed blobs becomes an instance only when the camera saw the whole object
 (``whole.py``), which a stack longer than a metre, or one always cut by the image's border,
 never is; nor does a track that detections named once or twice. This map asks instead
-whether a surface is *there*. At keyframes (every ``KEYFRAME_S``) the points of the not flat
-blobs of every class but the walkers' add their voxels (``VOXEL_M``), and
-every voxel kept so far is projected into the depth image: measured at its depth, the surface
-is seen there again; measured well behind it, the camera looked through it (expected, not
-seen). A voxel found there in ``MIN_SEEN_SHARE`` of the keyframes that could tell is evidence;
-a passing person, flying pixels at a depth edge and a drifting fragment are seen through from
-the next viewpoint and are not.
+whether a surface is *there*. At keyframes (every ``KEYFRAME_S``, and whenever the camera
+turned ``KEYFRAME_TURN_RAD`` or moved ``KEYFRAME_MOVE_M``) the points of the not flat blobs of
+every class but the walkers', and of the clusters too long for one object (a rack seen along
+its length), add their voxels (``VOXEL_M``), and every voxel kept so far is projected into the
+depth image: measured at its depth, the surface is seen there again; measured well behind it,
+the camera looked through it (expected, not seen). A voxel found there in ``MIN_SEEN_SHARE``
+of the keyframes that could tell is evidence; a passing person, flying pixels at a depth edge
+and a drifting fragment are seen through from the next viewpoint and are not.
 
-At the end of the log the evidence voxels outside the background are grouped into connected
-parts (voxels one above the other across a gap of ``STACK_GAP_M`` join: a rack's boards, a
-stack whose middle was hidden). A part is an object when its voxels were found there at
-``MIN_SEEN_PART`` keyframes (median), it is solid (not one sheet of voxels: a wall or a
-furniture side the background left), large enough, stands on the floor or a support
-(``BASE_REACH_M``), is at most ``MAX_EXTENT_M`` long, and no instance of the session (any
-class) covers it. Its box is the box of its voxels.
+At the end of the log the evidence voxels outside the background, and outside the columns
+that reach the mapped ceiling (a wall or a pillar the background missed), are grouped into
+parts: neighbours (voxels one above the other across a gap of ``STACK_GAP_M`` too: a rack's
+boards) join unless the keyframes' blobs held them apart as often as together or more (a
+chair at a desk, two stacks side by side). A part longer than ``MAX_EXTENT_M`` is several
+things run together (a row of shelves): it is parted into compact pieces. A part is an
+object when its voxels were found there at ``MIN_SEEN_PART`` keyframes (median), it is solid
+(not one sheet of voxels), large enough, stands on the floor or a support over its footprint
+(``BASE_REACH_M``), and no instance of the session (any class) covers it. Its box is the box
+of its voxels.
 """
 
 from __future__ import annotations
@@ -30,13 +34,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
+from hiper_cli.perceive.foreground.surface_samples import SAMPLE_POINTS
 from hiper_cli.perceive.foreground.whole import thickness_m
 from hiper_cli.types import Frame
 
 __all__ = ["KEYFRAME_S", "SolidMap", "SolidPart", "is_solid", "overlap_share"]
 
 FloatArray = NDArray[np.float64]
-KEYFRAME_S = 0.5  # the static map is refined at most this often (s of log)
+KEYFRAME_S = 0.5  # the static map is refined at least this often (s of log) ...
+KEYFRAME_TURN_RAD = np.deg2rad(10.0)  # ... and whenever the camera turned this much since ...
+KEYFRAME_MOVE_M = 0.3  # ... or moved this far
 VOXEL_M = 0.1  # edge of a voxel of the map
 MIN_SEEN_SHARE = 0.6  # of the keyframes that could tell, the share that found a voxel's surface
 MIN_SEEN_PART = 2  # a part: its voxels found there at this many keyframes (median)
@@ -46,13 +53,19 @@ MIN_VOXELS = 10  # a part with fewer is debris, not an object (0.01 m³ of surfa
 MIN_HEIGHT_M = 0.15  # ... or lower than this
 MIN_THICKNESS_M = 0.05  # the spread of a part's voxels across their thinnest direction: a sheet
 BASE_REACH_M = 0.25  # its lowest voxel this near the floor or a support top: it stands there
+SUNK_M = 0.15  # ... and not further below it (depth noise): deeper, it is the floor seen at range
 CEILING_REACH_M = 0.3  # its top this near the ceiling: it is the building's, or joined to it
-MAX_EXTENT_M = 4.5  # a longer part is structure or several things run together
+MAX_EXTENT_M = 4.5  # a longer part is several things run together: it is parted in pieces
+MAX_PIECES = 8  # ... at most this many
+MIN_PIECE_FILL = 0.5  # a piece covers this share of its box's footprint at least
 FLAT_M = 0.01  # a blob whose points spread less than this (σ, plus FLAT_PER_M2 · depth²) across
 FLAT_PER_M2 = 0.0015  # ... their thinnest direction is a piece of a surface: it adds no voxels
 COVERED_SHARE = 0.3  # a part whose box an instance's box covers by this share of it is that one
 _OFFSET = 1 << 20  # voxel indices are packed into one int64 key, 21 bits each
 _BITS = 21
+
+
+_Support = tuple[FloatArray, FloatArray, float]  # a support's footprint (lower, upper corner, m) and top
 
 
 def is_solid(points_cam: FloatArray) -> bool:
@@ -89,6 +102,7 @@ class SolidPart:
     last_seen_s: float
     observation_uuids: list[str]
     seen_share: float
+    surface_m: list[list[float]]  # up to SAMPLE_POINTS of its voxel centres: a later session's sample
 
 
 class SolidMap:
@@ -104,15 +118,25 @@ class SolidMap:
         self._blobs: list[tuple[str, int, NDArray[np.int64]]] = []
         self._keyframes = 0
         self._last_keyframe_s: float | None = None
+        self._last_pose: FloatArray | None = None  # T_map_cam of the last keyframe
 
-    def due(self, stamp_s: float) -> bool:
-        """Whether ``stamp_s`` is a keyframe (``KEYFRAME_S`` after the last one)."""
-        return self._last_keyframe_s is None or stamp_s - self._last_keyframe_s >= KEYFRAME_S
+    def due(self, stamp_s: float, T_map_cam: FloatArray | None = None) -> bool:
+        """Whether a frame is a keyframe: ``KEYFRAME_S`` after the last one, or a new viewpoint
+        (the camera turned by ``KEYFRAME_TURN_RAD`` or moved by ``KEYFRAME_MOVE_M`` since): a
+        camera sweeping past a shelf sees each of its voxels in several keyframes."""
+        if self._last_keyframe_s is None or stamp_s - self._last_keyframe_s >= KEYFRAME_S:
+            return True
+        if T_map_cam is None or self._last_pose is None:
+            return False
+        turn = np.clip((np.trace(self._last_pose[:3, :3].T @ T_map_cam[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)
+        moved_m = float(np.linalg.norm(T_map_cam[:3, 3] - self._last_pose[:3, 3]))
+        return float(np.arccos(turn)) >= KEYFRAME_TURN_RAD or moved_m >= KEYFRAME_MOVE_M
 
     def add(self, frame: Frame, blobs: Sequence[tuple[str, FloatArray]]) -> None:
         """One keyframe: ``blobs`` are (observation uuid, map points) of its solid blobs (walkers'
         left out: what walks is no part of the static map)."""
         self._last_keyframe_s = frame.stamp_s
+        self._last_pose = np.asarray(frame.T_map_cam, dtype=np.float64)
         self._keyframes += 1
         self._look(frame)  # the voxels kept so far: there, or seen through
         held: list[NDArray[np.int64]] = []
@@ -178,22 +202,74 @@ class SolidMap:
                 local = (centres - box.center_m) @ box.R
                 inside |= np.all(np.abs(local) <= box.extent_m / 2.0, axis=1)
             idx = idx[~inside]
+        if ceiling_z_m is not None and len(idx):
+            idx = idx[~_building_columns(_unpack(self._keys[idx]), ceiling_z_m)]
         if not len(idx):
             return []
         labels = np.full(len(self._keys), -1, dtype=np.int64)
-        labels[idx] = _components(_unpack(self._keys[idx]))
+        labels[idx] = self._grouped(idx)
         held = self._held_by(labels)
-        tops = [float(b.aabb()[1][2]) for b in supports] + [floor_z_m]
+        # what a part may stand on: the supports' tops over their footprints; the floor's height
+        # anywhere while the background has mapped no support
+        tops = [(b.aabb()[0][:2], b.aabb()[1][:2], float(b.aabb()[1][2])) for b in supports] or [
+            (np.full(2, -np.inf), np.full(2, np.inf), floor_z_m)]
         out: list[SolidPart] = []
         for label in range(int(labels.max()) + 1):
             frames, uuids = held.get(label, (set(), []))
-            members = np.flatnonzero(labels == label)
-            if not frames or np.median(self._seen[members]) < MIN_SEEN_PART:
+            if not frames:
                 continue
-            part = self._part(members, (tops, ceiling_z_m), taken, uuids)
-            if part is not None:
-                out.append(part)
+            members = np.flatnonzero(labels == label)
+            for piece in _pieces(members, _centres(self._keys[members])):
+                if np.median(self._seen[piece]) < MIN_SEEN_PART:
+                    continue
+                part = self._part(piece, (tops, ceiling_z_m), taken, uuids)
+                if part is not None:
+                    out.append(part)
         return out
+
+    def _grouped(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
+        """Labels 0..k-1 of the parts of the voxels ``idx``: neighbours (26-connected, or one above
+        the other across ``STACK_GAP_M``) are one part unless the keyframes' blobs held them apart
+        as often as together or more (a chair at a desk, a box beside a bucket: the segmenter parts
+        them wherever a view shows the gap between them). A voxel that two blobs of one view
+        held, in most of its views, lies between two things: it joins a neighbour's part, but
+        joins no parts together."""
+        a, b = _neighbour_pairs(_unpack(self._keys[idx]))
+        together, apart, between = self._votes(idx, a, b)
+        keep = ((together > apart) | (together + apart == 0)) & ~between[a] & ~between[b]
+        labels = _labels(len(idx), a, b, keep)
+        for x, y in ((a, b), (b, a)):  # a voxel between two things takes a neighbour's part
+            join = between[x] & ~between[y]
+            labels[x[join]] = labels[y[join]]
+        return np.asarray(labels, dtype=np.int64)
+
+    def _votes(self, idx: NDArray[np.int64], a: NDArray[np.int64], b: NDArray[np.int64]
+               ) -> tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.bool_]]:
+        """Per pair (``a``, ``b``: indices into ``idx``), the keyframes whose blobs held both
+        voxels in one blob and in two; per voxel, whether two blobs of one keyframe held it in
+        most of the keyframes that held it."""
+        together = np.zeros(len(a), dtype=np.int32)
+        apart = np.zeros(len(a), dtype=np.int32)
+        held = np.zeros(len(idx), dtype=np.int32)
+        shared = np.zeros(len(idx), dtype=np.int32)
+        where = np.full(len(self._keys), -1, dtype=np.int64)
+        where[idx] = np.arange(len(idx))
+        blob_of = np.full(len(idx), -1, dtype=np.int64)
+        keyframe = None
+        for n, (_, kf, keys) in enumerate([*self._blobs, ("", -1, np.zeros(0, np.int64))]):
+            if kf != keyframe:  # one keyframe's blobs are all in: count its votes
+                la, lb = blob_of[a], blob_of[b]
+                both = (la >= 0) & (lb >= 0)
+                together += both & (la == lb)
+                apart += both & (la != lb)
+                held += blob_of != -1
+                shared += blob_of == -2
+                keyframe = kf
+                blob_of[:] = -1
+            at = where[np.searchsorted(self._keys, keys)]
+            at = at[at >= 0]
+            blob_of[at] = np.where(blob_of[at] == -1, n, -2)  # -2: two blobs of one view held it
+        return together, apart, 2 * shared > held
 
     def _held_by(self, labels: NDArray[np.int64]) -> dict[int, tuple[set[int], list[str]]]:
         """Per part label, the keyframes and observations of the blobs whose voxels lie in it
@@ -209,11 +285,12 @@ class SolidMap:
             if counts[best] >= 0.5 * len(keys):
                 frames, uuids = held.setdefault(int(values[best]), (set(), []))
                 frames.add(keyframe)
-                uuids.append(uuid)
+                if uuid:  # a cluster too large for one object has no observation
+                    uuids.append(uuid)
         return held
 
     def _part(
-        self, members: NDArray[np.int64], levels: tuple[Sequence[float], float | None],
+        self, members: NDArray[np.int64], levels: tuple[Sequence[_Support], float | None],
         taken: Sequence[Box3D], uuids: list[str],
     ) -> SolidPart | None:
         """The object of one connected part (``members``: voxel indices), or None when it is
@@ -228,7 +305,8 @@ class SolidMap:
         extent = hi - lo
         if extent[2] < MIN_HEIGHT_M or max(float(extent[0]), float(extent[1])) > MAX_EXTENT_M:
             return None
-        if not any(abs(float(lo[2]) - top) <= BASE_REACH_M for top in tops):
+        if not any(-SUNK_M <= float(lo[2]) - top <= BASE_REACH_M  # stands on a support, over its footprint
+                   and np.all(lo[:2] < s_hi) and np.all(hi[:2] > s_lo) for s_lo, s_hi, top in tops):
             return None
         if ceiling_z_m is not None and float(hi[2]) >= ceiling_z_m - CEILING_REACH_M:
             return None  # from the floor to the ceiling: building structure, or run into it
@@ -238,23 +316,85 @@ class SolidMap:
         if any(overlap_share(box, other) >= COVERED_SHARE for other in taken):
             return None
         told = self._seen[members] + self._free[members]
+        sample = centres[np.linspace(0, len(centres) - 1, min(len(centres), SAMPLE_POINTS)).astype(np.int64)]
         return SolidPart(box, float(self._first_s[members].min()), float(self._last_s[members].max()),
-                         uuids, float(self._seen[members].sum() / max(int(told.sum()), 1)))
+                         uuids, float(self._seen[members].sum() / max(int(told.sum()), 1)),
+                         np.round(sample, 3).tolist())
 
 
-def _components(ijk: NDArray[np.int64]) -> NDArray[np.int64]:
-    """Labels 0..k-1 of the 26-connected parts of the voxels ``ijk`` (N, 3)."""
-    from scipy.ndimage import binary_dilation, label
+def _pieces(members: NDArray[np.int64], centres: FloatArray) -> list[NDArray[np.int64]]:
+    """``members`` (voxel indices, their ``centres``) in pieces at most ``MAX_EXTENT_M`` long
+    across the floor: a part longer than one object is several run together (a row of
+    shelves, a desk with its chairs), parted where nothing tells where: into the fewest
+    compact pieces (k-means over the footprint, seeded at voxels far apart)."""
+    xy = centres[:, :2]
+    if float(np.max(np.ptp(xy, axis=0))) <= MAX_EXTENT_M:
+        return [members]
+    for k in range(2, MAX_PIECES + 1):
+        seeds = [0]
+        for _ in range(k - 1):  # each next seed the voxel farthest from those chosen
+            gap = np.min(np.linalg.norm(xy[:, None, :] - xy[seeds][None, :, :], axis=2), axis=1)
+            seeds.append(int(np.argmax(gap)))
+        means = xy[seeds]
+        for _ in range(20):
+            nearest = np.argmin(np.linalg.norm(xy[:, None, :] - means[None, :, :], axis=2), axis=1)
+            means = np.array([xy[nearest == j].mean(axis=0) if np.any(nearest == j) else means[j]
+                              for j in range(k)])
+        groups = [np.flatnonzero(nearest == j) for j in range(k) if np.any(nearest == j)]
+        if all(_compact(xy[g]) for g in groups) or k == MAX_PIECES:
+            return [members[g] for g in groups]
+    return [members]
 
-    base = ijk.min(axis=0)
-    local = ijk - base
-    grid = np.zeros(tuple(int(v) + 1 for v in local.max(axis=0)), dtype=bool)
-    grid[local[:, 0], local[:, 1], local[:, 2]] = True
-    if STACK_GAP_M >= VOXEL_M:  # one above the other across a gap: a rack's boards, a stack
-        grid = binary_dilation(grid, structure=np.ones((1, 1, 3), dtype=bool),
-                               iterations=int(STACK_GAP_M / VOXEL_M / 2.0 + 0.5))
-    labelled, _ = label(grid, structure=np.ones((3, 3, 3), dtype=bool))
-    return np.asarray(labelled[local[:, 0], local[:, 1], local[:, 2]], dtype=np.int64) - 1
+
+def _compact(xy: FloatArray) -> bool:
+    """Whether voxel centres ``xy`` (N, 2) are one piece: at most ``MAX_EXTENT_M`` long, and
+    filling ``MIN_PIECE_FILL`` of their box's footprint (the corner of an L-shaped row is two)."""
+    extent = np.ptp(xy, axis=0) + VOXEL_M
+    if float(np.max(extent)) > MAX_EXTENT_M + VOXEL_M:
+        return False
+    cells = len(np.unique(np.round(xy / VOXEL_M).astype(np.int64), axis=0))
+    return cells * VOXEL_M * VOXEL_M >= MIN_PIECE_FILL * float(np.prod(extent))
+
+
+def _building_columns(ijk: NDArray[np.int64], ceiling_z_m: float) -> NDArray[np.bool_]:
+    """Per voxel ``ijk``, whether its column (the voxels above and below it) reaches up to the
+    ceiling: a wall or a pillar the background did not map, not the table or the shelf that
+    stands against it."""
+    columns = ijk[:, 0] * (1 << _BITS) + ijk[:, 1]
+    order = np.argsort(columns)
+    ordered = columns[order]
+    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
+    top_k = np.maximum.reduceat(ijk[order, 2], starts)
+    column_of = np.searchsorted(ordered[starts], columns)
+    return np.asarray((top_k[column_of] + 1) * VOXEL_M >= ceiling_z_m - CEILING_REACH_M, dtype=bool)
+
+
+def _labels(n: int, a: NDArray[np.int64], b: NDArray[np.int64], keep: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Labels 0..k-1 of the connected parts of ``n`` voxels joined by the pairs (``a``, ``b``) kept."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    graph = coo_matrix((np.ones(int(keep.sum())), (a[keep], b[keep])), shape=(n, n))
+    return np.asarray(connected_components(graph, directed=False)[1], dtype=np.int64)
+
+
+def _neighbour_pairs(ijk: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs (indices into ``ijk``, each pair once) of voxels that touch (26-connected) or
+    lie one above the other across at most ``STACK_GAP_M``."""
+    keys = _pack(ijk)
+    order = np.argsort(keys)
+    ordered = keys[order]
+    gap = round(STACK_GAP_M / VOXEL_M)
+    offsets = [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in range(0, gap + 2)
+               if (k, j, i) > (0, 0, 0) and (k <= 1 or (i == 0 and j == 0))]
+    a_all, b_all = [], []
+    for offset in offsets:
+        other = _pack(ijk + np.array(offset, dtype=np.int64))
+        pos = np.clip(np.searchsorted(ordered, other), 0, len(ordered) - 1)
+        hit = ordered[pos] == other
+        a_all.append(np.flatnonzero(hit))
+        b_all.append(order[pos[hit]])
+    return np.concatenate(a_all), np.concatenate(b_all)
 
 
 def _thinnest_spread_m(points: FloatArray) -> float:

@@ -196,6 +196,7 @@ class ForegroundStage:
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
         self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
+        self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
         """False for a walker-class blob whose lowest point is more than ``WALKER_MAX_BASE_M``
@@ -320,6 +321,7 @@ class ForegroundStage:
             blobs = drop_table_legs(
                 blobs, scene.tables, cfg, cfg.pixel_step, frame.camera.width, frame.camera.height
             )
+        self._large = seg.large  # too large for an object, not for the static map (``_measure``)
         return blobs, seg
 
     def _split_and_refine(
@@ -361,8 +363,11 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
-        keyframe = self._solid.due(frame.stamp_s)
-        held: list[tuple[str, FloatArray]] = []  # a keyframe's solid blobs but walkers' (``SolidMap``)
+        keyframe = self._solid.due(frame.stamp_s, frame.T_map_cam)
+        # a keyframe's solid blobs but walkers' (``SolidMap``), those too large for one object too
+        # (their points within the sensor's range: the slack beyond is for objects across it)
+        held = [("", b.points_map[b.points_cam[:, 2] <= cfg.max_depth_m])
+                for b in self._large if keyframe and is_solid(b.points_cam)]
         for blob, match in zip(blobs, matches, strict=True):
             match, longest = self._judged(frame, scene, blob, match)
             if match.detection_index is None and not cfg.keep_unknown:
@@ -780,7 +785,8 @@ def _solid_instance(part: SolidPart) -> Instance:
     return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
                     last_seen_s=part.last_seen_s, confidence=part.seen_share,
                     observation_uuids=part.observation_uuids,
-                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True})
+                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True,
+                          "surface_map": part.surface_m})  # a later session's empty-place test
 
 
 def _wall_boxes(world: World) -> list[Box3D]:

@@ -144,3 +144,17 @@ def test_cell_inverse_numbers_cells_like_unique_rows():
         xy = rng.normal(0.0, 2.0, (n, 2))
         _, expected = np.unique(np.floor(xy / 0.05).astype(np.int64), axis=0, return_inverse=True)
         assert np.array_equal(cell_inverse(xy, 0.05), expected.reshape(-1))
+
+
+def test_a_cluster_too_long_for_one_object_is_kept_aside_for_the_static_map():
+    # a rack 3.6 m long seen across the room: too long to be tracked as one object
+    rack = SceneBox(20, np.array([3.4, 0.0, 0.75]), np.array([0.8, 3.6, 1.5]), "shelf")
+    boxes = [*room(), rack, person(10, 1.8, -1.1)]
+    frame = make_frame(boxes, pose_looking_x(z=2.0), 0.0, 0)
+    bg = [i.box for i in background_instances(boxes).values()]
+    blobs, stats = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, ForegroundConfig(pixel_step=2))
+    assert len(blobs) == 1 and blobs[0].points_map[:, 0].max() < 2.0  # the person only
+    assert stats.large and stats.rejected_clusters == len(stats.large)
+    for large in stats.large:  # the rack's front and top, each longer than 3 m
+        lo, hi = large.bounds_map
+        assert hi[1] - lo[1] > 3.0 and lo[0] > 2.9

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D
-from hiper_cli.perceive.foreground.solid_map import KEYFRAME_S, SolidMap, is_solid
+from hiper_cli.perceive.foreground.solid_map import KEYFRAME_S, MAX_EXTENT_M, SolidMap, is_solid
 from hiper_cli.types import CameraIntrinsics, Frame
 
 CAM = CameraIntrinsics(width=160, height=120, fx=100.0, fy=100.0, cx=79.5, cy=59.5)
@@ -145,3 +145,84 @@ def test_a_part_from_the_floor_to_the_ceiling_is_the_buildings() -> None:
     assert len(solid.parts(0.0, [FLOOR], [], [])) == 1  # no ceiling mapped: a tall thing
     assert solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=2.6) == []
     assert len(solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=4.0)) == 1
+
+
+def test_a_camera_that_turns_or_moves_makes_a_keyframe_before_the_half_second() -> None:
+    solid = SolidMap()
+    start = pose_looking_at([0.0, -3.0, 1.2], [0.0, 0.0, 0.4])
+    frame, _ = render([floor_points()], start, 5.0)
+    solid.add(frame, [])
+    soon = 5.0 + KEYFRAME_S / 5
+    assert not solid.due(soon, start) and not solid.due(soon)
+    assert not solid.due(soon, pose_looking_at([0.0, -3.0, 1.2], [0.3, 0.0, 0.4]))  # 5°: the same view
+    assert solid.due(soon, pose_looking_at([0.0, -3.0, 1.2], [0.8, 0.0, 0.4]))  # 15°: a new one
+    moved = start.copy()
+    moved[:3, 3] += [0.5, 0.0, 0.0]
+    assert solid.due(soon, moved)
+
+
+def test_two_things_side_by_side_are_two_parts_when_the_views_held_them_apart() -> None:
+    # a crate and a lower bin 2 cm apart, seen from the front: their voxels touch
+    crate = box_surface([-0.8, -0.3, 0.0], [-0.01, 0.3, 0.7])
+    bin_ = box_surface([0.01, -0.3, 0.0], [0.8, 0.3, 0.5])
+    for apart in (True, False):  # the segmenter's blobs part them in every view, or never
+        solid = SolidMap()
+        for k in range(8):
+            x = -0.2 + 0.4 * k / 7
+            pose = pose_looking_at([x, -3.0, 1.2], [x, 0.0, 0.4])
+            frame, seen = render([crate, bin_, floor_points()], pose, 10.0 + k * KEYFRAME_S)
+            one = [(f"obs-{k}", np.concatenate(seen[:2]))]
+            solid.add(frame, [(f"obs-{k}-{i}", seen[i]) for i in (0, 1)] if apart else one)
+        parts = solid.parts(0.0, [FLOOR], [], [])
+        if apart:  # the crate's box and the bin's, side by side
+            (left, right) = sorted(parts, key=lambda p: float(p.box.center_m[0]))
+            assert left.box.aabb()[1][0] < 0.15 and right.box.aabb()[0][0] > -0.15
+            assert left.box.aabb()[1][2] > right.box.aabb()[1][2] + 0.1
+        else:
+            assert len(parts) == 1
+
+
+def test_a_run_longer_than_one_object_is_parted_in_compact_pieces() -> None:
+    # an L-shaped row of shelves along two walls: 6 m one way, 3 m the other
+    row = [box_surface([-3.0, 0.0, 0.0], [3.0, 0.4, 1.8]), box_surface([2.6, -3.0, 0.0], [3.0, 0.0, 1.8])]
+    solid = SolidMap()
+    for k in range(12):
+        eye = [-2.5 + 5.0 * k / 11, -2.5, 1.2]
+        frame, seen = render([*row, floor_points()], pose_looking_at(eye, [eye[0] + 1.0, 0.0, 0.9]),
+                             10.0 + k * KEYFRAME_S)
+        solid.add(frame, [(f"obs-{k}", np.concatenate(seen[:2]))])
+    parts = solid.parts(0.0, [FLOOR], [], [])
+    assert len(parts) >= 2
+    for part in parts:
+        lo, hi = part.box.aabb()
+        assert max(hi[:2] - lo[:2]) <= MAX_EXTENT_M + 0.1
+        assert min(hi[:2] - lo[:2]) < 1.0  # a piece of one leg, not the corner's square
+
+
+def test_a_table_against_an_unmapped_wall_is_kept_and_the_wall_is_not() -> None:
+    # the wall's columns reach the ceiling: the building's; the table before it stands on the floor
+    wall = box_surface([-1.5, 0.4, 0.0], [1.5, 0.5, 2.5])
+    table = box_surface([-0.6, -0.2, 0.0], [0.6, 0.4, 0.75])
+    solid = drive_past([wall, table, floor_points()], unnamed=[0, 1])
+    (part,) = solid.parts(0.0, [FLOOR], [], [], ceiling_z_m=2.6)
+    lo, hi = part.box.aabb()
+    assert hi[2] < 1.0 and lo[1] > -0.35 and hi[1] < 0.55  # the table's box
+    (joined,) = solid.parts(0.0, [FLOOR], [], [])  # no ceiling mapped: the table joined to the wall
+    assert joined.box.aabb()[1][2] > 2.0
+
+
+def test_a_thing_beyond_the_supports_footprint_stands_on_nothing() -> None:
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    solid = drive_past([crate, floor_points()], unnamed=[0])
+    elsewhere = Box3D(np.array([5.0, 5.0, -0.05]), np.array([2.0, 2.0, 0.1]))  # a floor piece away from it
+    assert solid.parts(0.0, [elsewhere], [], []) == []
+    assert len(solid.parts(0.0, [FLOOR, elsewhere], [], [])) == 1
+
+
+def test_a_thing_reaching_well_below_its_support_is_no_part() -> None:
+    # the floor seen at range with depth noise: its voxels reach 0.2 m below the mapped floor
+    crate = box_surface([-0.4, -0.3, 0.0], [0.4, 0.3, 0.7])
+    solid = drive_past([crate, floor_points()], unnamed=[0])
+    higher = Box3D(np.array([0.0, 0.0, 0.15]), np.array([20.0, 20.0, 0.1]))  # its top 0.2 m above the base
+    assert solid.parts(0.2, [higher], [], []) == []
+    assert len(solid.parts(0.0, [FLOOR], [], [])) == 1
