@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -57,6 +57,7 @@ from hiper_cli.perceive.foreground.reidentify import (
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
+from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
@@ -102,47 +103,13 @@ detector named twice (``classes.one_name_per_box``: a bottle and a vase, a bench
 chair): the one with the higher score stays; ``walker_classes`` are left out; 1: off."""
 
 FloatArray = NDArray[np.float64]
-SUPPORT_CLASSES = ("floor", "table")
 # Named constants (not the paper's): chosen so that they never bind on the simulated worlds.
-HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
-SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
 VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
 PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
 STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
-
-
-def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
-    """The floors and table tops objects stand on, map frame: axis-aligned, their top at the
-    fitted plane's height (``data["plane_map"]``) where there is one. The box of a plane
-    instance is thicker than the plane by the depth noise of its points; an object's base
-    rests on the plane itself."""
-    out: list[Box3D] = []
-    for inst in background:
-        if inst.class_name not in SUPPORT_CLASSES:
-            continue
-        lo, hi = inst.box.aabb()
-        plane = inst.data.get("plane_map")
-        if plane is not None and len(plane) == 4 and abs(float(plane[2])) > HORIZONTAL_PLANE_MIN_NZ:
-            a, b, c, d = (float(v) for v in plane)
-            cx, cy = (lo[:2] + hi[:2]) / 2.0
-            top = -(a * cx + b * cy + d) / c
-            if lo[2] - SUPPORT_TOP_BELOW_BOX_M <= top <= hi[2]:
-                hi = hi.copy()
-                hi[2] = top
-                lo = lo.copy()
-                lo[2] = min(lo[2], top)
-        out.append(Box3D((lo + hi) / 2.0, hi - lo))
-    return out
-
-
-def floor_height_m(background: Iterable[Instance]) -> float:
-    """The height of the floor, map frame: the lowest top of the floor instances (their box's
-    top; 0, the map's origin, before the background found one)."""
-    tops = [float(inst.box.aabb()[1][2]) for inst in background if inst.class_name == "floor"]
-    return min(tops) if tops else 0.0
 
 
 @lru_cache(maxsize=4096)

@@ -235,7 +235,7 @@ def test_every_option_is_documented():
 
 def test_objects_rest_on_the_fitted_floor_plane_not_on_the_top_of_its_box():
     from hiper_cli.model import Box3D, Instance
-    from hiper_cli.perceive.foreground.stage import support_boxes
+    from hiper_cli.perceive.foreground.supports import support_boxes
 
     # The background stage's floor box is 2 cm thick around its plane (the points' noise).
     floor_box = Box3D(np.array([2.0, 0.0, 0.0]), np.array([4.0, 4.0, 0.02]))

@@ -49,7 +49,8 @@ def test_path_speed_ignores_jitter_and_gaps():
 def test_a_person_blob_high_above_the_floor_is_no_walker():
     from hiper_cli.model import Box3D, Instance
     from hiper_cli.perceive.foreground.segment import Blob
-    from hiper_cli.perceive.foreground.stage import ForegroundStage, floor_height_m
+    from hiper_cli.perceive.foreground.stage import ForegroundStage
+    from hiper_cli.perceive.foreground.supports import floor_height_m
 
     floor = Instance(layer="background", class_name="floor", first_seen_s=0.0, last_seen_s=0.0,
                      box=Box3D(np.array([0.0, 0.0, 0.0]), np.array([5.0, 5.0, 0.02])))
