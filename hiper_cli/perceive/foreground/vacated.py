@@ -17,6 +17,14 @@ the ray; points within ``SUPPORT_MARGIN_M`` of its foot are left out, as the flo
 under them returns at their depth whether the object is there or not. A box point cannot: the
 wall or table is the box's far side, so such a place is told empty only from a view low
 enough for rays to pass the box's far side above the surface.
+
+Two sessions' views of one object lie apart by their pose error (drift, alignment: up to
+``POSE_SLACK_M``), which for a cup is more than its size: rays aimed at its old points pass it
+by and end on the wall behind. So a surface point is seen through only when nothing stands
+within ``POSE_SLACK_M`` of it either: probes around it (``PROBE_OFFSETS``, horizontal, at its
+height) whose rays end at their own depth met a surface there, and the point counts as hit.
+The margins grow with the depth noise at the point's range (``NOISE_PER_M2`` · z², three
+sigma).
 """
 
 from __future__ import annotations
@@ -27,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Instance
+from hiper_cli.perceive.foreground.reidentify import POSE_SLACK_M
 
 __all__ = ["EmptyPlaces"]
 
@@ -42,6 +51,11 @@ EMPTY_SHARE = 0.8  # of the usable rays through: the frame saw the place empty
 PRESENT_SHARE = 0.5  # of the usable rays hitting: the frame saw the object there
 MIN_EMPTY_FRAMES = 3
 SUPPORT_MARGIN_M = 0.05  # surface points this near the object's lowest one are not aimed at
+NOISE_PER_M2 = 0.0017  # depth noise (1 sigma) per squared metre of range
+_ANGLES = np.radians(np.arange(0, 360, 45))
+PROBE_OFFSETS = np.concatenate([
+    np.stack([r * np.cos(_ANGLES), r * np.sin(_ANGLES), np.zeros(len(_ANGLES))], axis=1)
+    for r in (POSE_SLACK_M / 2, POSE_SLACK_M)])  # around a surface point: where it may be now
 
 
 class EmptyPlaces:
@@ -90,9 +104,11 @@ class EmptyPlaces:
         entry, exit_ = np.where(self._on_surface, 1.0, entry), np.where(self._on_surface, 1.0, exit_)
         # depth grows linearly along a ray from the camera: the box spans these depths on it
         near_m, far_m = entry * z, exit_ * z
-        ray_usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M)
-        ray_through = ray_usable & (measured > far_m + THROUGH_MARGIN_M)
-        ray_hit = ray_usable & (measured <= far_m + HIT_MARGIN_M)
+        noise = 3.0 * NOISE_PER_M2 * z * z
+        ray_usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M - noise)
+        near_hit = self._probed(project)
+        ray_through = ray_usable & (measured > far_m + THROUGH_MARGIN_M + noise) & ~near_hit
+        ray_hit = ray_usable & ((measured <= far_m + HIT_MARGIN_M + noise) | near_hit)
         usable, through, hit = (np.bincount(self._owner, weights=a, minlength=n)
                                 for a in (ray_usable, ray_through, ray_hit))
         judged = usable >= MIN_RAYS
@@ -101,6 +117,19 @@ class EmptyPlaces:
         self.empty += empty
         self.present += present
         self.first_empty_s[empty & np.isnan(self.first_empty_s)] = stamp_s
+
+    def _probed(self, project: Projector) -> NDArray[np.bool_]:
+        """Per ray target: a surface point with a surface met within ``POSE_SLACK_M`` of it (a
+        probe's ray ending at the probe's depth); False for box points."""
+        surface = np.flatnonzero(self._on_surface)
+        out = np.zeros(len(self._points), dtype=bool)
+        if len(surface) == 0:
+            return out
+        probes = (self._points[surface, None, :] + PROBE_OFFSETS[None, :, :]).reshape(-1, 3)
+        ok, z, measured = project(probes)
+        met = ok & (measured > 0) & (np.abs(measured - z) <= HIT_MARGIN_M + 3.0 * NOISE_PER_M2 * z * z)
+        out[surface] = met.reshape(len(surface), len(PROBE_OFFSETS)).any(axis=1)
+        return out
 
     def vacated(self) -> dict[str, float]:
         """uuid -> the first stamp its place was seen empty, for the boxes seen empty in at
