@@ -20,11 +20,13 @@ enough for rays to pass the box's far side above the surface.
 
 Two sessions' views of one object lie apart by their pose error (drift, alignment: up to
 ``POSE_SLACK_M``), which for a cup is more than its size: rays aimed at its old points pass it
-by and end on the wall behind. So a surface point is seen through only when nothing stands
-within ``POSE_SLACK_M`` of it either: probes around it (``PROBE_OFFSETS``, horizontal, at its
+by and end on the wall behind. So a surface point of an object no wider than ``SMALL_M`` (where
+that shift moves the rays off most of it) is seen through only when nothing stands within
+``POSE_SLACK_M`` of it either: probes around it (``PROBE_OFFSETS``, horizontal, at its
 height) whose rays end at their own depth met a surface there, and the point counts as hit.
 The margins grow with the depth noise at the point's range (``NOISE_PER_M2`` · z², three
-sigma).
+sigma). A larger object keeps most of its rays on it through that shift, and its probes
+would meet the wall or the furniture it stood against.
 """
 
 from __future__ import annotations
@@ -52,6 +54,7 @@ PRESENT_SHARE = 0.5  # of the usable rays hitting: the frame saw the object ther
 MIN_EMPTY_FRAMES = 3
 SUPPORT_MARGIN_M = 0.05  # surface points this near the object's lowest one are not aimed at
 NOISE_PER_M2 = 0.0017  # depth noise (1 sigma) per squared metre of range
+SMALL_M = 3 * POSE_SLACK_M  # footprint's larger side: the pose slack is a large share of it
 _ANGLES = np.radians(np.arange(0, 360, 45))
 PROBE_OFFSETS = np.concatenate([
     np.stack([r * np.cos(_ANGLES), r * np.sin(_ANGLES), np.zeros(len(_ANGLES))], axis=1)
@@ -68,7 +71,7 @@ class EmptyPlaces:
         n = len(self.uuids)
         offsets = np.zeros((len(SAMPLE_OFFSETS), 3))
         offsets[:, :2] = SAMPLE_OFFSETS
-        points, lower, upper, owner, on_surface = [], [], [], [], []
+        points, lower, upper, owner, on_surface, small = [], [], [], [], [], []
         for k, inst in enumerate(instances):
             surface = np.asarray(inst.data.get("surface_map") or [], dtype=np.float64).reshape(-1, 3)
             if len(surface):  # a point at the object's foot: the support under it answers for it
@@ -85,12 +88,14 @@ class EmptyPlaces:
             upper.append(hi)
             owner.append(np.full(len(surface), k))
             on_surface.append(np.full(len(surface), seen))
+            small.append(np.full(len(surface), seen and float(np.max(inst.box.extent_m[:2])) <= SMALL_M))
         # per ray target: its point, the box it judges (lower, upper corners), whose it is
         self._points = np.concatenate(points) if points else np.zeros((0, 3))
         self._lower = np.concatenate(lower) if lower else np.zeros((0, 3))
         self._upper = np.concatenate(upper) if upper else np.zeros((0, 3))
         self._owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
         self._on_surface = np.concatenate(on_surface) if on_surface else np.zeros(0, dtype=bool)
+        self._probe = np.concatenate(small) if small else np.zeros(0, dtype=bool)  # probed around
         self.empty = np.zeros(n, dtype=np.int64)
         self.present = np.zeros(n, dtype=np.int64)
         self.first_empty_s = np.full(n, np.nan)
@@ -119,9 +124,10 @@ class EmptyPlaces:
         self.first_empty_s[empty & np.isnan(self.first_empty_s)] = stamp_s
 
     def _probed(self, project: Projector) -> NDArray[np.bool_]:
-        """Per ray target: a surface point with a surface met within ``POSE_SLACK_M`` of it (a
-        probe's ray ending at the probe's depth); False for box points."""
-        surface = np.flatnonzero(self._on_surface)
+        """Per ray target: a surface point of a small object with a surface met within
+        ``POSE_SLACK_M`` of it (a probe's ray ending at the probe's depth); False for the
+        others."""
+        surface = np.flatnonzero(self._probe)
         out = np.zeros(len(self._points), dtype=bool)
         if len(surface) == 0:
             return out

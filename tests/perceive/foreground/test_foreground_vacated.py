@@ -160,3 +160,14 @@ def test_a_cup_seen_a_few_centimetres_off_its_old_points_is_not_taken_for_gone()
     assert places.empty[0] == 0
     gone = _observed(*CUP, front, cls="cup")
     assert _look(EmptyPlaces([gone]), [TABLE]) == {gone.uuid: 10.0}
+
+
+def test_a_chair_gone_from_beside_a_wall_is_not_kept_by_the_wall():
+    """The pose slack is for objects it is a large share of: probes 10 cm around a chair's
+    points by a side wall would meet the wall; the chair is wider than ``SMALL_M``, its rays
+    alone judge, and its place is told empty."""
+    side = (np.array([0.0, 0.3, 0.0]), np.array([4.0, 0.4, 2.5]))  # along the view, by the chair
+    back = (np.array([3.5, -3.0, 0.0]), np.array([3.6, 3.0, 2.5]))
+    points = [(x, y, z) for x in (2.06, 2.25, 2.45) for y in (-0.2, 0.0, 0.2) for z in (0.5, 0.8)]
+    gone = _observed(*CHAIR, points)
+    assert _look(EmptyPlaces([gone]), [side, back]) == {gone.uuid: 10.0}
