@@ -28,6 +28,7 @@ from hiper_cli.graph.sessions import Alignment
 from hiper_cli.model import Environment
 from hiper_cli.perceive.align import BackgroundCloud, register
 from hiper_cli.perceive.align_start import refine_at_start
+from hiper_cli.perceive.static_cloud import StaticCloud
 from hiper_cli.types import Frame
 
 __all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment"]
@@ -144,15 +145,14 @@ def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:
 
 class MapCloudGrower:
     """The place's background cloud, grown by this session's frames (map frame) where they see
-    new space, and stored at the end of the session."""
+    new space, with what stands still in them (``perceive.static_cloud``), and stored at the
+    end of the session."""
 
     def __init__(self, kb: KnowledgeBase, env: Environment) -> None:
         self.kb, self.env = kb, env
-        self.cloud = BackgroundCloud()
         stored = kb.map_cloud(env)
         self.before = stored  # the place as the earlier sessions saw it (for ``FreeBefore``)
-        if stored is not None:
-            self.cloud.add_fixed(stored)
+        self.cloud = StaticCloud(stored)
         self._last_s = -np.inf
 
     def add(self, frame: Frame) -> None:

@@ -60,15 +60,6 @@ class BackgroundCloud:
         self.voxel_m = voxel_m
         self._sum: dict[tuple[int, int, int], list[float]] = {}  # x, y, z sums of the voxel's points
         self._n: dict[tuple[int, int, int], int] = {}
-        self._fixed: set[tuple[int, int, int]] = set()
-
-    def add_fixed(self, points: FloatArray) -> None:
-        """Voxels whose centroid later points do not move: the place as the sessions before saw
-        it. A later session, aligned with its own error and drifting in its own way, adds new
-        space to the map but does not pull the map toward itself (the map frame is the first
-        session's)."""
-        self.add_points(points)
-        self._fixed.update(self._sum)
 
     def add_points(self, points: FloatArray) -> None:
         if len(points) == 0:
@@ -80,8 +71,6 @@ class BackgroundCloud:
                         axis=1)
         counts = np.bincount(inverse, minlength=len(uniq))
         for key, s, n in zip(map(tuple, uniq.tolist()), sums.tolist(), counts.tolist(), strict=True):
-            if key in self._fixed:
-                continue
             old = self._sum.get(key)
             if old is not None:
                 self._sum[key] = [old[0] + s[0], old[1] + s[1], old[2] + s[2]]

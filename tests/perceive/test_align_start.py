@@ -105,12 +105,20 @@ def test_the_start_cloud_reads_only_the_first_metres():
 
 
 def test_a_later_session_adds_new_space_but_does_not_move_the_map():
-    from hiper_cli.perceive.align import BackgroundCloud
+    from hiper_cli.perceive.static_cloud import StaticCloud
+    from hiper_cli.types import CameraIntrinsics, Frame
 
-    cloud = BackgroundCloud(voxel_m=0.1)
-    cloud.add_fixed(np.array([[0.05, 0.05, 0.05]]))  # the place as the first session saw it
-    cloud.add_points(np.array([[0.09, 0.09, 0.09], [0.09, 0.01, 0.09], [0.55, 0.05, 0.05]]))  # a later one
+    w, h = 60, 40
+    camera = CameraIntrinsics(width=w, height=h, fx=50.0, fy=50.0, cx=w / 2, cy=h / 2)
+    earlier = np.array([[0.35, 0.25, 3.05]])  # the place as the first session saw it
+    cloud = StaticCloud(earlier, voxel_m=0.1)
+    depth = np.full((h, w), 3.09, dtype=np.float32)  # a later session sees that wall 4 cm deeper
+    depth[:, : w // 2] = 0.0
+    depth[0, 0] = 2.0  # and something new, nearer
+    frame = Frame(stamp_s=0.0, rgb=np.zeros((h, w, 3), np.uint8), depth_m=depth, camera=camera,
+                  T_map_cam=np.eye(4), pose_id=0)
+    cloud.add_frame(frame)
     pts = cloud.points()
-    assert len(pts) == 2
-    assert np.allclose(pts[np.argmin(pts[:, 0])], [0.05, 0.05, 0.05])  # not pulled toward the later session
-    assert np.allclose(pts[np.argmax(pts[:, 0])], [0.55, 0.05, 0.05])  # new space is added
+    stored = pts[np.all(np.floor(pts / 0.1) == np.floor(earlier / 0.1), axis=1)]
+    assert np.allclose(stored, earlier)  # not pulled toward the later session
+    assert len(pts) > 1  # new space is added

@@ -17,6 +17,16 @@ the ray; points within ``SUPPORT_MARGIN_M`` of its foot are left out, as the flo
 under them returns at their depth whether the object is there or not. A box point cannot: the
 wall or table is the box's far side, so such a place is told empty only from a view low
 enough for rays to pass the box's far side above the surface.
+
+Two sessions' views of one object lie apart by their pose error (drift, alignment: up to
+``POSE_SLACK_M``), which for a cup is more than its size: rays aimed at its old points pass it
+by and end on the wall behind. So a surface point of an object no wider than ``SMALL_M`` (where
+that shift moves the rays off most of it) is seen through only when nothing stands within
+``POSE_SLACK_M`` of it either: probes around it (``PROBE_OFFSETS``, horizontal, at its
+height) whose rays end at their own depth met a surface there, and the point counts as hit.
+The margins grow with the depth noise at the point's range (``NOISE_PER_M2`` · z², three
+sigma). A larger object keeps most of its rays on it through that shift, and its probes
+would meet the wall or the furniture it stood against.
 """
 
 from __future__ import annotations
@@ -27,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.model import Instance
+from hiper_cli.perceive.foreground.reidentify import POSE_SLACK_M
 
 __all__ = ["EmptyPlaces"]
 
@@ -42,6 +53,12 @@ EMPTY_SHARE = 0.8  # of the usable rays through: the frame saw the place empty
 PRESENT_SHARE = 0.5  # of the usable rays hitting: the frame saw the object there
 MIN_EMPTY_FRAMES = 3
 SUPPORT_MARGIN_M = 0.05  # surface points this near the object's lowest one are not aimed at
+NOISE_PER_M2 = 0.0017  # depth noise (1 sigma) per squared metre of range
+SMALL_M = 3 * POSE_SLACK_M  # footprint's larger side: the pose slack is a large share of it
+_ANGLES = np.radians(np.arange(0, 360, 45))
+PROBE_OFFSETS = np.concatenate([
+    np.stack([r * np.cos(_ANGLES), r * np.sin(_ANGLES), np.zeros(len(_ANGLES))], axis=1)
+    for r in (POSE_SLACK_M / 2, POSE_SLACK_M)])  # around a surface point: where it may be now
 
 
 class EmptyPlaces:
@@ -54,7 +71,7 @@ class EmptyPlaces:
         n = len(self.uuids)
         offsets = np.zeros((len(SAMPLE_OFFSETS), 3))
         offsets[:, :2] = SAMPLE_OFFSETS
-        points, lower, upper, owner, on_surface = [], [], [], [], []
+        points, lower, upper, owner, on_surface, small = [], [], [], [], [], []
         for k, inst in enumerate(instances):
             surface = np.asarray(inst.data.get("surface_map") or [], dtype=np.float64).reshape(-1, 3)
             if len(surface):  # a point at the object's foot: the support under it answers for it
@@ -71,12 +88,14 @@ class EmptyPlaces:
             upper.append(hi)
             owner.append(np.full(len(surface), k))
             on_surface.append(np.full(len(surface), seen))
+            small.append(np.full(len(surface), seen and float(np.max(inst.box.extent_m[:2])) <= SMALL_M))
         # per ray target: its point, the box it judges (lower, upper corners), whose it is
         self._points = np.concatenate(points) if points else np.zeros((0, 3))
         self._lower = np.concatenate(lower) if lower else np.zeros((0, 3))
         self._upper = np.concatenate(upper) if upper else np.zeros((0, 3))
         self._owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
         self._on_surface = np.concatenate(on_surface) if on_surface else np.zeros(0, dtype=bool)
+        self._probe = np.concatenate(small) if small else np.zeros(0, dtype=bool)  # probed around
         self.empty = np.zeros(n, dtype=np.int64)
         self.present = np.zeros(n, dtype=np.int64)
         self.first_empty_s = np.full(n, np.nan)
@@ -90,9 +109,11 @@ class EmptyPlaces:
         entry, exit_ = np.where(self._on_surface, 1.0, entry), np.where(self._on_surface, 1.0, exit_)
         # depth grows linearly along a ray from the camera: the box spans these depths on it
         near_m, far_m = entry * z, exit_ * z
-        ray_usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M)
-        ray_through = ray_usable & (measured > far_m + THROUGH_MARGIN_M)
-        ray_hit = ray_usable & (measured <= far_m + HIT_MARGIN_M)
+        noise = 3.0 * NOISE_PER_M2 * z * z
+        ray_usable = ok & (measured > 0) & (measured >= near_m - HIT_MARGIN_M - noise)
+        near_hit = self._probed(project)
+        ray_through = ray_usable & (measured > far_m + THROUGH_MARGIN_M + noise) & ~near_hit
+        ray_hit = ray_usable & ((measured <= far_m + HIT_MARGIN_M + noise) | near_hit)
         usable, through, hit = (np.bincount(self._owner, weights=a, minlength=n)
                                 for a in (ray_usable, ray_through, ray_hit))
         judged = usable >= MIN_RAYS
@@ -101,6 +122,20 @@ class EmptyPlaces:
         self.empty += empty
         self.present += present
         self.first_empty_s[empty & np.isnan(self.first_empty_s)] = stamp_s
+
+    def _probed(self, project: Projector) -> NDArray[np.bool_]:
+        """Per ray target: a surface point of a small object with a surface met within
+        ``POSE_SLACK_M`` of it (a probe's ray ending at the probe's depth); False for the
+        others."""
+        surface = np.flatnonzero(self._probe)
+        out = np.zeros(len(self._points), dtype=bool)
+        if len(surface) == 0:
+            return out
+        probes = (self._points[surface, None, :] + PROBE_OFFSETS[None, :, :]).reshape(-1, 3)
+        ok, z, measured = project(probes)
+        met = ok & (measured > 0) & (np.abs(measured - z) <= HIT_MARGIN_M + 3.0 * NOISE_PER_M2 * z * z)
+        out[surface] = met.reshape(len(surface), len(PROBE_OFFSETS)).any(axis=1)
+        return out
 
     def vacated(self) -> dict[str, float]:
         """uuid -> the first stamp its place was seen empty, for the boxes seen empty in at
