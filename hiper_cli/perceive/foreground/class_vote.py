@@ -150,23 +150,26 @@ def winner(track: Track, judged: bool = True) -> str:
         and not (judged and _refused(track, k))
     ]
     if not eligible:
-        return _closer_winner(track)
+        return _closer_winner(track, judged)
     best = max(eligible, key=lambda k: known[k])
     if known[best] < track.min_class_share * sum(known.values()):
-        return _closer_winner(track)
+        return _closer_winner(track, judged)
     if track.class_votes.get(UNKNOWN, 0.0) > known[best]:
-        return _closer_winner(track)
+        return _closer_winner(track, judged)
     return best
 
 
-def _closer_winner(track: Track) -> str:
-    """The closer looks' winner (see the module docstring), or ``unknown``."""
+def _closer_winner(track: Track, judged: bool = True) -> str:
+    """The closer looks' winner (see the module docstring), or ``unknown``; a class the full
+    views refused stays refused whichever look gave it (``judged``, as in ``winner``)."""
     known = {k: n for k, n in track.closer_counts.items() if k != UNKNOWN}
     if not known:
         return UNKNOWN
     best = max(sorted(known), key=lambda k: known[k])
     looks = sum(track.closer_counts.values())
     if known[best] < max(CLOSER_MIN_LOOKS, track.min_class_share * looks) or not _long_enough(track, best):
+        return UNKNOWN
+    if judged and _refused(track, best):
         return UNKNOWN
     return best
 

@@ -151,3 +151,18 @@ def test_the_closer_looks_name_a_thing_only_when_most_of_them_name_it():
     assert vote(["cup"] * 4 + ["unknown"] * 4) == "unknown"  # half the looks: not most
     assert vote(["cup"] * 5 + ["unknown"] * 3) == "cup"
     assert vote(["cup", "cup", "cup", "bowl", "bowl", "unknown"]) == "unknown"  # 3 of 6
+
+
+def test_a_class_the_full_views_refused_is_not_taken_back_from_the_closer_looks():
+    """A walker's shoulders cut by the border look like a refrigerator to every look; full views
+    that named it ``person`` refuse ``refrigerator``, and a closer look cannot undo that."""
+    from hiper_cli.perceive.foreground.class_vote import record, winner
+
+    track = _tallies()
+    track.refused_min_views = 8
+    for name in ["refrigerator"] * 4 + ["unknown"]:
+        record(track, _look(name), 0.15)
+    assert winner(track) == "refrigerator"
+    track.detected_classes = {"refrigerator", "person"}
+    track.full_views, track.full_named = 2, {"person": 2}
+    assert winner(track) == "unknown"
