@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.perceive.logs.trajectory import rotation_about
+
 __all__ = ["POSE_TOL_DEG", "POSE_TOL_M", "matrices", "pose_at", "thin_session"]
 
 POSE_TOL_M = 0.01  # an interpolated pose lies this close to the one recorded ...
@@ -40,21 +42,12 @@ def _log_so3(R: F64) -> F64:
     return np.asarray(w * (angle / (2.0 * np.sin(angle))), dtype=np.float64)
 
 
-def _exp_so3(v: F64) -> F64:
-    angle = float(np.linalg.norm(v))
-    if angle < 1e-12:
-        return np.eye(3)
-    k = v / angle
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.asarray(np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K), dtype=np.float64)
-
-
 def interpolate(T0: F64, T1: F64, a: float) -> F64:
     """The pose a fraction ``a`` of the way from ``T0`` to ``T1`` (translation on a line,
     rotation about one axis)."""
     T = np.eye(4)
     T[:3, 3] = (1.0 - a) * T0[:3, 3] + a * T1[:3, 3]
-    T[:3, :3] = T0[:3, :3] @ _exp_so3(a * _log_so3(T0[:3, :3].T @ T1[:3, :3]))
+    T[:3, :3] = T0[:3, :3] @ rotation_about(a * _log_so3(T0[:3, :3].T @ T1[:3, :3]))
     return T
 
 

@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.perceive.logs.trajectory import rotation_about
+
 __all__ = ["MIN_CONSTRAINT", "StartFit", "refine_at_start"]
 
 FloatArray = NDArray[np.float64]
@@ -57,16 +59,6 @@ def _normals(points: FloatArray) -> tuple[FloatArray, FloatArray]:
     return eigvec[:, :, 0], eigval[:, 0] / np.maximum(eigval.sum(axis=1), 1e-12)
 
 
-def _rotation(rotvec: FloatArray) -> FloatArray:
-    angle = float(np.linalg.norm(rotvec))
-    if angle < 1e-12:
-        return np.eye(3)
-    k = rotvec / angle
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    R: FloatArray = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
-    return R
-
-
 def _step(p: FloatArray, q: FloatArray, n: FloatArray) -> tuple[FloatArray, int, float]:
     """One Gauss-Newton step (4x4, applied on the left) in the constrained directions."""
     centre = p.mean(axis=0)
@@ -79,7 +71,7 @@ def _step(p: FloatArray, q: FloatArray, n: FloatArray) -> tuple[FloatArray, int,
     eigval, eigvec = np.linalg.eigh(H)
     keep = eigval >= MIN_CONSTRAINT
     x = -(eigvec[:, keep] @ ((eigvec[:, keep].T @ g) / eigval[keep]))
-    R = _rotation(x[:3] / radius)
+    R = rotation_about(x[:3] / radius)
     D = np.eye(4)
     D[:3, :3] = R
     D[:3, 3] = centre - R @ centre + x[3:]

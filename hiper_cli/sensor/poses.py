@@ -13,23 +13,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.perceive.logs.trajectory import rotation_about
 from hiper_cli.sensor.profiles import SensorProfile
 
 __all__ = ["BIAS_CORRELATION_M", "PoseSource", "drifting_poses", "rotation_about"]
 
 BIAS_CORRELATION_M = 5.0
 METRES_PER_RADIAN = 0.5
-
-
-def rotation_about(rotvec: NDArray[np.float64]) -> NDArray[np.float64]:
-    """3×3 rotation of the rotation vector ``rotvec`` (radians)."""
-    angle = float(np.linalg.norm(rotvec))
-    if angle < 1e-12:
-        return np.eye(3)
-    k = rotvec / angle
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    R: NDArray[np.float64] = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
-    return R
 
 
 def _angle(R: NDArray[np.float64]) -> float:

@@ -21,6 +21,7 @@ __all__ = [
     "matrix_to_quat_xyzw",
     "quat_xyzw_to_matrix",
     "read_tum_trajectory",
+    "rotation_about",
     "write_tum_trajectory",
 ]
 
@@ -30,6 +31,17 @@ FloatArray = NDArray[np.float64]
 QUAT_NORM_TOLERANCE = 1e-2
 MAX_POSITION_M = 1e6  # 1000 km from the map origin: a robot log never goes there; a pose that does is damage
 MAX_STAMP_S = 1e11  # Unix time and log time both fit
+
+
+def rotation_about(rotvec: FloatArray) -> FloatArray:
+    """3×3 rotation of the rotation vector ``rotvec`` (axis × angle in radians; Rodrigues)."""
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-12:
+        return np.eye(3)
+    k = rotvec / angle
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    R: FloatArray = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
+    return R
 
 
 def quat_xyzw_to_matrix(quat_xyzw: FloatArray) -> FloatArray:
