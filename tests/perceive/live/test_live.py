@@ -412,5 +412,12 @@ def test_ctrl_c_ends_the_session_with_everything_written(tmp_path):
 
 
 def _snapshot_or_none(kb: Path) -> int:
+    """Pose rows written so far; 0 while the store or its schema is still being created (the
+    file exists before the writer's first transaction commits its tables)."""
     db = kb / "documents.sqlite"
-    return _snapshot(db)[1] if db.exists() else 0
+    if not db.exists():
+        return 0
+    try:
+        return _snapshot(db)[1]
+    except sqlite3.OperationalError:
+        return 0
