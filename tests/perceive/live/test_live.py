@@ -315,7 +315,7 @@ def test_queries_during_a_live_run_see_only_whole_frames(tmp_path):
     while live.poll() is None:
         time.sleep(0.1)
         db = kb / "documents.sqlite"
-        if not db.exists():
+        if not _has_schema(db):
             continue
         try:
             snapshots.append(_snapshot(db))
@@ -411,13 +411,18 @@ def test_ctrl_c_ends_the_session_with_everything_written(tmp_path):
     assert ended is not None and frames == summary["frames_read"]
 
 
-def _snapshot_or_none(kb: Path) -> int:
-    """Pose rows written so far; 0 while the store or its schema is still being created (the
-    file exists before the writer's first transaction commits its tables)."""
-    db = kb / "documents.sqlite"
+def _has_schema(db: Path) -> bool:
+    """The store exists and its tables are committed (the file appears before the writer's
+    first transaction creates them)."""
     if not db.exists():
-        return 0
+        return False
+    con = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
     try:
-        return _snapshot(db)[1]
-    except sqlite3.OperationalError:
-        return 0
+        return con.execute("SELECT 1 FROM sqlite_master WHERE name = 'sessions'").fetchone() is not None
+    finally:
+        con.close()
+
+
+def _snapshot_or_none(kb: Path) -> int:
+    db = kb / "documents.sqlite"
+    return _snapshot(db)[1] if _has_schema(db) else 0
