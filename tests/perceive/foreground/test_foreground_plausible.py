@@ -217,9 +217,14 @@ def test_a_class_named_only_on_cut_views_and_declined_in_full_view_is_refused():
     assert _refused_track(0).search_class == "chair"  # it still says what it was taken for
     assert _refused_track(1).class_name == "chair"  # one full view named is enough
     assert _refused_track(0, full_views=7).class_name == "chair"  # too few silent ones to tell
-    # ... but two that named another class contradict it (a walker called refrigerator while cut)
-    assert _refused_track(0, full_views=2, within=frozenset({"person"})).class_name == "unknown"
-    assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "chair"
+    # ... but one that named another class contradicts it (a walker called refrigerator while
+    # cut, person in one of its three full views); none, or one that named the class, does not
+    assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "unknown"
+    assert _refused_track(0, full_views=3, within=frozenset({"person"})).class_name == "unknown"
+    assert _refused_track(0, full_views=1).class_name == "chair"
+    assert _refused_track(1, full_views=2, within=frozenset({"person"})).class_name == "chair"
+    with constants(contradicted_views=2):
+        assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "chair"
     assert _refused_track(0, refused_min_views=0).class_name == "chair"
     # a chair's box inside a blob that took no class (joined with the table beside it) is a
     # view that named the chair; a book's box on the shelf is not
