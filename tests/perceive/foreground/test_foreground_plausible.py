@@ -269,6 +269,44 @@ def test_a_class_the_silent_views_outweigh_names_nothing():
     assert shown_class(_named_in(6, 16, 0.41)) == "refrigerator"
 
 
+def _named_while(cut: bool, named: int = 6, silent: int = 14, score: float = 0.6) -> object:
+    """A track named ``oven`` in ``named`` views (``score``) whose blob the border cut when
+    ``cut``, and seen inside the image in ``silent`` views that named nothing."""
+    tracker = Tracker(TrackerConfig())
+    centre, extent = np.array([3.0, 0.0, 0.5]), np.array([0.8, 0.6, 0.9])
+    for k in range(named + silent):
+        is_named = k < named
+        m = Measurement(centre, extent, "oven" if is_named else "unknown", score if is_named else 0.0,
+                        f"o{k}", whole=False, detection_index=0 if is_named else None,
+                        cut_by_border=cut and is_named)
+        tracker.step(k / RATE_HZ, [m])
+    return tracker.tracks[0]
+
+
+def test_a_view_cut_by_the_border_counts_less():
+    """Degraded bookstore: a holder called ``oven`` in 6 of 20 views (score 0.6), every one cut
+    by the image's border, and nothing in the views that show it inside the image. A name given
+    to a part counts ``CUT_VIEW_WEIGHT``: too weak a support to name the object. The same names
+    on views inside the image name it; so do the cut ones when they count in full."""
+    cut = _named_while(cut=True)
+    assert cut.class_votes["oven"] == pytest.approx(6 * 0.6 * 0.8)
+    assert shown_class(cut) == "unknown"
+    assert shown_class(_named_while(cut=False)) == "oven"
+    with constants(cut_view_weight=1.0):
+        assert shown_class(_named_while(cut=True)) == "oven"
+
+
+def test_a_silent_view_cut_by_the_border_counts_less_too():
+    """A view cut by the border shows a part whichever way the detector answers: its silence
+    counts ``CUT_VIEW_WEIGHT`` of a silence inside the image."""
+    tracker = Tracker(TrackerConfig())
+    centre, extent = np.array([3.0, 0.0, 0.5]), np.array([0.4, 0.4, 0.9])
+    for k in range(4):
+        tracker.step(k / RATE_HZ, [Measurement(centre, extent, "unknown", 0.0, f"o{k}", cut_by_border=k < 2)])
+    weight = TrackerConfig().unknown_vote_weight
+    assert tracker.tracks[0].class_votes["unknown"] == pytest.approx(2 * weight * 0.8 + 2 * weight)
+
+
 def test_the_stage_shows_the_supported_class():
     """The instance of a track shows ``shown_class``, not the tracker's working class."""
     stage = ForegroundStage(detector="log")
