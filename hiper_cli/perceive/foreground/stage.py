@@ -410,6 +410,7 @@ class ForegroundStage:
             bottom_hidden=COMPLETE_FOOTPRINTS and match.class_name in FLOOR_STANDING
             and bottom_hidden(blob, frame.depth_m, cfg.pixel_step),
             full_view=full,
+            cut_by_border=not inside_image(blob, cfg.pixel_step, frame.camera),
             named_within=named_within(
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),

@@ -78,6 +78,9 @@ class Measurement:
     """The class a keyframe's closer look gave the blob, ``unknown`` included, when it saw the blob
     whole (``keyframes.py``; None: no closer look): it counts in the closer looks' own vote
     (``class_vote``), never in the every-frame one."""
+    cut_by_border: bool = False
+    """The blob reaches the image's border (``whole.inside_image``): the view shows a part of its
+    object, and its class vote counts ``class_vote.CUT_VIEW_WEIGHT``."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:

@@ -132,7 +132,8 @@ def _look(closer_class):
     from types import SimpleNamespace
 
     return SimpleNamespace(class_name="unknown", score=0.0, longest_m=None, full_view=False,
-                           named_within=frozenset(), detection_index=None, closer_class=closer_class)
+                           named_within=frozenset(), detection_index=None, closer_class=closer_class,
+                           cut_by_border=False)
 
 
 def test_the_closer_looks_name_a_thing_only_when_most_of_them_name_it():

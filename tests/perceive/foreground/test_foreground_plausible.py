@@ -217,9 +217,14 @@ def test_a_class_named_only_on_cut_views_and_declined_in_full_view_is_refused():
     assert _refused_track(0).search_class == "chair"  # it still says what it was taken for
     assert _refused_track(1).class_name == "chair"  # one full view named is enough
     assert _refused_track(0, full_views=7).class_name == "chair"  # too few silent ones to tell
-    # ... but two that named another class contradict it (a walker called refrigerator while cut)
-    assert _refused_track(0, full_views=2, within=frozenset({"person"})).class_name == "unknown"
-    assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "chair"
+    # ... but one that named another class contradicts it (a walker called refrigerator while
+    # cut, person in one of its three full views); none, or one that named the class, does not
+    assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "unknown"
+    assert _refused_track(0, full_views=3, within=frozenset({"person"})).class_name == "unknown"
+    assert _refused_track(0, full_views=1).class_name == "chair"
+    assert _refused_track(1, full_views=2, within=frozenset({"person"})).class_name == "chair"
+    with constants(contradicted_views=2):
+        assert _refused_track(0, full_views=1, within=frozenset({"person"})).class_name == "chair"
     assert _refused_track(0, refused_min_views=0).class_name == "chair"
     # a chair's box inside a blob that took no class (joined with the table beside it) is a
     # view that named the chair; a book's box on the shelf is not
@@ -262,6 +267,44 @@ def test_a_class_the_silent_views_outweigh_names_nothing():
     with constants(support_margin=1.0):
         assert shown_class(_named_in(7, 24, 0.51)) == "refrigerator"  # a bare majority named it
     assert shown_class(_named_in(6, 16, 0.41)) == "refrigerator"
+
+
+def _named_while(cut: bool, named: int = 6, silent: int = 14, score: float = 0.6) -> object:
+    """A track named ``oven`` in ``named`` views (``score``) whose blob the border cut when
+    ``cut``, and seen inside the image in ``silent`` views that named nothing."""
+    tracker = Tracker(TrackerConfig())
+    centre, extent = np.array([3.0, 0.0, 0.5]), np.array([0.8, 0.6, 0.9])
+    for k in range(named + silent):
+        is_named = k < named
+        m = Measurement(centre, extent, "oven" if is_named else "unknown", score if is_named else 0.0,
+                        f"o{k}", whole=False, detection_index=0 if is_named else None,
+                        cut_by_border=cut and is_named)
+        tracker.step(k / RATE_HZ, [m])
+    return tracker.tracks[0]
+
+
+def test_a_view_cut_by_the_border_counts_less():
+    """Degraded bookstore: a holder called ``oven`` in 6 of 20 views (score 0.6), every one cut
+    by the image's border, and nothing in the views that show it inside the image. A name given
+    to a part counts ``CUT_VIEW_WEIGHT``: too weak a support to name the object. The same names
+    on views inside the image name it; so do the cut ones when they count in full."""
+    cut = _named_while(cut=True)
+    assert cut.class_votes["oven"] == pytest.approx(6 * 0.6 * 0.8)
+    assert shown_class(cut) == "unknown"
+    assert shown_class(_named_while(cut=False)) == "oven"
+    with constants(cut_view_weight=1.0):
+        assert shown_class(_named_while(cut=True)) == "oven"
+
+
+def test_a_silent_view_cut_by_the_border_counts_less_too():
+    """A view cut by the border shows a part whichever way the detector answers: its silence
+    counts ``CUT_VIEW_WEIGHT`` of a silence inside the image."""
+    tracker = Tracker(TrackerConfig())
+    centre, extent = np.array([3.0, 0.0, 0.5]), np.array([0.4, 0.4, 0.9])
+    for k in range(4):
+        tracker.step(k / RATE_HZ, [Measurement(centre, extent, "unknown", 0.0, f"o{k}", cut_by_border=k < 2)])
+    weight = TrackerConfig().unknown_vote_weight
+    assert tracker.tracks[0].class_votes["unknown"] == pytest.approx(2 * weight * 0.8 + 2 * weight)
 
 
 def test_the_stage_shows_the_supported_class():
