@@ -57,7 +57,7 @@ from hiper_cli.perceive.foreground.reidentify import (
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
-from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
+from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes, table_bodies
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
@@ -511,9 +511,15 @@ class ForegroundStage:
                  if i.layer == "foreground"]
         grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
         ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
-        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown,
-                                  min(ceilings) if ceilings else None)
-        return [_solid_instance(p) for p in parts]
+        floor_z_m = floor_height_m(background)
+        parts = [_solid_instance(p) for p in self._solid.parts(
+            floor_z_m, support_boxes(background), taken, grown, min(ceilings) if ceilings else None)]
+        # the tables whose tops the background maps: objects too, unless an instance holds them
+        pieces = [i.box for i in (*self._instances.values(), *instances, *parts)
+                  if i.layer == "foreground" and i.class_name in (UNKNOWN, TABLE_CLASS)]
+        bodies = table_bodies(background, floor_z_m, [*taken, *(i.box for i in parts)], pieces)
+        return parts + [_solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
+                                                  np.round(top, 3).tolist())) for t, box, top in bodies]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
