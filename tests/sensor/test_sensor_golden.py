@@ -4,8 +4,9 @@ The fixture recorded by a structured-light sensor (seed 1: shadows, flying pixel
 colour shifted 3, 2 px, 1.5 cm RMS pose drift), truth detector and truth background boxes as in
 ``test_foreground_golden.py``. Against the clean fixture (chair 3 TP, 2 unknown, 7 truth
 instances seen, classified centre error 0.016 m) the degraded one loses one chair to
-``unknown`` and the drift adds about 4 cm of centre error: 2 chairs, 3 unknown, 6 seen, 0.058 m. The two tables
-the truth background maps are ``unknown`` objects too (``supports.table_bodies``): 5 unknown.
+``unknown`` and the drift adds about 4 cm of centre error: 2 chairs, 3 unknown, 6 seen, 0.058 m.
+The two tables the truth background maps are ``unknown`` objects too (``supports.table_bodies``):
+5 unknown.
 """
 
 import pytest

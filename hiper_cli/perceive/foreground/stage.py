@@ -110,6 +110,7 @@ VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the vo
 PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
 STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
+WALL_NOISE_M = 0.05  # ... and across their face a further depth noise of a wall seen from 3-4 m
 
 
 @lru_cache(maxsize=4096)
@@ -745,10 +746,13 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
 def _grown(box: Box3D, tall: bool) -> Box3D:
     """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
     its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
-    background saw)."""
+    background saw), and across its face by ``WALL_NOISE_M`` more: a wall seen from afar puts
+    points of its face that far in front of it, which fill the voxels along it (a sheet that
+    joined a table to the wall behind it up to the ceiling)."""
     extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
     if tall:
         extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
+        extent[int(np.argmin(box.extent_m))] += 2.0 * WALL_NOISE_M
     return Box3D(box.center_m, extent, box.R)
 
 
