@@ -69,6 +69,7 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     withdraw_mapped,
 )
 from hiper_cli.perceive.foreground.vacated import EmptyPlaces
+from hiper_cli.perceive.foreground.wall_relief import WallRelief
 from hiper_cli.perceive.foreground.whole import (
     FULL_VIEW_COVER,
     FULL_VIEW_MIN_PX2,
@@ -163,6 +164,7 @@ class ForegroundStage:
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
+        self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
         self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
         self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
@@ -356,6 +358,7 @@ class ForegroundStage:
                                             obs.uuid, bounds_map_m=_corners(blob)))
         if keyframe:
             self._solid.add(frame, held)
+            self._relief.add(frame, self._walls)
         return observations, measurements, surfaces
 
     def _judged(
@@ -519,8 +522,11 @@ class ForegroundStage:
         pieces = [i.box for i in (*self._instances.values(), *instances, *parts)
                   if i.layer == "foreground" and i.class_name in (UNKNOWN, TABLE_CLASS)]
         bodies = table_bodies(background, floor_z_m, [*taken, *(i.box for i in parts)], pieces)
-        return parts + [_solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
-                                                  np.round(top, 3).tolist())) for t, box, top in bodies]
+        parts += [_solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
+                                            np.round(top, 3).tolist())) for t, box, top in bodies]
+        # and the objects hung on the walls (``wall_relief.py``)
+        hung = self._relief.parts(floor_z_m, [*taken, *(i.box for i in parts)])
+        return parts + [_solid_instance(p) for p in hung]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
