@@ -12,7 +12,9 @@ A cell proud in ``MIN_VIEWS`` views and in ``PROUD_SHARE`` of those that could t
 one noisy view, or the pixels at a depth edge, do not repeat from the next viewpoint.
 
 At the end of the log, touching evidence cells are parts. A part is an object hung on the wall
-when it is at least ``MIN_SIDE_M`` both ways and ``MAX_SIDE_M`` at most, its lowest cell is
+when it is at least ``MIN_SIDE_M`` both ways and ``MAX_SIDE_M`` at most, no more than
+``MAX_ASPECT`` times longer than wide (a strip is an edge of the building: a corner the wall's
+extent ran past, a door frame, a pillar's side), its lowest cell is
 ``HUNG_M`` above the floor (lower, it is the back of a thing standing there, which the map of
 solid things keeps), and no instance's box lies beside it at its height (``BESIDE_M``: the
 head board of a bed against the wall is the bed's).
@@ -46,6 +48,7 @@ PROUD_SHARE = 0.6  # ... and in this share of the views that told proud from flu
 MIN_CELLS = 4  # a part of fewer cells is noise
 MIN_SIDE_M = 0.2  # a part at least this wide and high ...
 MAX_SIDE_M = 2.5  # ... and at most this: longer runs are the wall's own relief (a skirting, a beam)
+MAX_ASPECT = 4.0  # ... and at most this many times longer than wide: an edge of the building
 HUNG_M = 0.3  # its lowest cell this far above the floor: hung, not the back of a thing standing
 BESIDE_M = 0.2  # an instance's box this near across the floor, at the part's height, owns it
 _OFFSET = 1 << 20  # cell indices are packed into one int64 key, 21 bits each
@@ -128,7 +131,8 @@ class WallRelief:
             ijk = np.array(group, dtype=np.float64)
             lo, hi = ijk.min(axis=0) * CELL_M, (ijk.max(axis=0) + 1.0) * CELL_M
             sides = np.sort(hi - lo)[1:]  # the two largest: across the wall's face
-            if sides[0] < MIN_SIDE_M - 1e-9 or sides[1] > MAX_SIDE_M + 1e-9 or lo[2] < floor_z_m + HUNG_M:
+            shaped = MIN_SIDE_M - 1e-9 <= sides[0] and sides[1] <= min(MAX_SIDE_M + 1e-9, MAX_ASPECT * sides[0])
+            if not shaped or lo[2] < floor_z_m + HUNG_M:
                 continue
             if any(_beside(box, lo, hi) for box in instances):
                 continue

@@ -77,3 +77,8 @@ def test_a_picture_an_instance_stands_beside_at_its_height_is_that_instance() ->
     assert pass_by().parts(0.0, [shelf]) == []
     table = Box3D(np.array([0.0, WALL_Y - 0.5, 0.37]), np.array([1.0, 0.8, 0.75]))  # below it
     assert len(pass_by().parts(0.0, [table])) == 1
+
+
+def test_a_long_narrow_strip_proud_of_the_wall_is_an_edge_of_the_building() -> None:
+    strip = ([-0.1, 0.6], [0.1, 2.1])  # 0.2 m wide, 1.5 m high: a door frame, a corner
+    assert pass_by(picture=strip).parts(0.0, []) == []
