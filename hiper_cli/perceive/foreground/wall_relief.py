@@ -130,8 +130,8 @@ class WallRelief:
                 continue
             ijk = np.array(group, dtype=np.float64)
             lo, hi = ijk.min(axis=0) * CELL_M, (ijk.max(axis=0) + 1.0) * CELL_M
-            sides = np.sort(hi - lo)[1:]  # the two largest: across the wall's face
-            shaped = sides[0] >= MIN_SIDE_M - 1e-9 and sides[1] <= min(MAX_SIDE_M + 1e-9, MAX_ASPECT * sides[0])
+            short, long = np.sort(hi - lo)[1:]  # the two largest: across the wall's face
+            shaped = short >= MIN_SIDE_M - 1e-9 and long <= min(MAX_SIDE_M + 1e-9, MAX_ASPECT * short)
             if not shaped or lo[2] < floor_z_m + HUNG_M:
                 continue
             if any(_beside(box, lo, hi) for box in instances):
