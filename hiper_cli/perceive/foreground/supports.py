@@ -17,7 +17,8 @@ HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 TOUCH_M = 0.1  # an unnamed piece reaching a table's top this near its footprint ... (``table_bodies``)
 ALONG_SHARE = 0.5  # ... and along this share of its side at least holds it: it is the table's other part
-TOP_GRID = 5  # a table's stored surface: TOP_GRID × TOP_GRID points on its top
+TOP_GRID = 5  # a table's stored surface: TOP_GRID × TOP_GRID points on its top ...
+TOP_INSET = 0.1  # ... this share of its sides inside its edges (the background's extent is an estimate)
 
 FloatArray = NDArray[np.float64]
 
@@ -57,7 +58,9 @@ def table_bodies(background: Iterable[Instance], floor_z_m: float, taken: Sequen
                  pieces: Sequence[Box3D]) -> list[tuple[Instance, Box3D, FloatArray]]:
     """The objects the mapped table tops belong to: per table of ``background`` no instance
     holds yet, (the table, the box from the floor up to its top over the top's footprint, a grid
-    of points on its top: the surface the views saw). The top is the background's support;
+    of points on its top, the surface the views saw, and its four feet at the floor, where it
+    stands: a later session's empty-place test aims at the top, not at the air under it, and
+    leaves the feet out). The top is the background's support;
     the thing standing there, top and legs, is still an object, which the foreground filter
     (its points are the background's) and the map of solid things (its voxels lie in the
     background's box) never see. An instance holds it when its box (``taken``) covers
@@ -78,9 +81,12 @@ def table_bodies(background: Iterable[Instance], floor_z_m: float, taken: Sequen
         if any(overlap_share(box, other) >= COVERED_SHARE for other in held) or any(
                 _touches(piece, lo, hi) for piece in near):
             continue
-        u, v = np.meshgrid(np.linspace(lo[0], hi[0], TOP_GRID), np.linspace(lo[1], hi[1], TOP_GRID))
-        grid = np.column_stack([u.ravel(), v.ravel(), np.full(u.size, top_z)])
-        out.append((inst, box, grid))
+        inner = (hi[:2] - lo[:2]) * TOP_INSET
+        u, v = np.meshgrid(np.linspace(lo[0] + inner[0], hi[0] - inner[0], TOP_GRID),
+                           np.linspace(lo[1] + inner[1], hi[1] - inner[1], TOP_GRID))
+        top_points = np.column_stack([u.ravel(), v.ravel(), np.full(u.size, top_z)])
+        feet = np.array([[x, y, floor_z_m] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+        out.append((inst, box, np.concatenate([top_points, feet])))
         held.append(box)
         near.append(box)
     return out

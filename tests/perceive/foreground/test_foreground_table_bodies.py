@@ -33,7 +33,8 @@ def test_a_mapped_table_is_an_object_from_the_floor_to_its_top() -> None:
     assert table is TABLE
     np.testing.assert_allclose(lo, [0.9, 1.45, 0.0], atol=1e-9)
     np.testing.assert_allclose(hi, [2.5, 2.35, 0.75], atol=1e-9)
-    assert top.shape == (25, 3) and np.allclose(top[:, 2], 0.75)  # the surface seen: its top
+    assert top.shape == (29, 3) and np.allclose(top[:25, 2], 0.75)  # the surface seen: its top ...
+    assert np.all((top[:25, 0] > 0.9) & (top[:25, 0] < 2.5)) and np.allclose(top[25:, 2], 0.0)  # ... its feet
 
 
 def test_a_table_an_instance_holds_is_that_instance() -> None:
@@ -68,6 +69,15 @@ def test_the_stage_adds_the_tables_body_as_a_geometry_only_unknown() -> None:
     assert body.class_name == "unknown" and body.data["geometry_only"]
     assert body.box.center_m[2] == pytest.approx(0.375)
     assert (body.first_seen_s, body.last_seen_s) == (2.0, 9.0)
-    assert all(p[2] == pytest.approx(0.75) for p in body.data["surface_map"])
+    assert sum(p[2] == pytest.approx(0.75) for p in body.data["surface_map"]) == 25
     held = Instance("foreground", "table", _box([1.7, 1.9, 0.38], [1.5, 0.8, 0.76]), 0.0, 1.0)
     assert stage._geometry_only(world, [held]) == []
+
+
+def test_a_later_sessions_empty_place_test_aims_at_the_tables_top_not_under_it() -> None:
+    from hiper_cli.perceive.foreground.vacated import EmptyPlaces
+
+    stage = ForegroundStage(detector="log")
+    (body,) = stage._geometry_only(World(background={i.uuid: i for i in (FLOOR, TABLE)}), [])
+    targets = EmptyPlaces([body])._points
+    assert len(targets) == 25 and np.allclose(targets[:, 2], 0.75)  # the feet are left out
