@@ -51,19 +51,23 @@ MAX_SIDE_M = 2.5  # ... and at most this: longer runs are the wall's own relief 
 MAX_ASPECT = 4.0  # ... and at most this many times longer than wide: an edge of the building
 HUNG_M = 0.3  # its lowest cell this far above the floor: hung, not the back of a thing standing
 BESIDE_M = 0.2  # an instance's box this near across the floor, at the part's height, owns it
+FOLD_EVERY = 64  # views kept aside before they are folded into the counts per cell
 _OFFSET = 1 << 20  # cell indices are packed into one int64 key, 21 bits each
 _BITS = 21
 
 
 class WallRelief:
-    """Per view, the cells on the walls (keys of their map-frame position) that stood proud
-    and those flush (see the module docstring)."""
+    """Per cell on the walls ever told (packed keys of its map-frame position, sorted): the
+    views that saw it proud, those that saw it flush, and when it was first and last proud
+    (see the module docstring). Memory grows with the walls' area, not with the log's length."""
 
     def __init__(self) -> None:
-        # per view and wall: the packed keys of the cells that stood proud, and of those flush
-        self._proud: list[NDArray[np.int64]] = []
-        self._flush: list[NDArray[np.int64]] = []
-        self._stamps: list[float] = []  # the stamp of each entry of ``_proud``
+        self._keys = np.zeros(0, dtype=np.int64)
+        self._proud = np.zeros(0, dtype=np.int64)
+        self._flush = np.zeros(0, dtype=np.int64)
+        self._first_s = np.zeros(0, dtype=np.float64)
+        self._last_s = np.zeros(0, dtype=np.float64)
+        self._pending: list[tuple[NDArray[np.int64], NDArray[np.int64], float]] = []  # views not folded yet
 
     def add(self, frame: Frame, walls: Sequence[Box3D]) -> None:
         """One keyframe: its depth image against the walls mapped so far."""
@@ -106,24 +110,43 @@ class WallRelief:
         relief = mean_m - np.median(mean_m[enough])
         margin = np.maximum(RELIEF_M, 3.0 * NOISE_PER_M2 * depth_m**2 / np.sqrt(counts))
         keys, relief, margin = keys[enough], relief[enough], margin[enough]
-        self._proud.append(keys[relief >= margin])
-        self._flush.append(keys[np.abs(relief) < margin])
-        self._stamps.append(stamp_s)
+        self._count(keys[relief >= margin], keys[np.abs(relief) < margin], stamp_s)
+
+    def _count(self, proud: NDArray[np.int64], flush: NDArray[np.int64], stamp_s: float) -> None:
+        """One view's cells (unique keys) that stood ``proud`` and ``flush``: kept aside, and
+        folded into the counts every ``FOLD_EVERY`` views (``_fold``)."""
+        self._pending.append((proud, flush, stamp_s))
+        if len(self._pending) >= FOLD_EVERY:
+            self._fold()
+
+    def _fold(self) -> None:
+        """Fold the views kept aside into the counts per cell."""
+        if not self._pending:
+            return
+        proud = np.concatenate([p for p, _, _ in self._pending])
+        flush = np.concatenate([f for _, f, _ in self._pending])
+        stamps = np.concatenate([np.full(len(p), t) for p, _, t in self._pending])
+        self._pending = []
+        keys, inverse = np.unique(np.concatenate([self._keys, proud, flush]), return_inverse=True)
+        old, at_proud = inverse[: len(self._keys)], inverse[len(self._keys): len(self._keys) + len(proud)]
+        at_flush = inverse[len(self._keys) + len(proud):]
+        counts = np.zeros((2, len(keys)), dtype=np.int64)
+        first_s, last_s = np.full(len(keys), np.inf), np.full(len(keys), -np.inf)
+        counts[0, old], counts[1, old], first_s[old], last_s[old] = (self._proud, self._flush, self._first_s,
+                                                                    self._last_s)
+        np.add.at(counts[0], at_proud, 1)
+        np.add.at(counts[1], at_flush, 1)
+        np.minimum.at(first_s, at_proud, stamps)
+        np.maximum.at(last_s, at_proud, stamps)
+        self._keys, self._proud, self._flush = keys, counts[0], counts[1]
+        self._first_s, self._last_s = first_s, last_s
 
     def parts(self, floor_z_m: float, instances: Sequence[Box3D]) -> list[SolidPart]:
         """The objects hung on the walls (see the module docstring)."""
-        if not self._proud:
-            return []
-        proud_keys, proud_n = np.unique(np.concatenate(self._proud), return_counts=True)
-        flush_keys, flush_n = np.unique(np.concatenate(self._flush), return_counts=True)
-        flush = np.zeros(len(proud_keys), dtype=np.int64)
-        if len(flush_keys):
-            at = np.clip(np.searchsorted(flush_keys, proud_keys), 0, len(flush_keys) - 1)
-            flush = np.where(flush_keys[at] == proud_keys, flush_n[at], 0)
-        evidence = (proud_n >= MIN_VIEWS) & (proud_n >= PROUD_SHARE * (proud_n + flush))
-        counts = zip(proud_n[evidence].tolist(), flush[evidence].tolist(), strict=True)
-        cells = dict(zip(map(tuple, _unpack(proud_keys[evidence]).tolist()), counts, strict=True))
-        seen = [(stamp, set(keys.tolist())) for stamp, keys in zip(self._stamps, self._proud, strict=True)]
+        self._fold()
+        evidence = np.flatnonzero((self._proud >= MIN_VIEWS)
+                                   & (self._proud >= PROUD_SHARE * (self._proud + self._flush)))
+        cells = dict(zip(map(tuple, _unpack(self._keys[evidence]).tolist()), evidence.tolist(), strict=True))
         out: list[SolidPart] = []
         for group in _connected(set(cells)):
             if len(group) < MIN_CELLS:
@@ -136,13 +159,13 @@ class WallRelief:
                 continue
             if any(_beside(box, lo, hi) for box in instances):
                 continue
-            proud = sum(cells[key][0] for key in group)
-            told = proud + sum(cells[key][1] for key in group)
-            packed = set(_pack(np.array(group, dtype=np.int64)).tolist())
-            stamps = [stamp for stamp, keys in seen if keys & packed]
+            at = np.array([cells[key] for key in group], dtype=np.int64)
+            proud = int(self._proud[at].sum())
+            told = proud + int(self._flush[at].sum())
             centres = (ijk + 0.5) * CELL_M
-            out.append(SolidPart(Box3D((lo + hi) / 2.0, hi - lo), min(stamps), max(stamps), [],
-                                 proud / max(told, 1), np.round(centres[:SAMPLE_POINTS], 3).tolist()))
+            out.append(SolidPart(Box3D((lo + hi) / 2.0, hi - lo), float(self._first_s[at].min()),
+                                 float(self._last_s[at].max()), [], proud / max(told, 1),
+                                 np.round(centres[:SAMPLE_POINTS], 3).tolist()))
         return out
 
 

@@ -82,3 +82,14 @@ def test_a_picture_an_instance_stands_beside_at_its_height_is_that_instance() ->
 def test_a_long_narrow_strip_proud_of_the_wall_is_an_edge_of_the_building() -> None:
     strip = ([-0.1, 0.6], [0.1, 2.1])  # 0.2 m wide, 1.5 m high: a door frame, a corner
     assert pass_by(picture=strip).parts(0.0, []) == []
+
+
+def test_views_folded_into_the_counts_as_they_come_give_the_same_part(monkeypatch) -> None:
+    from hiper_cli.perceive.foreground import wall_relief
+
+    (whole,) = pass_by().parts(0.0, [])
+    monkeypatch.setattr(wall_relief, "FOLD_EVERY", 2)  # fold every second wall view
+    (folded,) = pass_by().parts(0.0, [])
+    np.testing.assert_allclose(folded.box.aabb(), whole.box.aabb())
+    assert (folded.first_seen_s, folded.last_seen_s, folded.seen_share, folded.surface_m) == (
+        whole.first_seen_s, whole.last_seen_s, whole.seen_share, whole.surface_m)
