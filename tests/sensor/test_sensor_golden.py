@@ -5,6 +5,8 @@ colour shifted 3, 2 px, 1.5 cm RMS pose drift), truth detector and truth backgro
 ``test_foreground_golden.py``. Against the clean fixture (chair 3 TP, 2 unknown, 7 truth
 instances seen, classified centre error 0.016 m) the degraded one loses one chair to
 ``unknown`` and the drift adds about 4 cm of centre error: 2 chairs, 3 unknown, 6 seen, 0.058 m.
+The two tables the truth background maps are ``unknown`` objects too (``supports.table_bodies``):
+5 unknown.
 """
 
 import pytest
@@ -28,7 +30,7 @@ def degraded(tmp_path_factory):
 def test_golden_table_iii_on_the_degraded_fixture(degraded):
     ours = evaluate_foreground(degraded, detector="truth", ablation=False, background="truth").ours
     assert ours["classification"] == {"chair": {"tp": 2, "fp": 0}, "person": {"tp": 1, "fp": 0}}
-    assert ours["unknown_instances"] == 3 and ours["truth_instances_seen"] == 6
+    assert ours["unknown_instances"] == 5 and ours["truth_instances_seen"] == 6
     assert ours["identity_switches"] == 0
     assert ours["localisation_classified_m"][0] == pytest.approx(0.058, abs=0.015)
     assert ours["localisation_box_centre_m"][0] == pytest.approx(0.133, abs=0.03)

@@ -57,7 +57,7 @@ from hiper_cli.perceive.foreground.reidentify import (
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
-from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
+from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes, table_bodies
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
@@ -69,6 +69,7 @@ from hiper_cli.perceive.foreground.unmapped_tables import (
     withdraw_mapped,
 )
 from hiper_cli.perceive.foreground.vacated import EmptyPlaces
+from hiper_cli.perceive.foreground.wall_relief import WallRelief
 from hiper_cli.perceive.foreground.whole import (
     FULL_VIEW_COVER,
     FULL_VIEW_MIN_PX2,
@@ -110,6 +111,7 @@ VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the vo
 PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
 STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
+WALL_NOISE_M = 0.05  # ... and across their face a further depth noise of a wall seen from 3-4 m
 
 
 @lru_cache(maxsize=4096)
@@ -162,6 +164,7 @@ class ForegroundStage:
         self.occupied_before: Callable[[Instance], bool] | None = None
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
+        self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
         self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
         self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
@@ -355,6 +358,7 @@ class ForegroundStage:
                                             obs.uuid, bounds_map_m=_corners(blob)))
         if keyframe:
             self._solid.add(frame, held)
+            self._relief.add(frame, self._walls)
         return observations, measurements, surfaces
 
     def _judged(
@@ -512,9 +516,18 @@ class ForegroundStage:
                  if i.layer == "foreground"]
         grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
         ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
-        parts = self._solid.parts(floor_height_m(background), support_boxes(background), taken, grown,
-                                  min(ceilings) if ceilings else None)
-        return [_solid_instance(p) for p in parts]
+        floor_z_m = floor_height_m(background)
+        parts = [_solid_instance(p) for p in self._solid.parts(
+            floor_z_m, support_boxes(background), taken, grown, min(ceilings) if ceilings else None)]
+        # the tables whose tops the background maps: objects too, unless an instance holds them
+        pieces = [i.box for i in (*self._instances.values(), *instances, *parts)
+                  if i.layer == "foreground" and i.class_name in (UNKNOWN, TABLE_CLASS)]
+        bodies = table_bodies(background, floor_z_m, [*taken, *(i.box for i in parts)], pieces)
+        parts += [_solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
+                                            np.round(top, 3).tolist())) for t, box, top in bodies]
+        # and the objects hung on the walls (``wall_relief.py``)
+        hung = self._relief.parts(floor_z_m, [*taken, *(i.box for i in parts)])
+        return parts + [_solid_instance(p) for p in hung]
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
@@ -740,10 +753,13 @@ def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
 def _grown(box: Box3D, tall: bool) -> Box3D:
     """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
     its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
-    background saw)."""
+    background saw), and across its face by ``WALL_NOISE_M`` more: a wall seen from afar puts
+    points of its face that far in front of it, which fill the voxels along it (a sheet that
+    joined a table to the wall behind it up to the ceiling)."""
     extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
     if tall:
         extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
+        extent[int(np.argmin(box.extent_m))] += 2.0 * WALL_NOISE_M
     return Box3D(box.center_m, extent, box.R)
 
 

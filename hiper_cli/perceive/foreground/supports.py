@@ -1,15 +1,26 @@
 """The background's supports as the foreground stage reads them: the floors and table tops
-objects stand on (their tops at the fitted plane), and the floor's height, map frame."""
+objects stand on (their tops at the fitted plane), and the floor's height, map frame; and the
+tables those tops belong to, as objects (``table_bodies``)."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
 
 from hiper_cli.model import Box3D, Instance
+from hiper_cli.perceive.foreground.solid_map import COVERED_SHARE, overlap_share
 
 SUPPORT_CLASSES = ("floor", "table")
 HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|) gives the top
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
+TOUCH_M = 0.1  # an unnamed piece reaching a table's top this near its footprint ... (``table_bodies``)
+ALONG_SHARE = 0.5  # ... and along this share of its side at least holds it: it is the table's other part
+TOP_GRID = 5  # a table's stored surface: TOP_GRID × TOP_GRID points on its top ...
+TOP_INSET = 0.1  # ... this share of its sides inside its edges (the background's extent is an estimate)
+
+FloatArray = NDArray[np.float64]
 
 
 def support_boxes(background: Iterable[Instance]) -> list[Box3D]:
@@ -41,3 +52,52 @@ def floor_height_m(background: Iterable[Instance]) -> float:
     top; 0, the map's origin, before the background found one)."""
     tops = [float(inst.box.aabb()[1][2]) for inst in background if inst.class_name == "floor"]
     return min(tops) if tops else 0.0
+
+
+def table_bodies(background: Iterable[Instance], floor_z_m: float, taken: Sequence[Box3D],
+                 pieces: Sequence[Box3D]) -> list[tuple[Instance, Box3D, FloatArray]]:
+    """The objects the mapped table tops belong to: per table of ``background`` no instance
+    holds yet, (the table, the box from the floor up to its top over the top's footprint, a grid
+    of points on its top, the surface the views saw, and its four feet at the floor, where it
+    stands: a later session's empty-place test aims at the top, not at the air under it, and
+    leaves the feet out). The top is the background's support;
+    the thing standing there, top and legs, is still an object, which the foreground filter
+    (its points are the background's) and the map of solid things (its voxels lie in the
+    background's box) never see. An instance holds it when its box (``taken``) covers
+    ``COVERED_SHARE`` of the table's, or when a piece of an unnamed or table instance (``pieces``)
+    continues the top (``_touches``): the table's other part."""
+    tables = [inst for inst in background if inst.class_name == "table"]
+    tables.sort(key=lambda inst: -float(np.prod(inst.box.extent_m[:2])))
+    held, near = list(taken), list(pieces)
+    out: list[tuple[Instance, Box3D, FloatArray]] = []
+    for inst in tables:
+        top = support_boxes([inst])[0]
+        lo, hi = top.aabb()
+        top_z = float(hi[2])
+        if top_z <= floor_z_m:
+            continue
+        lo = np.array([lo[0], lo[1], floor_z_m])
+        box = Box3D((lo + hi) / 2.0, hi - lo)
+        if any(overlap_share(box, other) >= COVERED_SHARE for other in held) or any(
+                _touches(piece, lo, hi) for piece in near):
+            continue
+        inner = (hi[:2] - lo[:2]) * TOP_INSET
+        u, v = np.meshgrid(np.linspace(lo[0] + inner[0], hi[0] - inner[0], TOP_GRID),
+                           np.linspace(lo[1] + inner[1], hi[1] - inner[1], TOP_GRID))
+        top_points = np.column_stack([u.ravel(), v.ravel(), np.full(u.size, top_z)])
+        feet = np.array([[x, y, floor_z_m] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+        out.append((inst, box, np.concatenate([top_points, feet])))
+        held.append(box)
+        near.append(box)
+    return out
+
+
+def _touches(piece: Box3D, lo: FloatArray, hi: FloatArray) -> bool:
+    """Whether ``piece`` is a part of the table whose top spans ``lo``-``hi``: it reaches the
+    top's height, within ``TOUCH_M`` of the footprint, and runs along a side of it for at least
+    ``ALONG_SHARE`` of that side (a chair at the table is narrower than the side it stands at)."""
+    p_lo, p_hi = piece.aabb()
+    if not p_lo[2] - TOUCH_M <= hi[2] <= p_hi[2] + TOUCH_M:
+        return False
+    overlap = np.minimum(p_hi[:2], hi[:2]) - np.maximum(p_lo[:2], lo[:2])
+    return bool(np.all(overlap >= -TOUCH_M) and np.any(overlap >= ALONG_SHARE * (hi[:2] - lo[:2])))
