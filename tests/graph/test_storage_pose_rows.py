@@ -72,15 +72,15 @@ def test_the_rows_kept_are_those_a_row_by_row_check_keeps():
         return np.linalg.norm(T[:3, 3] - U[:3, 3]) <= poserows.POSE_TOL_M and turn <= poserows.POSE_TOL_DEG
 
     def row_by_row(stamps, poses):
+        def line_holds(i, end):
+            share = [(stamps[k] - stamps[i]) / (stamps[end] - stamps[i]) for k in range(i + 1, end)]
+            return all(close(poserows.interpolate(poses[i], poses[end], a), poses[k])
+                       for k, a in zip(range(i + 1, end), share, strict=True))
+
         keep, i, n = [0], 0, len(stamps)
         while i < n - 1:
             j = i + 1
-            def line_holds(end):
-                share = [(stamps[k] - stamps[i]) / (stamps[end] - stamps[i]) for k in range(i + 1, end)]
-                return all(close(poserows.interpolate(poses[i], poses[end], a), poses[k])
-                           for k, a in zip(range(i + 1, end), share, strict=True))
-
-            while j + 1 < n and j + 1 - i <= poserows.SPAN_ROWS and line_holds(j + 1):
+            while j + 1 < n and j + 1 - i <= poserows.SPAN_ROWS and line_holds(i, j + 1):
                 j += 1
             keep.append(j)
             i = j
