@@ -1,6 +1,6 @@
 """The detections of the detector's last look, held for the frames it does not look at.
 
-The detector looks at every ``QUICK_LOOK_EVERY``-th frame (``keyframes.py``); the frames between
+The detector looks ``QUICK_LOOK_HZ`` times a second (``keyframes.py``); the frames between
 are segmented and tracked all the same. Their blobs are named by the last look's detections,
 each box moved to where the camera sees it now: its corners are lifted to the depth of what the
 box held (the median depth of its inner half) and projected into the new view. At 30 Hz the

@@ -1,10 +1,10 @@
 """Two rates: the detector's quick look every few frames, the static scene a closer one at keyframes.
 
 Every frame is segmented and tracked at the sensor rate. The quick look (the whole image at the
-detector's input size) runs on every ``QUICK_LOOK_EVERY``-th frame and on every keyframe; the
-frames between are named by the last look's detections, moved to the new view (``held.py``),
-which never count as views in a track's class vote. At 30 Hz a look every third frame is ten
-looks a second; at 15 Hz every second frame (``QUICK_LOOK_MAX_S``). The quick look shrinks a 640
+detector's input size) runs ``QUICK_LOOK_HZ`` times a second and on every keyframe; the frames
+between are named by the last look's detections, moved to the new view (``held.py``), which
+never count as views in a track's class vote. At 30 Hz a look every third frame is ten looks a
+second; at 20 Hz every second frame, at 15 Hz or less every frame. The quick look shrinks a 640
 × 480 image to 416 × 312 for YOLOX-Nano, and small or distant things (a book on a shelf, a cup
 on a desk) fall below what it can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last
 one, or sooner at a new viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned
@@ -30,16 +30,15 @@ from hiper_cli.perceive.detect.tiled import merge_detections, tile_boxes, tile_d
 from hiper_cli.types import Detections, Frame
 
 __all__ = [
-    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "QUICK_LOOK_EVERY",
-    "QUICK_LOOK_MAX_S", "KeyframeLook",
+    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "QUICK_LOOK_HZ",
+    "KeyframeLook",
 ]
 
-QUICK_LOOK_EVERY: int = 3
-"""The detector's quick look runs on every this many frames, and on every keyframe (1: every
-frame); the frames between hold the last look's detections (``held.py``) ..."""
-QUICK_LOOK_MAX_S: float = 0.09
-"""... and held detections are at most this old (s of log): a 15 Hz log is looked at every second
-frame, a 10 Hz one at every frame."""
+QUICK_LOOK_HZ: float = 10.0
+"""The detector's quick look runs this often (per s of log) and on every keyframe: on the frame
+nearest to 1 / ``QUICK_LOOK_HZ`` after the last look (a 30 Hz log every third frame, a 20 Hz one
+every second, one of 15 Hz or less every frame; 0: every frame). The frames between hold the last
+look's detections (``held.py``)."""
 
 CLOSER_LOOK_S: float = 0.5
 """A keyframe at most this long (s of log) after the last one (0: no closer look)."""
@@ -71,7 +70,7 @@ class KeyframeLook:
         self._last_pose: np.ndarray | None = None
         self._pending: list[int] = []  # the tiles the frames after a keyframe still get
         self._looked_s: float | None = None  # the stamp of the last quick look
-        self._since_look = 0  # frames since then
+        self._scheduled_s: float | None = None  # the stamp of the frame scheduled last
         self._given: dict[float, int] = {}  # stamp (s) -> the tile of that frame, the latest few
         self._tiles: dict[float, Detections] = {}  # stamp (s) -> its tile's detections
         self._closer: dict[float, Detections] = {}  # stamp (s) -> its closer look's detections
@@ -84,15 +83,16 @@ class KeyframeLook:
         tile = self.tile_for(frame)
         if not self.looks_at_images:
             return True, tile
-        # a frame handed over before the one looked at last (the first, started ahead) is looked at
+        step_s = 0.0 if self._scheduled_s is None else max(frame.stamp_s - self._scheduled_s, 0.0)
+        self._scheduled_s = max(frame.stamp_s, self._scheduled_s or frame.stamp_s)
+        # a frame handed over before the one looked at last (the first, started ahead) is looked at;
+        # a frame half a step or more past 1 / QUICK_LOOK_HZ would be farther than this one
         age_s = None if self._looked_s is None else frame.stamp_s - self._looked_s
-        look = (age_s is None or age_s <= 0 or age_s > QUICK_LOOK_MAX_S or tile == 0
-                or self._since_look + 1 >= QUICK_LOOK_EVERY)
+        look = (QUICK_LOOK_HZ <= 0 or age_s is None or age_s <= 0 or tile == 0
+                or age_s >= 1.0 / QUICK_LOOK_HZ - step_s / 2.0 - 1e-6)
         if look:
-            self._looked_s, self._since_look = frame.stamp_s, 0
+            self._looked_s = frame.stamp_s
             self.quick_looks += 1
-        else:
-            self._since_look += 1
         return look, tile
 
     def tile_for(self, frame: Frame) -> int | None:
