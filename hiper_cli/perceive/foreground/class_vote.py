@@ -47,10 +47,7 @@ from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 
-__all__ = [
-    "UNKNOWN", "absorb_votes", "named_object", "record", "record_closer", "search_class", "shown_class",
-    "winner",
-]
+__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "shown_class", "winner"]
 
 UNKNOWN = "unknown"
 CONTRADICTED_VIEWS: int = 2
@@ -111,7 +108,7 @@ def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
     track.class_votes[m.class_name] = track.class_votes.get(m.class_name, 0.0) + weight
     track.class_counts[m.class_name] = track.class_counts.get(m.class_name, 0) + 1
     if m.closer_class is not None:
-        record_closer(track, m.closer_class)
+        track.closer_counts[m.closer_class] = track.closer_counts.get(m.closer_class, 0) + 1
     if m.longest_m is not None and m.class_name != UNKNOWN:
         seen = track.class_longest_m.get(m.class_name, 0.0)
         track.class_longest_m[m.class_name] = max(seen, m.longest_m)
@@ -121,12 +118,6 @@ def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
             track.full_named[cls] = track.full_named.get(cls, 0) + 1
     if m.detection_index is not None:
         track.detected_classes.add(m.class_name)
-    track._class_name = None
-
-
-def record_closer(track: Track, closer_class: str) -> None:
-    """Count a closer look's class (``closer_class``) in the track's closer-look vote."""
-    track.closer_counts[closer_class] = track.closer_counts.get(closer_class, 0) + 1
     track._class_name = None
 
 

@@ -2,20 +2,20 @@
 
 Every frame is segmented and tracked at the sensor rate. The quick look (the whole image at the
 detector's input size) runs ``QUICK_LOOK_HZ`` times a second and on every keyframe; the frames
-between are named by the last look's detections, moved to the new view (``held.py``), which
-never count as views in a track's class vote. At 30 Hz a look every third frame is ten looks a
-second; at 20 Hz every second frame, at 15 Hz or less every frame. The quick look shrinks a 640
-× 480 image to 416 × 312 for YOLOX-Nano, and small or distant things (a book on a shelf, a cup
-on a desk) fall below what it can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last
-one, or sooner at a new viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned
-``CLOSER_LOOK_TURN_DEG``) the detector also looks at the image's tiles (``detect.tiled``: 2 × 2
-tiles, each shrunk less, 1.8 times closer). One tile a frame, on the keyframe and the frames
-after it: the worker's time per frame grows by one detector run, not four, so the whole command
-keeps the sensor rate, and over those few frames (a tenth of a second at 30 Hz) the static scene
-barely moves in the image. The tile's detections joined with the frame's own, looked at or held
-(``tiled.merge_detections``), name the blobs the tile held whole (``closer_detections``); those
-names count in the closer looks' own vote (``class_vote``): the quick look's ``unknown`` on a
-thing too small for it is no evidence against them.
+between are named by the last look's detections, moved to the new view (``held.py``). At 30 Hz a
+look every third frame is ten looks a second; at 20 Hz every second frame, at 15 Hz or less
+every frame. The quick look shrinks a 640 × 480 image to 416 × 312 for YOLOX-Nano, and small or
+distant things (a book on a shelf, a cup on a desk) fall below what it can name. At a keyframe
+(``CLOSER_LOOK_S`` of log after the last one, or sooner at a new viewpoint: the camera moved
+``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the detector also looks at the
+image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8 times closer). One tile a
+frame, on the keyframe and the frames after it: the worker's time per frame grows by one
+detector run, not four, so the whole command keeps the sensor rate, and over those few frames (a
+tenth of a second at 30 Hz) the static scene barely moves in the image. The tile's detections
+joined with the frame's own, looked at or held (``tiled.merge_detections``), name the blobs the
+tile held whole (``closer_detections``); those names count in the closer looks' own vote
+(``class_vote``): the quick look's ``unknown`` on a thing too small for it is no evidence
+against them.
 
 Only a detector that looks at the image gets the closer look and a quick look below the sensor
 rate: ``log`` and ``truth`` replay recorded detections of every frame, at no cost.

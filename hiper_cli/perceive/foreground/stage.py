@@ -254,7 +254,7 @@ class ForegroundStage:
         self, frame: Frame, future: Future[tuple[Detections | None, float]] | None
     ) -> tuple[Detections, float]:
         """The frame's detections (waiting for the worker; the last look's, held, when the detector
-        did not look at it: ``_looked``), with the classes the stage names, one name per box and no
+        did not look at it: ``held.py``), with the classes the stage names, one name per box and no
         object carried by a person; and the detector's time (s)."""
         cfg = self.config
         if future is not None:
@@ -406,8 +406,7 @@ class ForegroundStage:
         (``_judged``)."""
         cfg = self.config
         obs, longest = seen
-        # a full view is one the detector looked at (``class_vote``): held names are no views
-        full = self._looked and cfg.refused_min_views > 0 and in_full_view(
+        full = cfg.refused_min_views > 0 and in_full_view(
             blob, frame.depth_m, frame.camera, frame.T_map_cam, cfg.pixel_step, FULL_VIEW_MIN_PX2
         )
         walker = match.class_name in cfg.walker_classes
@@ -430,7 +429,6 @@ class ForegroundStage:
             named_within=named_within(
                 blob.image_box_xyxy, dets, min_score=cfg.min_detection_score, min_cover=FULL_VIEW_COVER,
             ) if full else frozenset(),
-            looked=self._looked,
         )
 
     def _closer_class(self, frame: Frame, scene: _Background, blob: Blob) -> str | None:

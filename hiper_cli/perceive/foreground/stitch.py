@@ -260,7 +260,6 @@ def absorb(old: Track, new: Track, kind: str, drop_rows: int = 0) -> None:
     old.apart_from |= new.apart_from
     absorb_votes(old, new)
     old.score_sum += new.score_sum
-    old.looks += new.looks
     old.travelled = old.travelled or new.travelled
     old.whole_stamps_s = sorted(old.whole_stamps_s + new.whole_stamps_s)  # in time, as tracked
     old.unsure_views += new.unsure_views

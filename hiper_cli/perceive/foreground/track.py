@@ -78,9 +78,6 @@ class Measurement:
     """The class a keyframe's closer look gave the blob, ``unknown`` included, when it saw the blob
     whole (``keyframes.py``; None: no closer look): it counts in the closer looks' own vote
     (``class_vote``), never in the every-frame one."""
-    looked: bool = True
-    """The detector looked at the frame. False: ``class_name`` comes from the last look's
-    detections, held (``held.py``): it guides association, but is no view in the class vote."""
 
     def corners(self) -> tuple[FloatArray, FloatArray]:
         if self.bounds_map_m is not None:
@@ -113,7 +110,6 @@ class Track:
     extent_m: FloatArray
     max_size_m: float = 0.0  # the largest blob seen (``_size_m``: footprint diagonal or height)
     hits: int = 1
-    looks: int = 0  # observations in frames the detector looked at (``Measurement.looked``)
     whole_stamps_s: list[float] = field(default_factory=list)  # of the whole observations
     unsure_views: int = 0  # observations that could not tell whether it was whole (``whole=None``)
     whole_footprint_m: FloatArray | None = None  # smoothed like ``extent_m``, whole views only
@@ -197,4 +193,4 @@ class Track:
 
     @property
     def confidence(self) -> float:
-        return self.score_sum / max(self.looks, 1)
+        return self.score_sum / max(self.hits, 1)

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 from hiper_cli.errors import ConfigError
 from hiper_cli.model import ROW_POSITION, ROW_VELOCITY, new_uuid
 from hiper_cli.perceive.foreground.association import get_association
-from hiper_cli.perceive.foreground.class_vote import UNKNOWN, named_object, record, record_closer
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, named_object, record
 from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.motion import MOTION_MODELS, make_motion_model
 from hiper_cli.perceive.foreground.moving import MOVING_SPEED_MPS, is_static, note_travel, was_moving
@@ -416,9 +416,9 @@ class Tracker:
             if named_object(track):
                 return True  # detections gave it a class (its full views may refuse that class)
             lasted = track.last_update_s - track.first_seen_s >= UNKNOWN_MIN_SPAN_S
-            if named >= cfg.min_class_share * track.looks and (lasted or not closing):
+            if named >= cfg.min_class_share * track.hits and (lasted or not closing):
                 return True  # detections name it most of the time
-        elif named >= cfg.min_class_observations or named >= cfg.min_class_share * track.looks:
+        elif named >= cfg.min_class_observations or named >= cfg.min_class_share * track.hits:
             return True  # detections name it (often, or most of the time)
         stamps = track.whole_stamps_s
         return (
@@ -428,15 +428,9 @@ class Tracker:
         )
 
     def _vote(self, track: Track, m: Measurement) -> None:
-        """Count ``m`` in the track's tallies: its class in the vote only when the detector looked
-        (a held name is no view: ``Measurement.looked``), its geometry always."""
-        if m.looked:
-            record(track, m, self.config.unknown_vote_weight)
-            track.score_sum += m.score
-            track.looks += 1
-        elif m.closer_class is not None:
-            record_closer(track, m.closer_class)
-        if m.looked and m.detection_index is not None:
+        record(track, m, self.config.unknown_vote_weight)
+        track.score_sum += m.score
+        if m.detection_index is not None:
             stamp = round(track.last_update_s, STAMP_DECIMALS)
             track.named_at[stamp] = NamedBlob(m.detection_index, *m.corners(), m.detection_xyxy_px)
         track.unsure_views += m.whole is None

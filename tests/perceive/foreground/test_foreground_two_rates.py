@@ -1,15 +1,13 @@
 """Two rates (``keyframes.py``, ``held.py``): every frame is tracked, the detector looks ten times a
 second (every third frame of a 30 Hz log) and at every keyframe; the frames between hold the last
-look's names, moved with the camera, and those held names never count as views in a track's vote."""
+look's names, moved with the camera, and count as those frames' own."""
 
 import numpy as np
 
 from hiper_cli.perceive.detect.recorded import LogDetector
 from hiper_cli.perceive.foreground import ForegroundStage
-from hiper_cli.perceive.foreground.config import TrackerConfig
 from hiper_cli.perceive.foreground.held import HeldDetections
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
-from hiper_cli.perceive.foreground.tracking import Measurement, Tracker
 from hiper_cli.perceive.stage import World
 from tests.fg_constants import set_constants
 from tests.fg_scene import CAMERA, background_instances, chair, make_frame, pose_looking_x, room
@@ -84,24 +82,33 @@ def _run_by_hand(frames, stage):
     return observations
 
 
-def test_a_track_keeps_its_class_between_looks_and_only_looks_vote(monkeypatch):
-    """The camera passes a chair 4 m away at 3 m/s (2.5 px a frame in the image): the frames the
-    detector does not look at name it by the last look's box, moved with the camera; the track's
-    vote counts the looks alone."""
+def _passing_chair():
+    """The camera passes a chair 4 m away at 3 m/s (2.5 px a frame in the image)."""
+    return [make_frame([*room(), chair(11, 4.0, -1.0)], pose_looking_x(y=-0.1 * k), k / 30.0, k)
+            for k in range(30)]
+
+
+def test_a_track_keeps_its_class_between_looks(monkeypatch):
+    """The frames the detector does not look at name the chair by the last look's box, moved
+    with the camera: the track's tallies are those of a detector that looked at every frame."""
     set_constants(monkeypatch, closer_look_s=0.0)
-    frames = [make_frame([*room(), chair(11, 4.0, -1.0)], pose_looking_x(y=-0.1 * k), k / 30.0, k)
-              for k in range(30)]
     detector = CountingDetector()
     stage = ForegroundStage(detector_instance=detector, pixel_step=2)
-    observations = _run_by_hand(frames, stage)
+    observations = _run_by_hand(_passing_chair(), stage)
     assert detector.looked == list(range(0, 30, 3))
     (track,) = stage.tracker.tracks
-    assert track.hits == 30 and track.looks == 10  # tracked on every frame, looked at on every third
-    assert track.class_counts == {"chair": 10}
-    assert track.class_name == "chair"
+    assert track.hits == 30 and track.class_name == "chair"
     assert [o.class_name for o in observations] == ["chair"] * 30
     held = [o.pose_id for o in observations if o.data["detection"].get("held")]
     assert held == [k for k in range(30) if k % 3]
+    set_constants(monkeypatch, quick_look_hz=0.0)  # the detector on every frame
+    every = CountingDetector()
+    looked_all = ForegroundStage(detector_instance=every, pixel_step=2)
+    _run_by_hand(_passing_chair(), looked_all)
+    assert every.looked == list(range(30))
+    (same,) = looked_all.tracker.tracks
+    assert track.class_counts == same.class_counts == {"chair": 30}
+    assert track.full_views == same.full_views and track.full_named == same.full_named
 
 
 def test_without_moving_them_the_held_boxes_would_miss_the_chair(monkeypatch):
@@ -111,32 +118,6 @@ def test_without_moving_them_the_held_boxes_would_miss_the_chair(monkeypatch):
 
     set_constants(monkeypatch, closer_look_s=0.0)
     monkeypatch.setattr(held, "_moved", lambda box, *_: box)
-    frames = [make_frame([*room(), chair(11, 4.0, -1.0)], pose_looking_x(y=-0.1 * k), k / 30.0, k)
-              for k in range(30)]
-    observations = _run_by_hand(frames, ForegroundStage(detector_instance=CountingDetector(), pixel_step=2))
+    observations = _run_by_hand(_passing_chair(), ForegroundStage(detector_instance=CountingDetector(),
+                                                                  pixel_step=2))
     assert "unknown" in [o.class_name for o in observations]
-
-
-def test_held_names_are_no_views_in_the_vote():
-    """A track whose held frames named nothing (``looked`` False) keeps the class its looks gave
-    it: the silent held frames are neither ``unknown`` votes nor observations against the share."""
-    tracker = Tracker(TrackerConfig())
-    centre, extent = np.array([2.0, 0.0, 0.45]), np.array([0.5, 0.5, 0.9])
-    for k in range(24):
-        looked = k % 3 == 0
-        m = Measurement(centre, extent, "chair" if looked else "unknown", 0.25 if looked else 0.0, f"o{k}",
-                        looked=looked)
-        tracker.step(k / 30.0, [m])
-    (track,) = tracker.tracks
-    assert track.hits == 24 and track.looks == 8
-    assert "unknown" not in track.class_votes
-    assert track.class_name == "chair" and track.confirmed
-    assert abs(track.confidence - 0.25) < 1e-9  # the looks' mean score
-    # the same silent frames, looked at: 16 unknown votes (0.15 each) outweigh 8 weak chairs (0.25)
-    heard = Tracker(TrackerConfig())
-    for k in range(24):
-        named = k % 3 == 0
-        m = Measurement(centre, extent, "chair" if named else "unknown", 0.25 if named else 0.0, f"o{k}")
-        heard.step(k / 30.0, [m])
-    assert heard.tracks[0].class_name == "unknown"
-
