@@ -9,8 +9,8 @@ alone, a person by a few pixels of its own. The held names shape the frame's blo
 detector's would (split and joined, ``refine.py``), guide the association and count in a track's
 class vote as the frame's own would: at the sensor rate consecutive looks were near copies of
 each other, and the vote's thresholds (views before a class wins, full views that refuse one)
-count frames. Counted only at the looks, they named fewer objects and refused fewer wrong
-classes (``docs/results/2026-12-07-two-rates.md``).
+count frames (counted only at the looks, they cost as much accuracy:
+``docs/results/2026-12-07-two-rates.md``).
 """
 
 from __future__ import annotations

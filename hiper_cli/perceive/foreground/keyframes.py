@@ -1,21 +1,20 @@
 """Two rates: the detector's quick look every few frames, the static scene a closer one at keyframes.
 
 Every frame is segmented and tracked at the sensor rate. The quick look (the whole image at the
-detector's input size) runs ``QUICK_LOOK_HZ`` times a second and on every keyframe; the frames
-between are named by the last look's detections, moved to the new view (``held.py``). At 30 Hz a
-look every third frame is ten looks a second; at 20 Hz every second frame, at 15 Hz or less
-every frame. The quick look shrinks a 640 × 480 image to 416 × 312 for YOLOX-Nano, and small or
-distant things (a book on a shelf, a cup on a desk) fall below what it can name. At a keyframe
-(``CLOSER_LOOK_S`` of log after the last one, or sooner at a new viewpoint: the camera moved
-``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the detector also looks at the
-image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8 times closer). One tile a
-frame, on the keyframe and the frames after it: the worker's time per frame grows by one
-detector run, not four, so the whole command keeps the sensor rate, and over those few frames (a
-tenth of a second at 30 Hz) the static scene barely moves in the image. The tile's detections
-joined with the frame's own, looked at or held (``tiled.merge_detections``), name the blobs the
-tile held whole (``closer_detections``); those names count in the closer looks' own vote
-(``class_vote``): the quick look's ``unknown`` on a thing too small for it is no evidence
-against them.
+detector's input size) runs on every frame, or, with ``QUICK_LOOK_HZ`` set, that many times a
+second and on every keyframe; the frames between are then named by the last look's detections,
+moved to the new view (``held.py``). The quick look shrinks a 640 × 480 image to 416 × 312 for
+YOLOX-Nano, and small or distant things (a book on a shelf, a cup on a desk) fall below what it
+can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last one, or sooner at a new
+viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the
+detector also looks at the image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8
+times closer). One tile a frame, on the keyframe and the frames after it: the worker's time per
+frame grows by one detector run, not four, so the whole command keeps the sensor rate, and over
+those few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. The
+tile's detections joined with the frame's own, looked at or held (``tiled.merge_detections``),
+name the blobs the tile held whole (``closer_detections``); those names count in the closer
+looks' own vote (``class_vote``): the quick look's ``unknown`` on a thing too small for it is no
+evidence against them.
 
 Only a detector that looks at the image gets the closer look and a quick look below the sensor
 rate: ``log`` and ``truth`` replay recorded detections of every frame, at no cost.
@@ -34,11 +33,13 @@ __all__ = [
     "KeyframeLook",
 ]
 
-QUICK_LOOK_HZ: float = 10.0
+QUICK_LOOK_HZ: float = 0.0
 """The detector's quick look runs this often (per s of log) and on every keyframe: on the frame
-nearest to 1 / ``QUICK_LOOK_HZ`` after the last look (a 30 Hz log every third frame, a 20 Hz one
-every second, one of 15 Hz or less every frame; 0: every frame). The frames between hold the last
-look's detections (``held.py``)."""
+nearest to 1 / ``QUICK_LOOK_HZ`` after the last look (at 10: a 30 Hz log every third frame; at 15:
+every second frame, one of 15 Hz or less every frame); the frames between hold the last look's
+detections (``held.py``). 0 (the default): every frame. 10 saves a quarter of the CPU of a 30 Hz
+log and 15 an eighth, but both changed the object map on some logs (10: a couch named ``bed``, a
+walker ``refrigerator``; ``docs/results/2026-12-07-two-rates.md``)."""
 
 CLOSER_LOOK_S: float = 0.5
 """A keyframe at most this long (s of log) after the last one (0: no closer look)."""

@@ -60,7 +60,7 @@ def still_frames(n=60):
 
 
 def test_a_keyframes_closer_look_names_what_the_every_frame_look_misses(monkeypatch):
-    set_constants(monkeypatch, closer_look_s=0.5)
+    set_constants(monkeypatch, closer_look_s=0.5, quick_look_hz=10.0)
     frames = still_frames()
     detector = FixedInputDetector(frames)
     assert len(detector.detect(frames[0])) == 1  # the every-frame look: the chair, not the suitcase

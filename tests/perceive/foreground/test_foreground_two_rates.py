@@ -30,7 +30,7 @@ class CountingDetector:
 
 
 def _schedule(rate_hz, n, closer_look_s=0.0, monkeypatch=None):
-    set_constants(monkeypatch, closer_look_s=closer_look_s)
+    set_constants(monkeypatch, closer_look_s=closer_look_s, quick_look_hz=10.0)
     look = KeyframeLook(CountingDetector(), "counting")
     frames = [make_frame(room(), pose_looking_x(), k / rate_hz, k) for k in range(n)]
     return [f.pose_id for f in frames if look.schedule(f)[0]]
@@ -43,6 +43,12 @@ def test_the_quick_look_runs_ten_times_a_second(monkeypatch):
     assert _schedule(60.0, 14, monkeypatch=monkeypatch) == [0, 6, 12]
 
 
+def test_quick_look_hz_0_looks_at_every_frame(monkeypatch):
+    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=0.0)
+    look = KeyframeLook(CountingDetector(), "counting")
+    assert all(look.schedule(make_frame(room(), pose_looking_x(), k / 30.0, k))[0] for k in range(6))
+
+
 def test_every_keyframe_gets_the_quick_look(monkeypatch):
     # keyframes 0.2 s apart: frames 0, 6, 12 (each then every third frame after it)
     assert _schedule(30.0, 14, closer_look_s=0.2, monkeypatch=monkeypatch) == [0, 3, 6, 9, 12]
@@ -50,7 +56,7 @@ def test_every_keyframe_gets_the_quick_look(monkeypatch):
 
 
 def test_a_replayed_detector_is_read_on_every_frame(monkeypatch):
-    set_constants(monkeypatch, closer_look_s=0.0)
+    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
     look = KeyframeLook(LogDetector(), "log")
     assert all(look.schedule(make_frame(room(), pose_looking_x(), k / 30.0, k))[0] for k in range(6))
 
@@ -91,7 +97,7 @@ def _passing_chair():
 def test_a_track_keeps_its_class_between_looks(monkeypatch):
     """The frames the detector does not look at name the chair by the last look's box, moved
     with the camera: the track's tallies are those of a detector that looked at every frame."""
-    set_constants(monkeypatch, closer_look_s=0.0)
+    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
     detector = CountingDetector()
     stage = ForegroundStage(detector_instance=detector, pixel_step=2)
     observations = _run_by_hand(_passing_chair(), stage)
@@ -116,7 +122,7 @@ def test_without_moving_them_the_held_boxes_would_miss_the_chair(monkeypatch):
     chair's blob no longer overlaps its box by the IoU the match asks (the move is what holds)."""
     import hiper_cli.perceive.foreground.held as held
 
-    set_constants(monkeypatch, closer_look_s=0.0)
+    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
     monkeypatch.setattr(held, "_moved", lambda box, *_: box)
     observations = _run_by_hand(_passing_chair(), ForegroundStage(detector_instance=CountingDetector(),
                                                                   pixel_step=2))
