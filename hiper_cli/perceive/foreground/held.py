@@ -1,16 +1,16 @@
 """The detections of the detector's last look, held for the frames it does not look at.
 
 With ``QUICK_LOOK_HZ`` set (``keyframes.py``; 0 by default: every frame), the detector looks
-that many times a second; the frames between are segmented and tracked all the same. Their blobs are named by the last look's detections,
-each box moved to where the camera sees it now: its corners are lifted to the depth of what the
-box held (the median depth of its inner half) and projected into the new view. At 30 Hz the
-last look is at most a few frames old: a static thing moves in the image by the camera's motion
-alone, a person by a few pixels of its own. The held names shape the frame's blobs as the
-detector's would (split and joined, ``refine.py``), guide the association and count in a track's
-class vote as the frame's own would: at the sensor rate consecutive looks were near copies of
-each other, and the vote's thresholds (views before a class wins, full views that refuse one)
-count frames (counted only at the looks, they cost as much accuracy:
-``docs/results/2026-12-07-two-rates.md``).
+that many times a second; the frames between are segmented and tracked all the same. Their blobs
+are named by the last look's detections, each box moved to where the camera sees it now: its
+corners are lifted to the depth of what the box held (the median depth of its inner half) and
+projected into the new view. At 30 Hz the last look is at most a few frames old: a static thing
+moves in the image by the camera's motion alone, a person by a few pixels of its own. The held
+names shape the frame's blobs as the detector's would (split and joined, ``refine.py``), guide
+the association and count in a track's class vote as the frame's own would: at the sensor rate
+consecutive looks were near copies of each other, and the vote's thresholds (views before a
+class wins, full views that refuse one) count frames (counted only at the looks, they cost as
+much accuracy: ``docs/results/2026-12-07-two-rates.md``).
 """
 
 from __future__ import annotations
