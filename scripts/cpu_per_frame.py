@@ -35,12 +35,13 @@ def frames(log: Path) -> int:
 
 def one_run(code: Path, log: Path, kb: Path, extra: list[str]) -> tuple[float, float]:
     """CPU seconds (user + system of the child and its threads) and wall seconds of one perceive."""
+    # -P: the checkout at ``code``, not the one in the current folder (``-m`` puts that first)
     env = dict(os.environ, PYTHONPATH=str(code))
     env.setdefault("HIPER_MODELS", str(SHARED / "models"))
     shutil.rmtree(kb, ignore_errors=True)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
-    run = subprocess.run([sys.executable, "-m", "hiper_cli", "perceive", str(log), "--kb", str(kb),
+    run = subprocess.run([sys.executable, "-P", "-m", "hiper_cli", "perceive", str(log), "--kb", str(kb),
                           "--json", *extra],
                          capture_output=True, text=True, env=env, check=False)
     wall_s = time.monotonic() - start

@@ -31,9 +31,10 @@ PY = sys.executable
 
 
 def hiper(*args: str) -> subprocess.CompletedProcess[str]:
+    # -P: the checkout on PYTHONPATH, not the one in the current folder (``-m`` puts that first)
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     env.setdefault("HIPER_MODELS", str(SHARED / "models"))
-    return subprocess.run([PY, "-m", "hiper_cli", *args], capture_output=True, text=True, env=env,
+    return subprocess.run([PY, "-P", "-m", "hiper_cli", *args], capture_output=True, text=True, env=env,
                           check=False)
 
 

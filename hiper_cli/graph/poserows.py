@@ -51,9 +51,42 @@ def interpolate(T0: F64, T1: F64, a: float) -> F64:
     return T
 
 
-def _close(T: F64, U: F64) -> bool:
-    turn = np.degrees(np.linalg.norm(_log_so3(T[:3, :3].T @ U[:3, :3])))
-    return bool(np.linalg.norm(T[:3, 3] - U[:3, 3]) <= POSE_TOL_M and turn <= POSE_TOL_DEG)
+def _turns_rad(R: F64) -> F64:
+    """The angles (radians) of rotations ``R`` (M, 3, 3): the norms of their rotation vectors,
+    as ``_log_so3`` gives them."""
+    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    w = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=1)
+    w_norm = np.linalg.norm(w, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        general = w_norm * (angle / (2.0 * np.sin(angle)))
+    return np.asarray(np.where(angle < 1e-9, 0.5 * w_norm, np.where(np.pi - angle < 1e-6, angle, general)))
+
+
+def _rotations_about(rotvecs: F64) -> F64:
+    """(M, 3, 3) rotations of the rotation vectors ``rotvecs`` (M, 3) (``rotation_about``, batched)."""
+    angle = np.linalg.norm(rotvecs, axis=1)
+    small = angle < 1e-12
+    k = rotvecs / np.where(small, 1.0, angle)[:, None]
+    K = np.zeros((len(k), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = k[:, 2], -k[:, 1], k[:, 0]
+    R = np.eye(3) + np.sin(angle)[:, None, None] * K + (1 - np.cos(angle))[:, None, None] * (K @ K)
+    R[small] = np.eye(3)
+    return np.asarray(R, dtype=np.float64)
+
+
+def _line_holds(stamps: F64, poses: F64, i: int, end: int) -> bool:
+    """Whether every row strictly between rows ``i`` and ``end`` lies within ``POSE_TOL_M`` and
+    ``POSE_TOL_DEG`` of the pose ``interpolate`` gives it between those two (all rows at once)."""
+    T0, T1 = poses[i], poses[end]
+    a = (stamps[i + 1:end] - stamps[i]) / (stamps[end] - stamps[i])
+    moved = (1.0 - a)[:, None] * T0[:3, 3] + a[:, None] * T1[:3, 3]
+    turned = T0[:3, :3] @ _rotations_about(a[:, None] * _log_so3(T0[:3, :3].T @ T1[:3, :3]))
+    seen = poses[i + 1:end]
+    off_m = np.linalg.norm(moved - seen[:, :3, 3], axis=1)
+    off_deg = np.degrees(_turns_rad(np.transpose(turned, (0, 2, 1)) @ seen[:, :3, :3]))
+    return bool(np.all((off_m <= POSE_TOL_M) & (off_deg <= POSE_TOL_DEG)))
 
 
 def _keep(stamps: list[float], poses: list[F64]) -> list[int]:
@@ -62,11 +95,10 @@ def _keep(stamps: list[float], poses: list[F64]) -> list[int]:
     keep = [0]
     i = 0
     n = len(stamps)
+    t, T = np.asarray(stamps, dtype=np.float64), np.asarray(poses, dtype=np.float64)
     while i < n - 1:
         j = i + 1
-        while j + 1 < n and j + 1 - i <= SPAN_ROWS and all(
-            _close(interpolate(poses[i], poses[j + 1], (stamps[k] - stamps[i]) / (stamps[j + 1] - stamps[i])),
-                   poses[k]) for k in range(i + 1, j + 1)):
+        while j + 1 < n and j + 1 - i <= SPAN_ROWS and _line_holds(t, T, i, j + 1):
             j += 1
         keep.append(j)
         i = j

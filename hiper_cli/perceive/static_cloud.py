@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from hiper_cli.perceive.align import MAX_DEPTH_M, PIXEL_STRIDE, VOXEL_M
+from hiper_cli.perceive.align import MAX_DEPTH_M, PIXEL_STRIDE, VOXEL_M, _unique_rows
 from hiper_cli.types import CameraIntrinsics, Frame
 
 __all__ = ["NOISE_PER_M2", "THROUGH_M", "StaticCloud"]
@@ -79,7 +79,7 @@ class StaticCloud:
 
     def __init__(self, earlier_m: FloatArray | None = None, voxel_m: float = VOXEL_M) -> None:
         self.voxel_m = voxel_m
-        self._sum: dict[tuple[int, int, int], FloatArray] = {}
+        self._sum: dict[tuple[int, int, int], list[float]] = {}  # x, y, z sums of the voxel's points
         self._n: dict[tuple[int, int, int], int] = {}
         self._views_hit: dict[tuple[int, int, int], int] = {}  # this session's views that hit it
         self._earlier: set[tuple[int, int, int]] = set()
@@ -89,19 +89,21 @@ class StaticCloud:
 
     def _add(self, points: FloatArray, *, count_view: bool) -> set[tuple[int, int, int]]:
         keys = np.floor(points / self.voxel_m).astype(np.int64)
-        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-        sums = np.zeros((len(uniq), 3))
-        np.add.at(sums, inverse.reshape(-1), points)
-        counts = np.bincount(inverse.reshape(-1), minlength=len(uniq))
+        uniq, inverse = _unique_rows(keys)
+        # per voxel, the sums of its points in input order (as ``np.add.at``), one pass per axis
+        sums = np.stack([np.bincount(inverse, weights=points[:, k], minlength=len(uniq)) for k in range(3)],
+                        axis=1)
+        counts = np.bincount(inverse, minlength=len(uniq))
         out = set()
-        for key, s, n in zip(map(tuple, uniq.tolist()), sums, counts, strict=True):
+        for key, s, n in zip(map(tuple, uniq.tolist()), sums.tolist(), counts.tolist(), strict=True):
             out.add(key)
             if count_view and key in self._earlier:
                 # the map frame is the first session's: a later session, aligned with its own
                 # error and drifting its own way, adds new space but does not pull the map
                 continue
-            self._sum[key] = self._sum.get(key, 0.0) + s
-            self._n[key] = self._n.get(key, 0) + int(n)
+            old = self._sum.get(key)
+            self._sum[key] = s if old is None else [old[0] + s[0], old[1] + s[1], old[2] + s[2]]
+            self._n[key] = self._n.get(key, 0) + n
             if count_view:
                 self._views_hit[key] = self._views_hit.get(key, 0) + 1
         return out
@@ -131,7 +133,7 @@ class StaticCloud:
         if not self._sum:
             return np.zeros((0, 3))
         keys = list(self._sum)
-        centroids = np.array([self._sum[k] / self._n[k] for k in keys])
+        centroids = np.array([self._sum[k] for k in keys]) / np.array([self._n[k] for k in keys])[:, None]
         new = np.array([k not in self._earlier for k in keys])
         hits = np.array([self._views_hit.get(k, 0) for k in keys])
         judged = np.flatnonzero(new)

@@ -59,3 +59,44 @@ def test_compaction_keeps_a_matrix_only_where_the_motion_bends(tmp_path):
         recorded = kb.session_poses(session.id)  # the whole session at once, interpolated alike
         assert np.allclose(recorded.stamps_s, stamps)
         assert np.abs(recorded.T_map_cam[:, :3, 3] - np.stack(poses)[:, :3, 3]).max() <= 0.0101
+
+
+def test_the_rows_kept_are_those_a_row_by_row_check_keeps():
+    """``_keep`` checks a stretch's rows all at once; a row-by-row check (``interpolate`` and the
+    tolerances, one row at a time) keeps the same rows, on smooth, noisy and jerky paths."""
+    from hiper_cli.graph import poserows
+    from hiper_cli.perceive.logs.trajectory import rotation_about
+
+    def close(T, U):
+        turn = np.degrees(np.linalg.norm(poserows._log_so3(T[:3, :3].T @ U[:3, :3])))
+        return np.linalg.norm(T[:3, 3] - U[:3, 3]) <= poserows.POSE_TOL_M and turn <= poserows.POSE_TOL_DEG
+
+    def row_by_row(stamps, poses):
+        def line_holds(i, end):
+            share = [(stamps[k] - stamps[i]) / (stamps[end] - stamps[i]) for k in range(i + 1, end)]
+            return all(close(poserows.interpolate(poses[i], poses[end], a), poses[k])
+                       for k, a in zip(range(i + 1, end), share, strict=True))
+
+        keep, i, n = [0], 0, len(stamps)
+        while i < n - 1:
+            j = i + 1
+            while j + 1 < n and j + 1 - i <= poserows.SPAN_ROWS and line_holds(i, j + 1):
+                j += 1
+            keep.append(j)
+            i = j
+        return keep
+
+    rng = np.random.default_rng(7)
+    for noise in (0.0, 0.0005, 0.002, 0.01):
+        n = 200
+        stamps = np.cumsum(rng.uniform(0.02, 0.05, n)).tolist()
+        turn, go = rng.normal(0, 0.5, 3), rng.normal(0, 0.5, 3)
+        poses = []
+        for s in stamps:
+            T = np.eye(4)
+            T[:3, :3] = rotation_about(turn * s * np.sin(s) + rng.normal(0, noise, 3))
+            T[:3, 3] = go * s + np.array([0.3 * np.sin(s), 0.0, 0.0]) + rng.normal(0, noise, 3)
+            poses.append(T)
+        kept = poserows._keep(stamps, poses)
+        assert kept == row_by_row(stamps, poses)
+        assert 2 <= len(kept) <= n

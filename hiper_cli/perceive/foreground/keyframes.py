@@ -1,21 +1,23 @@
-"""Two rates: every frame gets the detector's quick look, the static scene a closer one at keyframes.
+"""Two rates: the detector's quick look every few frames, the static scene a closer one at keyframes.
 
-The quick look (the whole image at the detector's input size) runs on every frame, at the
-sensor rate, for the tracking of movers. It shrinks a 640 × 480 image to 416 × 312 for
-YOLOX-Nano, and small or distant things (a book on a shelf, a cup on a desk) fall below what
-it can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last one, or sooner at a
-new viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the
-detector also looks at the image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8 times
-closer). One tile a frame, on the keyframe and the frames after it: the worker's time per frame
-grows by one detector run, not four, so the whole command keeps the sensor rate, and over those
-few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. The tile's
-detections joined with the frame's own (``tiled.merge_detections``) name the blobs the tile held
-whole (``closer_detections``); those names count in the closer looks' own vote (``class_vote``):
-the every-frame look's ``unknown`` on a thing too small for it is no evidence against them. The
-every-frame look (segmentation, tracking, its vote) is left as it was.
+Every frame is segmented and tracked at the sensor rate. The quick look (the whole image at the
+detector's input size) runs on every frame, or, with ``QUICK_LOOK_HZ`` set, that many times a
+second and on every keyframe; the frames between are then named by the last look's detections,
+moved to the new view (``held.py``). The quick look shrinks a 640 × 480 image to 416 × 312 for
+YOLOX-Nano, and small or distant things (a book on a shelf, a cup on a desk) fall below what it
+can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last one, or sooner at a new
+viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the
+detector also looks at the image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8
+times closer). One tile a frame, on the keyframe and the frames after it: the worker's time per
+frame grows by one detector run, not four, so the whole command keeps the sensor rate, and over
+those few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. The
+tile's detections joined with the frame's own, looked at or held (``tiled.merge_detections``),
+name the blobs the tile held whole (``closer_detections``); those names count in the closer
+looks' own vote (``class_vote``): the quick look's ``unknown`` on a thing too small for it is no
+evidence against them.
 
-Only a detector that looks at the image gets the closer look: ``log`` and ``truth`` replay
-recorded detections of the whole frame.
+Only a detector that looks at the image gets the closer look and a quick look below the sensor
+rate: ``log`` and ``truth`` replay recorded detections of every frame, at no cost.
 """
 
 from __future__ import annotations
@@ -27,8 +29,17 @@ from hiper_cli.perceive.detect.tiled import merge_detections, tile_boxes, tile_d
 from hiper_cli.types import Detections, Frame
 
 __all__ = [
-    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "KeyframeLook",
+    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "QUICK_LOOK_HZ",
+    "KeyframeLook",
 ]
+
+QUICK_LOOK_HZ: float = 0.0
+"""The detector's quick look runs this often (per s of log) and on every keyframe: on the frame
+nearest to 1 / ``QUICK_LOOK_HZ`` after the last look (at 10: a 30 Hz log every third frame; at 15:
+every second frame, one of 15 Hz or less every frame); the frames between hold the last look's
+detections (``held.py``). 0 (the default): every frame. 10 saves a quarter of the CPU of a 30 Hz
+log and 15 an eighth, but both changed the object map on some logs (10: a couch named ``bed``, a
+walker ``refrigerator``; ``docs/results/2026-12-07-two-rates.md``)."""
 
 CLOSER_LOOK_S: float = 0.5
 """A keyframe at most this long (s of log) after the last one (0: no closer look)."""
@@ -54,13 +65,36 @@ class KeyframeLook:
     def __init__(self, detector: Detector, detector_name: str) -> None:
         self.detector = detector
         names = {detector_name, getattr(detector, "name", "")}
-        self.enabled = CLOSER_LOOK_S > 0 and not names & set(REPLAYED)
+        self.looks_at_images = not names & set(REPLAYED)
+        self.enabled = CLOSER_LOOK_S > 0 and self.looks_at_images
         self._last_s: float | None = None
         self._last_pose: np.ndarray | None = None
         self._pending: list[int] = []  # the tiles the frames after a keyframe still get
+        self._looked_s: float | None = None  # the stamp of the last quick look
+        self._scheduled_s: float | None = None  # the stamp of the frame scheduled last
         self._given: dict[float, int] = {}  # stamp (s) -> the tile of that frame, the latest few
+        self._tiles: dict[float, Detections] = {}  # stamp (s) -> its tile's detections
         self._closer: dict[float, Detections] = {}  # stamp (s) -> its closer look's detections
         self.keyframes = 0
+        self.quick_looks = 0
+
+    def schedule(self, frame: Frame) -> tuple[bool, int | None]:
+        """Whether the quick look runs on ``frame``, and the tile of the closer look it gets
+        (``tile_for``). Called once per frame, in the log's order."""
+        tile = self.tile_for(frame)
+        if not self.looks_at_images:
+            return True, tile
+        step_s = 0.0 if self._scheduled_s is None else max(frame.stamp_s - self._scheduled_s, 0.0)
+        self._scheduled_s = max(frame.stamp_s, self._scheduled_s or frame.stamp_s)
+        # a frame handed over before the one looked at last (the first, started ahead) is looked at;
+        # a frame half a step or more past 1 / QUICK_LOOK_HZ would be farther than this one
+        age_s = None if self._looked_s is None else frame.stamp_s - self._looked_s
+        look = (QUICK_LOOK_HZ <= 0 or age_s is None or age_s <= 0 or tile == 0
+                or age_s >= 1.0 / QUICK_LOOK_HZ - step_s / 2.0 - 1e-6)
+        if look:
+            self._looked_s = frame.stamp_s
+            self.quick_looks += 1
+        return look, tile
 
     def tile_for(self, frame: Frame) -> int | None:
         """The tile (index into ``tile_boxes``) ``frame`` gets, or None."""
@@ -79,6 +113,7 @@ class KeyframeLook:
             stamp_s = next(iter(self._given))
             del self._given[stamp_s]
             self._closer.pop(stamp_s, None)
+            self._tiles.pop(stamp_s, None)
         return tile
 
     def covers(self, frame: Frame, xyxy: np.ndarray) -> bool:
@@ -102,13 +137,21 @@ class KeyframeLook:
         turned_deg = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
         return moved_m >= CLOSER_LOOK_MOVE_M or turned_deg >= CLOSER_LOOK_TURN_DEG
 
-    def look(self, frame: Frame, dets: Detections, tile: int) -> None:
-        """Run the closer look on ``frame``'s tile ``tile`` (in the detector's worker): its
-        detections with ``dets``, the frame's quick look, are kept for ``closer_detections``."""
+    def look(self, frame: Frame, tile: int) -> None:
+        """Run the closer look on ``frame``'s tile ``tile`` (in the detector's worker); ``join``
+        adds the frame's own detections."""
         rows, cols, overlap = CLOSER_LOOK_TILES
         box = tile_boxes(frame.width, frame.height, rows, cols, overlap)[tile]
-        self._closer[frame.stamp_s] = merge_detections([dets, tile_detections(self.detector, frame, box)])
+        self._tiles[frame.stamp_s] = tile_detections(self.detector, frame, box)
+
+    def join(self, frame: Frame, dets: Detections) -> None:
+        """Keep ``frame``'s closer look for ``closer_detections``: its tile's detections with
+        ``dets``, the frame's own (looked at or held)."""
+        tiled = self._tiles.pop(frame.stamp_s, None)
+        if tiled is not None:
+            self._closer[frame.stamp_s] = merge_detections([dets, tiled])
 
     def closer_detections(self, frame: Frame, xyxy: np.ndarray) -> Detections | None:
         """``frame``'s closer look when its tile held the image box ``xyxy`` whole, else None."""
         return self._closer.get(frame.stamp_s) if self.covers(frame, xyxy) else None
+

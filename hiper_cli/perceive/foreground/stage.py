@@ -30,6 +30,7 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.held import HeldDetections
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
@@ -151,7 +152,9 @@ class ForegroundStage:
         # the ``log`` detector reads the log's own detections: perceive checks the log has them
         self.needs_log_detections = cfg.detector == "log"
         self._pool: ThreadPoolExecutor | None = None
-        self._ahead: dict[int, tuple[Frame, Future[tuple[Detections, float]]]] = {}
+        self._ahead: dict[int, tuple[Frame, Future[tuple[Detections | None, float]]]] = {}
+        self._held = HeldDetections()  # the last quick look's, for the frames between (``held.py``)
+        self._looked = True  # whether the detector looked at this frame (``_detections``)
         self._priors = LearnedPriors(cfg)
         self._floor_z_m = 0.0  # floor_height_m of the world, per frame (``_stands``)
         self._floor_mapped = False  # the background found a floor (``complete_base``)
@@ -195,18 +198,24 @@ class ForegroundStage:
         return center, extent
 
     # --- the stage --------------------------------------------------------------------------
-    def _detect_timed(self, frame: Frame, tile: int | None) -> tuple[Detections, float]:
-        """The frame's detections; and the closer look at its ``tile`` of a keyframe (``keyframes.py``)."""
+    def _detect_timed(self, frame: Frame, look: bool, tile: int | None) -> tuple[Detections | None, float]:
+        """The frame's detections when the quick look runs on it (else None: ``held.py``); and the
+        closer look at its ``tile`` of a keyframe (``keyframes.py``)."""
         t0 = time.perf_counter()
-        dets = self.detector.detect(frame)
+        dets = self.detector.detect(frame) if look else None
         if tile is not None:
-            self._keyframes.look(frame, dets, tile)
+            self._keyframes.look(frame, tile)
         return dets, time.perf_counter() - t0
 
-    def _submit(self, frame: Frame) -> Future[tuple[Detections, float]]:
+    def _submit(self, frame: Frame) -> Future[tuple[Detections | None, float]]:
+        look, tile = self._keyframes.schedule(frame)
+        if not look and tile is None:  # nothing for the worker
+            done: Future[tuple[Detections | None, float]] = Future()
+            done.set_result((None, 0.0))
+            return done
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hiper-detect")
-        return self._pool.submit(self._detect_timed, frame, self._keyframes.tile_for(frame))
+        return self._pool.submit(self._detect_timed, frame, look, tile)
 
     def prepare(self, frame: Frame) -> None:
         """Start the detector on the next frame (``run_stages`` hands it over before it
@@ -236,7 +245,7 @@ class ForegroundStage:
         return FrameResult(observations=observations, instances=instances, deleted_instances=merged,
                            timings_s=_timings(clock, detect_s, seg))
 
-    def _detection_of(self, frame: Frame) -> Future[tuple[Detections, float]] | None:
+    def _detection_of(self, frame: Frame) -> Future[tuple[Detections | None, float]] | None:
         """The detector's work on ``frame``: started ahead by ``prepare``, started now in the
         worker, or None (``detector_threads`` off: detect in this thread)."""
         ahead = self._ahead.pop(id(frame), None)
@@ -245,10 +254,11 @@ class ForegroundStage:
         return self._submit(frame) if self.config.detector_threads else None
 
     def _detections(
-        self, frame: Frame, future: Future[tuple[Detections, float]] | None
+        self, frame: Frame, future: Future[tuple[Detections | None, float]] | None
     ) -> tuple[Detections, float]:
-        """The frame's detections (waiting for the worker), with the classes the stage names,
-        one name per box and no object carried by a person; and the detector's time (s)."""
+        """The frame's detections (waiting for the worker; the last look's, held, when the detector
+        did not look at it: ``held.py``), with the classes the stage names, one name per box and no
+        object carried by a person; and the detector's time (s)."""
         cfg = self.config
         if future is not None:
             try:
@@ -257,7 +267,13 @@ class ForegroundStage:
                 where = frame.source or f"frame {frame.pose_id}"
                 raise PerceptionError(f"detector {self.detector.name!r} failed on {where}: {err}") from err
         else:
-            dets, detect_s = self._detect_timed(frame, self._keyframes.tile_for(frame))
+            dets, detect_s = self._detect_timed(frame, *self._keyframes.schedule(frame))
+        self._looked = dets is not None
+        if dets is None:
+            dets = self._held.at(frame)
+        else:
+            self._held.keep(frame, dets)
+        self._keyframes.join(frame, dets)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
         dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
@@ -605,6 +621,8 @@ class ForegroundStage:
                 "score": float(dets.scores[k]),
                 "iou": match.iou,
             }
+            if not self._looked:
+                detection["held"] = True  # the last look's, moved to this view (``held.py``)
         return Observation(
             layer="foreground",
             class_name=match.class_name,
