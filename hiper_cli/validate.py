@@ -70,6 +70,7 @@ OPTION_RANGES: dict[str, Range] = {
     "pose_drift": Range(0.0, 1.0),  # hiper convert --degrade: metres of drift per metre travelled
     "mapping_hz": Range(0.0, 1000.0, lo_open=True), "keyframe_hz": Range(0.0, 1000.0, lo_open=True),
     "max_hz": Range(0.0, 1000.0, lo_open=True),  # hiper perceive --max-hz
+    "detector_hz": Range(0.0, 1000.0),  # hiper perceive --detector-hz (0: every frame)
     # hiper analyze
     "hours": Range(0.0, 1000.0, lo_open=True), "resolution_m": Range(0.001, 10.0),
     # hiper sim

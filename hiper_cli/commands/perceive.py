@@ -22,7 +22,7 @@ def perceive_command(
     align: o.Align = "auto", keep_observations: o.Keep = "0", view: o.View = False,
     timings: o.Timings = False, idle_timeout: o.IdleTimeout = None, queue: o.Queue = 1,
     look_ahead: o.LookAhead = False, stats: o.Stats = False, as_json: Json = False,
-    max_hz: o.MaxHz = None, *, log_options: LogOptions) -> None:
+    max_hz: o.MaxHz = None, detector_hz: o.DetectorHz = None, *, log_options: LogOptions) -> None:
     """Stream a log's frames through the recognition stages into a knowledge base.
 
     Each frame's results are written atomically; an interrupted run continues with --resume.
@@ -41,7 +41,8 @@ def perceive_command(
     options = o.perceive_options(
         stages=stages, option=option, env=env, resume=resume, replace=replace, again=again, align=align,
         keep_observations=keep_observations, detector=detector, no_background_filter=no_background_filter,
-        classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz, max_hz=max_hz)
+        classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz, max_hz=max_hz,
+        detector_hz=detector_hz)
     o.check_source_flags(is_live(log), log, idle_timeout=idle_timeout, queue=queue, look_ahead=look_ahead,
                          stats=stats, resume=resume, replace=replace, again=again, view=view, max_hz=max_hz)
     if is_live(log):

@@ -258,6 +258,11 @@ class ForegroundConfig(TrackerConfig, MatchConfig, RefineConfig):
     """Detections below this score are ignored by the matching."""
     detector_threads: bool = True
     """Run the detector in a worker thread, concurrently with the point-cloud work."""
+    detector_hz: float = 0.0
+    """The detector looks this often (per s of log) and at every keyframe; the frames between are
+    still segmented and tracked, named by the last look's boxes moved with the camera
+    (``held.py``). 0: every frame. 10 saves about a quarter of a 30 Hz log's CPU but changed
+    borderline names on some logs (``docs/results/2026-12-07-two-rates.md``)."""
     classes: tuple[str, ...] = ()
     """Only these detector classes name blobs (empty: all); a per-environment class list."""
     exclude_classes: tuple[str, ...] = INDOOR_EXCLUDED

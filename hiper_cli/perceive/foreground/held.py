@@ -1,6 +1,6 @@
 """The detections of the detector's last look, held for the frames it does not look at.
 
-With ``QUICK_LOOK_HZ`` set (``keyframes.py``; 0 by default: every frame), the detector looks
+With ``detector_hz`` set (``perceive --detector-hz``; 0 by default: every frame), the detector looks
 that many times a second; the frames between are segmented and tracked all the same. Their blobs
 are named by the last look's detections, each box moved to where the camera sees it now: its
 corners are lifted to the depth of what the box held (the median depth of its inner half) and

@@ -1,20 +1,20 @@
 """Two rates: the detector's quick look every few frames, the static scene a closer one at keyframes.
 
 Every frame is segmented and tracked at the sensor rate. The quick look (the whole image at the
-detector's input size) runs on every frame, or, with ``QUICK_LOOK_HZ`` set, that many times a
-second and on every keyframe; the frames between are then named by the last look's detections,
-moved to the new view (``held.py``). The quick look shrinks a 640 × 480 image to 416 × 312 for
-YOLOX-Nano, and small or distant things (a book on a shelf, a cup on a desk) fall below what it
-can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last one, or sooner at a new
-viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned ``CLOSER_LOOK_TURN_DEG``) the
-detector also looks at the image's tiles (``detect.tiled``: 2 × 2 tiles, each shrunk less, 1.8
-times closer). One tile a frame, on the keyframe and the frames after it: the worker's time per
-frame grows by one detector run, not four, so the whole command keeps the sensor rate, and over
-those few frames (a tenth of a second at 30 Hz) the static scene barely moves in the image. The
-tile's detections joined with the frame's own, looked at or held (``tiled.merge_detections``),
-name the blobs the tile held whole (``closer_detections``); those names count in the closer
-looks' own vote (``class_vote``): the quick look's ``unknown`` on a thing too small for it is no
-evidence against them.
+detector's input size) runs on every frame, or, with ``detector_hz`` set (``perceive
+--detector-hz``), that many times a second and on every keyframe; the frames between are then
+named by the last look's detections, moved to the new view (``held.py``). The quick look shrinks a
+640 × 480 image to 416 × 312 for YOLOX-Nano, and small or distant things (a book on a shelf, a cup
+on a desk) fall below what it can name. At a keyframe (``CLOSER_LOOK_S`` of log after the last
+one, or sooner at a new viewpoint: the camera moved ``CLOSER_LOOK_MOVE_M`` or turned
+``CLOSER_LOOK_TURN_DEG``) the detector also looks at the image's tiles (``detect.tiled``: 2 × 2
+tiles, each shrunk less, 1.8 times closer). One tile a frame, on the keyframe and the frames after
+it: the worker's time per frame grows by one detector run, not four, so the whole command keeps
+the sensor rate, and over those few frames (a tenth of a second at 30 Hz) the static scene barely
+moves in the image. The tile's detections joined with the frame's own, looked at or held
+(``tiled.merge_detections``), name the blobs the tile held whole (``closer_detections``); those
+names count in the closer looks' own vote (``class_vote``): the quick look's ``unknown`` on a
+thing too small for it is no evidence against them.
 
 Only a detector that looks at the image gets the closer look and a quick look below the sensor
 rate: ``log`` and ``truth`` replay recorded detections of every frame, at no cost.
@@ -29,17 +29,9 @@ from hiper_cli.perceive.detect.tiled import merge_detections, tile_boxes, tile_d
 from hiper_cli.types import Detections, Frame
 
 __all__ = [
-    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG", "QUICK_LOOK_HZ",
+    "CLOSER_LOOK_MOVE_M", "CLOSER_LOOK_S", "CLOSER_LOOK_TILES", "CLOSER_LOOK_TURN_DEG",
     "KeyframeLook",
 ]
-
-QUICK_LOOK_HZ: float = 0.0
-"""The detector's quick look runs this often (per s of log) and on every keyframe: on the frame
-nearest to 1 / ``QUICK_LOOK_HZ`` after the last look (at 10: a 30 Hz log every third frame; at 15:
-every second frame, one of 15 Hz or less every frame); the frames between hold the last look's
-detections (``held.py``). 0 (the default): every frame. 10 saves a quarter of the CPU of a 30 Hz
-log and 15 an eighth, but both changed the object map on some logs (10: a couch named ``bed``, a
-walker ``refrigerator``; ``docs/results/2026-12-07-two-rates.md``)."""
 
 CLOSER_LOOK_S: float = 0.5
 """A keyframe at most this long (s of log) after the last one (0: no closer look)."""
@@ -62,8 +54,9 @@ class KeyframeLook:
     started) and says which tile that frame gets (None: the quick look only); ``look`` runs the
     detector on that tile and joins its detections to the frame's own."""
 
-    def __init__(self, detector: Detector, detector_name: str) -> None:
+    def __init__(self, detector: Detector, detector_name: str, detector_hz: float = 0.0) -> None:
         self.detector = detector
+        self.detector_hz = detector_hz  # quick looks per s of log, and at keyframes (0: every frame)
         names = {detector_name, getattr(detector, "name", "")}
         self.looks_at_images = not names & set(REPLAYED)
         self.enabled = CLOSER_LOOK_S > 0 and self.looks_at_images
@@ -87,10 +80,10 @@ class KeyframeLook:
         step_s = 0.0 if self._scheduled_s is None else max(frame.stamp_s - self._scheduled_s, 0.0)
         self._scheduled_s = max(frame.stamp_s, self._scheduled_s or frame.stamp_s)
         # a frame handed over before the one looked at last (the first, started ahead) is looked at;
-        # a frame half a step or more past 1 / QUICK_LOOK_HZ would be farther than this one
+        # a frame half a step or more past 1 / detector_hz would be farther than this one
         age_s = None if self._looked_s is None else frame.stamp_s - self._looked_s
-        look = (QUICK_LOOK_HZ <= 0 or age_s is None or age_s <= 0 or tile == 0
-                or age_s >= 1.0 / QUICK_LOOK_HZ - step_s / 2.0 - 1e-6)
+        look = (self.detector_hz <= 0 or age_s is None or age_s <= 0 or tile == 0
+                or age_s >= 1.0 / self.detector_hz - step_s / 2.0 - 1e-6)
         if look:
             self._looked_s = frame.stamp_s
             self.quick_looks += 1

@@ -168,7 +168,8 @@ class ForegroundStage:
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
         self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
-        self._keyframes = KeyframeLook(self.detector, cfg.detector)  # the closer look at the static scene
+        # the quick look at cfg.detector_hz, the closer look at the static scene at keyframes
+        self._keyframes = KeyframeLook(self.detector, cfg.detector, cfg.detector_hz)
         self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
     def _stands(self, class_name: str, blob: Blob) -> bool:

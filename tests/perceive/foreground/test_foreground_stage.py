@@ -14,7 +14,6 @@ from hiper_cli.perceive.foreground.segment import segment
 from hiper_cli.perceive.runner import run_stages
 from hiper_cli.perceive.stage import FrameResult, World, make_stage
 from tests import REPO_ROOT
-from tests.fg_constants import set_constants
 from tests.fg_scene import (
     CAMERA,
     SceneBox,
@@ -274,7 +273,6 @@ class _RecordingDetector:
 
 
 def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker(monkeypatch):
-    set_constants(monkeypatch, quick_look_hz=0.0)  # the quick look on every frame (``keyframes.py``)
     detector = _RecordingDetector()
     stage = ForegroundStage(detector_instance=detector, pixel_step=2)
     calls = []
@@ -304,7 +302,6 @@ def test_the_detector_runs_one_frame_ahead_once_per_frame_in_its_worker(monkeypa
 def test_live_the_detector_starts_on_each_frame_before_the_stages_before_it(monkeypatch):
     """``look_ahead=False`` (a live stream): no next frame to hand over, so each frame goes to
     the detector before the first stage (the background) processes it; same result."""
-    set_constants(monkeypatch, quick_look_hz=0.0)  # the quick look on every frame (``keyframes.py``)
     detector = _RecordingDetector()
     stage = ForegroundStage(detector_instance=detector, pixel_step=2)
     calls = []

@@ -9,6 +9,7 @@ from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.held import HeldDetections
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.stage import World
+from tests import REPO_ROOT
 from tests.fg_constants import set_constants
 from tests.fg_scene import CAMERA, background_instances, chair, make_frame, pose_looking_x, room
 
@@ -30,8 +31,8 @@ class CountingDetector:
 
 
 def _schedule(rate_hz, n, closer_look_s=0.0, monkeypatch=None):
-    set_constants(monkeypatch, closer_look_s=closer_look_s, quick_look_hz=10.0)
-    look = KeyframeLook(CountingDetector(), "counting")
+    set_constants(monkeypatch, closer_look_s=closer_look_s)
+    look = KeyframeLook(CountingDetector(), "counting", detector_hz=10.0)
     frames = [make_frame(room(), pose_looking_x(), k / rate_hz, k) for k in range(n)]
     return [f.pose_id for f in frames if look.schedule(f)[0]]
 
@@ -43,9 +44,9 @@ def test_the_quick_look_runs_ten_times_a_second(monkeypatch):
     assert _schedule(60.0, 14, monkeypatch=monkeypatch) == [0, 6, 12]
 
 
-def test_quick_look_hz_0_looks_at_every_frame(monkeypatch):
-    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=0.0)
-    look = KeyframeLook(CountingDetector(), "counting")
+def test_detector_hz_0_looks_at_every_frame(monkeypatch):
+    set_constants(monkeypatch, closer_look_s=0.0)
+    look = KeyframeLook(CountingDetector(), "counting", detector_hz=0.0)
     assert all(look.schedule(make_frame(room(), pose_looking_x(), k / 30.0, k))[0] for k in range(6))
 
 
@@ -56,8 +57,8 @@ def test_every_keyframe_gets_the_quick_look(monkeypatch):
 
 
 def test_a_replayed_detector_is_read_on_every_frame(monkeypatch):
-    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
-    look = KeyframeLook(LogDetector(), "log")
+    set_constants(monkeypatch, closer_look_s=0.0)
+    look = KeyframeLook(LogDetector(), "log", detector_hz=10.0)
     assert all(look.schedule(make_frame(room(), pose_looking_x(), k / 30.0, k))[0] for k in range(6))
 
 
@@ -97,9 +98,9 @@ def _passing_chair():
 def test_a_track_keeps_its_class_between_looks(monkeypatch):
     """The frames the detector does not look at name the chair by the last look's box, moved
     with the camera: the track's tallies are those of a detector that looked at every frame."""
-    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
+    set_constants(monkeypatch, closer_look_s=0.0)
     detector = CountingDetector()
-    stage = ForegroundStage(detector_instance=detector, pixel_step=2)
+    stage = ForegroundStage(detector_instance=detector, pixel_step=2, detector_hz=10.0)
     observations = _run_by_hand(_passing_chair(), stage)
     assert detector.looked == list(range(0, 30, 3))
     (track,) = stage.tracker.tracks
@@ -107,8 +108,7 @@ def test_a_track_keeps_its_class_between_looks(monkeypatch):
     assert [o.class_name for o in observations] == ["chair"] * 30
     held = [o.pose_id for o in observations if o.data["detection"].get("held")]
     assert held == [k for k in range(30) if k % 3]
-    set_constants(monkeypatch, quick_look_hz=0.0)  # the detector on every frame
-    every = CountingDetector()
+    every = CountingDetector()  # the detector on every frame (detector_hz 0, the default)
     looked_all = ForegroundStage(detector_instance=every, pixel_step=2)
     _run_by_hand(_passing_chair(), looked_all)
     assert every.looked == list(range(30))
@@ -122,8 +122,25 @@ def test_without_moving_them_the_held_boxes_would_miss_the_chair(monkeypatch):
     chair's blob no longer overlaps its box by the IoU the match asks (the move is what holds)."""
     import hiper_cli.perceive.foreground.held as held
 
-    set_constants(monkeypatch, closer_look_s=0.0, quick_look_hz=10.0)
+    set_constants(monkeypatch, closer_look_s=0.0)
     monkeypatch.setattr(held, "_moved", lambda box, *_: box)
     observations = _run_by_hand(_passing_chair(), ForegroundStage(detector_instance=CountingDetector(),
-                                                                  pixel_step=2))
+                                                                  pixel_step=2, detector_hz=10.0))
     assert "unknown" in [o.class_name for o in observations]
+
+
+def test_perceive_detector_hz_sets_the_foreground_rate_and_refuses_a_negative_one(tmp_path):
+    from typer.testing import CliRunner
+
+    from hiper_cli.cli import app
+    from hiper_cli.cmdline.perceive import perceive_options
+
+    flags = dict(stages=None, option=None, env=None, resume=False, replace=False, again=False, align="auto",
+                 keep_observations="0", detector=None, no_background_filter=False, classes=None,
+                 exclude_classes=None, mapping_hz=None)
+    assert perceive_options(**flags, detector_hz=10.0).stage_options["foreground"] == {"detector_hz": 10.0}
+    assert "detector_hz" not in perceive_options(**flags).stage_options.get("foreground", {})
+    result = CliRunner().invoke(app, ["perceive", str(REPO_ROOT / "fixtures" / "house_small"),
+                                      "--kb", str(tmp_path / "kb"), "--detector-hz", "-1"])
+    assert result.exit_code != 0 and "--detector-hz -1" in result.output
+    assert not (tmp_path / "kb").exists()
