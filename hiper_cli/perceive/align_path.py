@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiper_cli.errors import LogError
 from hiper_cli.perceive.align import BackgroundCloud
 from hiper_cli.perceive.align_start import MapSurface, refine
 from hiper_cli.perceive.logs.trajectory import rotation_about
@@ -104,13 +105,18 @@ class PathCorrection:
 
 
 def _frame_clouds(reader: Any, s: FloatArray) -> dict[int, FloatArray]:
-    """Background points (log frame, voxel centroids) of one frame per ``STEP_M`` of motion."""
+    """Background points (log frame, voxel centroids) of one frame per ``STEP_M`` of motion; a
+    frame whose images cannot be read is passed over (perception skips it too)."""
     clouds: dict[int, FloatArray] = {}
     last = -np.inf
     for k in range(len(s)):
         if s[k] - last >= STEP_M or k == len(s) - 1:
+            try:
+                frame = reader.read_frame(k)
+            except LogError:
+                continue
             cloud = BackgroundCloud()
-            cloud.add_frame(reader.read_frame(k))
+            cloud.add_frame(frame)
             clouds[k] = cloud.points()
             last = s[k]
     return clouds
@@ -122,7 +128,7 @@ def correct_path(reader: Any, map_points: FloatArray, T_start: FloatArray) -> Pa
     poses = np.asarray(reader.info().T_map_cam, dtype=np.float64)
     s = travelled_m(poses)
     clouds = _frame_clouds(reader, s)
-    picked = np.array(sorted(clouds))
+    picked = np.array(sorted(clouds), dtype=np.int64)
     surface = MapSurface(map_points)
     keys = np.arange(0.0, s[-1] + SEGMENT_M, SEGMENT_M) if len(s) else np.zeros(1)
     T_prev = np.asarray(T_start, dtype=np.float64)

@@ -141,3 +141,18 @@ def test_a_frame_between_two_keyframes_gets_a_transform_between_theirs():
 def test_motion_counts_metres_and_turns():
     poses = np.stack([_turn(0.0, (0, 0, 0)), _turn(0.0, (1.0, 0, 0)), _turn(90.0, (1.0, 0, 0))])
     assert np.allclose(travelled_m(poses), [0.0, 1.0, 1.0 + 0.5 * np.pi / 2])
+
+
+def test_a_frame_that_cannot_be_read_is_passed_over():
+    from hiper_cli.errors import LogError
+
+    class _Broken(_DriftingLog):
+        def read_frame(self, k: int) -> Frame:
+            if k % 7 == 3:
+                raise LogError(f"frame {k}: depth image truncated")
+            return super().read_frame(k)
+
+    T_map_log = _turn(15.0, (0.5, 0.5, 0.0))
+    log = _Broken(np.linalg.inv(T_map_log))
+    path = correct_path(log, _place(_DriftingLog(np.linalg.inv(T_map_log))), T_map_log)
+    assert _errors(path.T_map_log, log).max() < 0.04
