@@ -34,7 +34,7 @@ from hiper_cli.graph.history import FreeBefore, session_changes, snapshot
 from hiper_cli.perceive.logs import LogOptions, LogReader, open_log
 from hiper_cli.perceive.runner import prefetch, run_stages
 from hiper_cli.perceive.stage import STAGES, FrameResult, Stage, make_stage, stage_names
-from hiper_cli.session_align import MapCloudGrower, aligned, choose_alignment
+from hiper_cli.session_align import MapCloudGrower, aligned, choose_alignment, correct_drift
 from hiper_cli.types import Frame
 
 __all__ = [
@@ -376,6 +376,7 @@ def perceive(
     names = [s.name for s in stage_list]
     _check_log_fits(reader, stage_list, path)
     alignment = choose_alignment(reader, kb, env, options.align, log_name)
+    alignment, drift = correct_drift(reader, kb, env, alignment)
     session = _session_for(kb, env, log_name, names,
                            on_existing="resume" if resume else options.on_existing)
     kb.record_alignment(session, alignment)
@@ -396,7 +397,7 @@ def perceive(
     current = session
 
     def frames() -> Iterator[Frame]:
-        yield from aligned(iter(reader), alignment)
+        yield from aligned(iter(reader), alignment, drift)
 
     hook = on_frame
 

@@ -5,7 +5,10 @@ every later one is registered to the place's background cloud (``perceive.align`
 spread over its log, and refused when it does not fit; that transform is then refined on the
 log's first metres, where its odometry has not drifted yet (``perceive.align_start``), in the
 directions the start constrains, and kept as it was when the refinement finds too little or
-moves it too far. ``--align none`` takes the log's poses
+moves it too far. Along its path the log then drifts away from the map (and the map's own
+session drifted too): ``correct_drift`` re-localises it on the map every metre of motion
+(``perceive.align_path``), so each frame gets its own, smoothly varying transform and what the
+session sees is compared with the map where both agree. ``--align none`` takes the log's poses
 as map-frame poses; ``--align FILE`` reads ``T_map_log`` (a 4×4 matrix, JSON or 16 numbers).
 Frames are then handed to the stages with ``T_map_cam = T_map_log · T_log_cam``, so everything
 stored is in the place's one map frame; and during the run the session's own background adds
@@ -27,11 +30,12 @@ from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.sessions import Alignment
 from hiper_cli.model import Environment
 from hiper_cli.perceive.align import BackgroundCloud, register
+from hiper_cli.perceive.align_path import PathCorrection, correct_path
 from hiper_cli.perceive.align_start import refine_at_start
 from hiper_cli.perceive.static_cloud import StaticCloud
 from hiper_cli.types import Frame
 
-__all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment"]
+__all__ = ["ALIGN_FRAMES", "MIN_FITNESS", "MapCloudGrower", "aligned", "choose_alignment", "correct_drift"]
 
 ALIGN_FRAMES = 40  # frames spread over the log make its cloud
 MIN_FITNESS = 0.4  # below this share of the log's background on the map, the log is refused
@@ -133,14 +137,33 @@ def choose_alignment(reader: Any, kb: KnowledgeBase, env: Environment, align: st
     return Alignment(T_map_log, "registration", found.fitness, found.rmse_m, how)
 
 
-def aligned(frames: Iterator[Frame], alignment: Alignment) -> Iterator[Frame]:
-    """The frames with their poses carried into the map frame."""
+def correct_drift(reader: Any, kb: KnowledgeBase, env: Environment,
+                  alignment: Alignment) -> tuple[Alignment, PathCorrection | None]:
+    """A registered session's drift corrected along its path against the place's map
+    (``perceive.align_path``), and the alignment with a note saying how; a first session, a
+    given transform or a log without its frames to read is left as it is."""
+    if alignment.method != "registration" or not hasattr(reader, "read_frame"):
+        return alignment, None
+    place = kb.map_cloud(env)
+    if place is None or len(place) < 100 or len(reader) < 2:
+        return alignment, None
+    path = correct_path(reader, place, alignment.T_map_log)
+    note = "; ".join(n for n in (alignment.note, path.note()) if n)
+    return replace(alignment, note=note), path
+
+
+def aligned(frames: Iterator[Frame], alignment: Alignment,
+            path: PathCorrection | None = None) -> Iterator[Frame]:
+    """The frames with their poses carried into the map frame (per frame along ``path``)."""
     T = np.asarray(alignment.T_map_log, dtype=np.float64)
-    if np.allclose(T, np.eye(4)):
+    if path is None and np.allclose(T, np.eye(4)):
         yield from frames
         return
     for frame in frames:
-        yield replace(frame, T_map_cam=T @ frame.T_map_cam)
+        if path is not None and 0 <= frame.pose_id < len(path.travelled_m):
+            yield replace(frame, T_map_cam=path.T_map_log(frame.pose_id) @ frame.T_map_cam)
+        else:
+            yield replace(frame, T_map_cam=T @ frame.T_map_cam)
 
 
 class MapCloudGrower:

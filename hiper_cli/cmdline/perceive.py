@@ -46,8 +46,9 @@ Env = Annotated[Text, typer.Option("--env", help=(
     "Place (environment) name; default: the one place the knowledge base holds, or the log folder's "
     "name in a new one. A new name starts another place."))]
 Align = Annotated[str, typer.Option("--align", help=(
-    "How the log's poses join the place's map frame: auto (register its background to the map; the "
-    "first session defines the frame), none (its poses are map poses) or FILE (a 4x4 T_map_log)."))]
+    "How the log's poses join the place's map frame: auto (register its background to the map and "
+    "correct its drift along its path; the first session defines the frame), none (its poses are map "
+    "poses) or FILE (a 4x4 T_map_log)."))]
 Keep = Annotated[str, typer.Option("--keep-observations", help=(
     "Keep raw observations this long before the newest stamp ('10 minutes', '2 h'); older ones that add "
     "nothing are summarised at the end of the session. 0 (default) summarises all (what hiper reanchor "

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from hiper_cli.perceive.logs.trajectory import rotation_about
 
-__all__ = ["MIN_CONSTRAINT", "StartFit", "refine_at_start"]
+__all__ = ["MIN_CONSTRAINT", "MapSurface", "StartFit", "refine", "refine_at_start"]
 
 FloatArray = NDArray[np.float64]
 
@@ -78,26 +78,40 @@ def _step(p: FloatArray, q: FloatArray, n: FloatArray) -> tuple[FloatArray, int,
     return D, int(keep.sum()), float(np.sqrt((w * r * r).sum() / w.sum()))
 
 
-def refine_at_start(start_points: FloatArray, map_points: FloatArray, T0: FloatArray) -> StartFit:
-    """``T0`` (the whole log's registration) refined on the start's cloud (log frame) against
-    the map (see the module docstring)."""
-    from scipy.spatial import cKDTree
+class MapSurface:
+    """The map's points with their normals, planarity and a search tree: built once, for the
+    start's fit and for every segment of a path (``perceive.align_path``)."""
 
-    normals, curvature = _normals(map_points)
-    tree = cKDTree(map_points)
+    def __init__(self, map_points: FloatArray) -> None:
+        from scipy.spatial import cKDTree
+
+        self.points = np.asarray(map_points, dtype=np.float64)
+        self.normals, self.curvature = _normals(self.points)
+        self.tree = cKDTree(self.points)
+
+
+def refine(points: FloatArray, surface: MapSurface, T0: FloatArray) -> StartFit:
+    """``T0`` refined on ``points`` (log frame) against the map's surface, in the directions
+    they constrain (see the module docstring)."""
     T = np.asarray(T0, dtype=np.float64).copy()
     constrained, inliers, rmse = 0, 0.0, float("inf")
     for gate in DISTANCES_M:
         for _ in range(ITERATIONS):
-            p = start_points @ T[:3, :3].T + T[:3, 3]
-            d, j = tree.query(p, distance_upper_bound=gate)
+            p = points @ T[:3, :3].T + T[:3, 3]
+            d, j = surface.tree.query(p, distance_upper_bound=gate)
             ok = np.isfinite(d)
-            ok[ok] = curvature[j[ok]] < MAX_CURVATURE
+            ok[ok] = surface.curvature[j[ok]] < MAX_CURVATURE
             inliers = float(ok.mean()) if len(ok) else 0.0
             if ok.sum() < 20:
                 return StartFit(np.asarray(T0, dtype=np.float64), 0, inliers, rmse)
-            D, constrained, rmse = _step(p[ok], map_points[j[ok]], normals[j[ok]])
+            D, constrained, rmse = _step(p[ok], surface.points[j[ok]], surface.normals[j[ok]])
             T = D @ T
             if np.abs(D - np.eye(4)).max() < 1e-5:
                 break
     return StartFit(T, constrained, inliers, rmse)
+
+
+def refine_at_start(start_points: FloatArray, map_points: FloatArray, T0: FloatArray) -> StartFit:
+    """``T0`` (the whole log's registration) refined on the start's cloud (log frame) against
+    the map (see the module docstring)."""
+    return refine(start_points, MapSurface(map_points), T0)

@@ -17,7 +17,11 @@ the range): a flying pixel in mid-air is seen through from the next view, a pers
 robot looks there again after they left. Each view's depth is kept as the nearest return of
 each ``PIXEL_STRIDE`` block, so a voxel is seen through only when the whole block lies beyond
 it: an edge, where a block mixes a near surface and the wall behind it, does not carve the
-near surface away. Voxels the earlier sessions stored are kept as they are, where they are.
+near surface away. Voxels the earlier sessions stored keep their centroid (the map frame is
+the first session's); one goes only when this session saw through it in at least
+``EARLIER_THROUGH`` views and more often than it saw it: a chair moved or taken away leaves
+the place's cloud, so the next session finds its space free as it was last seen
+(``FreeBefore``), not as the first session saw it.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from numpy.typing import NDArray
 from hiper_cli.perceive.align import MAX_DEPTH_M, PIXEL_STRIDE, VOXEL_M, _unique_rows
 from hiper_cli.types import CameraIntrinsics, Frame
 
-__all__ = ["NOISE_PER_M2", "THROUGH_M", "StaticCloud"]
+__all__ = ["EARLIER_THROUGH", "NOISE_PER_M2", "THROUGH_M", "StaticCloud"]
 
 FloatArray = NDArray[np.float64]
 
@@ -36,6 +40,7 @@ THROUGH_M = 0.15  # a block's nearest return this far beyond a voxel (plus the n
 NOISE_PER_M2 = 0.0017  # depth noise (1 sigma) per squared metre of range
 MIN_DEPTH_M = 0.2
 MAX_VIEWS = 1200  # views kept for the carving; beyond, every other one is let go
+EARLIER_THROUGH = 2  # an earlier session's voxel goes when seen through in this many views or more
 
 
 class _View:
@@ -97,15 +102,15 @@ class StaticCloud:
         out = set()
         for key, s, n in zip(map(tuple, uniq.tolist()), sums.tolist(), counts.tolist(), strict=True):
             out.add(key)
-            if count_view and key in self._earlier:
-                # the map frame is the first session's: a later session, aligned with its own
-                # error and drifting its own way, adds new space but does not pull the map
-                continue
+            if count_view:
+                self._views_hit[key] = self._views_hit.get(key, 0) + 1
+                if key in self._earlier:
+                    # the map frame is the first session's: a later session, aligned with its
+                    # own error and drifting its own way, adds new space but does not pull the map
+                    continue
             old = self._sum.get(key)
             self._sum[key] = s if old is None else [old[0] + s[0], old[1] + s[1], old[2] + s[2]]
             self._n[key] = self._n.get(key, 0) + n
-            if count_view:
-                self._views_hit[key] = self._views_hit.get(key, 0) + 1
         return out
 
     def add_frame(self, frame: Frame) -> None:
@@ -129,22 +134,22 @@ class StaticCloud:
         return len(self._sum)
 
     def points(self) -> FloatArray:
-        """The earlier sessions' voxels, and this session's that stand still (centroids)."""
+        """The earlier sessions' voxels this session did not see gone, and this session's that
+        stand still (centroids)."""
         if not self._sum:
             return np.zeros((0, 3))
         keys = list(self._sum)
         centroids = np.array([self._sum[k] for k in keys]) / np.array([self._n[k] for k in keys])[:, None]
         new = np.array([k not in self._earlier for k in keys])
         hits = np.array([self._views_hit.get(k, 0) for k in keys])
-        judged = np.flatnonzero(new)
-        through = np.zeros(len(judged), dtype=np.int64)
-        seen = np.zeros(len(judged), dtype=np.int64)
+        through = np.zeros(len(keys), dtype=np.int64)
+        seen = np.zeros(len(keys), dtype=np.int64)
         for view in self._views:
-            ok, z, measured = view.measure(centroids[judged])
+            ok, z, measured = view.measure(centroids)
             margin = THROUGH_M + 3.0 * NOISE_PER_M2 * z * z
             through += ok & (measured > z + margin)
             seen += ok & (np.abs(measured - z) <= margin)
-        keep = ~new
-        keep[judged] = through < np.maximum(seen, hits[judged])
+        saw = np.maximum(seen, hits)
+        keep = np.where(new, through < saw, (through < EARLIER_THROUGH) | (through <= saw))
         kept: FloatArray = centroids[keep]
         return kept

@@ -81,12 +81,27 @@ def test_an_edge_seen_beside_the_wall_behind_it_stays():
     assert front[:, 0].min() < 0.05  # the voxels at the edge (x = 0) stay
 
 
-def test_the_earlier_sessions_points_stay_whatever_this_session_sees():
+def test_the_earlier_sessions_points_stay_unless_this_session_saw_through_them_twice():
+    """A chair an earlier session stored 1.5 m in front of the wall: seen through from one
+    view (a stray ray, noise), it stays; from two, it was moved or taken away and leaves the
+    cloud, so the next session finds its space free; seen there again, it stays."""
     earlier = np.array([[0.0, 0.0, 1.5], [0.1, 0.0, 1.5]])
-    cloud = StaticCloud(earlier)
-    cloud.add_frame(_frame(_wall(), 0.0))
-    cloud.add_frame(_frame(_wall(), 1.0))
-    assert _inside(cloud.points(), PERSON_LO, PERSON_HI) == 2
+    once = StaticCloud(earlier)
+    once.add_frame(_frame(_wall(), 0.0))
+    assert _inside(once.points(), PERSON_LO, PERSON_HI) == 2
+    twice = StaticCloud(earlier)
+    twice.add_frame(_frame(_wall(), 0.0))
+    twice.add_frame(_frame(_wall(), 1.0))
+    assert _inside(twice.points(), PERSON_LO, PERSON_HI) == 0
+    assert len(twice.points()) > 100  # the wall this session saw is added
+    chair = _wall()
+    chair[40:50, 55:70] = 1.5  # the chair still there, seen from both views
+    there = StaticCloud(earlier)
+    there.add_frame(_frame(chair, 0.0))
+    there.add_frame(_frame(chair, 1.0))
+    kept = there.points()
+    assert _inside(kept, PERSON_LO, PERSON_HI) >= 2
+    assert all(np.isclose(kept, p).all(axis=1).any() for p in earlier)  # where they were
 
 
 class _Place:

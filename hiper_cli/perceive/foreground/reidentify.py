@@ -22,7 +22,11 @@ An earlier instance seen empty and left unpaired is marked vacated by the stage,
 session saw an object of its class at its place all the same (``still_seen``): a small object
 (a cup) a few centimetres off where it was, through pose drift, or a second instance an
 earlier session made of one object, is seen empty by rays aimed at its old points, yet the
-object is there.
+object is there. An instance this session found again as another earlier object is that
+object: it stands for the gone one only where their footprints meet with no slack (two
+instances of one object), not within the pose slack beside it, where a neighbouring object
+of the class stands (a chair beside the one taken away, both boxes grown by what their blobs
+caught).
 
 A walker is not where it was, so it is never joined by place; but one seen at the same times
 at the same place is the same walker (``cosighted_pairs``): the same log perceived again
@@ -101,21 +105,25 @@ def move_cost(earlier: Instance, new: Instance, *, max_m: float) -> float | None
 
 
 def still_seen(
-    gone: Iterable[Instance], seen: Iterable[Instance], *, slack_m: float = POSE_SLACK_M
+    gone: Iterable[Instance], seen: Iterable[Instance], *, slack_m: float = POSE_SLACK_M,
+    found_again: Iterable[Instance] = (),
 ) -> set[str]:
     """The uuids of the ``gone`` instances (their place seen empty) that an instance of their
     class this session ``seen`` stands at all the same: their footprints, each grown by
-    ``slack_m``, meet (and they are less than ``slack_m`` apart vertically, per box gap)."""
-    seen = list(seen)
+    ``slack_m``, meet (and they are less than ``slack_m`` apart vertically, per box gap). Those
+    of ``seen`` in ``found_again`` (found again as another earlier object) stand at it only
+    where the boxes themselves meet."""
+    again = {n.uuid for n in found_again}
     out = set()
     for g in gone:
         lo_g, hi_g = g.box.aabb()
         for n in seen:
             if n.class_name != g.class_name or n.uuid == g.uuid:
                 continue
+            slack = 0.0 if n.uuid in again else slack_m
             lo_n, hi_n = n.box.aabb()
             gap = np.maximum(lo_g - hi_n, lo_n - hi_g)  # per axis, > 0 where the boxes lie apart
-            if gap[0] <= 2 * slack_m and gap[1] <= 2 * slack_m and gap[2] <= slack_m:
+            if gap[0] <= 2 * slack and gap[1] <= 2 * slack and gap[2] <= slack:
                 out.add(g.uuid)
                 break
     return out

@@ -599,7 +599,8 @@ class ForegroundStage:
         found += cosighted
         joined = {old.uuid for old, _ in found}
         left = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
-        there = still_seen(left, new)  # seen empty by its old points, yet seen at its place
+        # seen empty by its old points, yet seen at its place (not by another object found again)
+        there = still_seen(left, new, found_again=[n for _, n in found])
         marked = [i for i in left if i.uuid not in there]
         for inst in marked:
             # never before it was last seen (logs whose stamps all start at 0 overlap in time)
