@@ -56,7 +56,9 @@ def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.flo
         z_plane = np.where(facing < -1e-6, -plane_cam[3] / facing, np.inf)
     z = grid.points_cam[rows, cols, 2]
     valid = grid.valid[rows, cols]
-    tol = cfg.wall_probe_tolerance_m + cfg.wall_probe_tolerance_frac * z_plane
+    # a few sigmas of the depth noise at the plane's range (``planes.py``'s model: z squared)
+    sigma_m = cfg.cell_noise_m * np.maximum(z_plane, 1.0) ** 2
+    tol = cfg.wall_probe_tolerance_m + cfg.wall_probe_sigmas * sigma_m
     out = np.full(len(rows), _UNKNOWN, dtype=np.int64)
     seen = valid & np.isfinite(z_plane)
     out[seen & (z > z_plane + tol)] = _OPEN

@@ -90,13 +90,22 @@ class BackgroundConfig:
     wall_probe_gap_px: float = 8.0
     wall_probe_reach_px: float = 48.0  # probes walk out to this, over occluders in front
     wall_probe_tolerance_m: float = 0.05
-    wall_probe_tolerance_frac: float = 0.05
+    # a probe lies on the plane within wall_probe_tolerance_m + wall_probe_sigmas depth noise
+    # sigmas at its range (cell_noise_m times depth squared, the segmenter's model: 0.15 m at
+    # 4 m); a tolerance growing as 5 % of the depth was as deep as a shelf (0.25 m) at 4 m, so a
+    # free-standing shelf a 4 m view saw read as a wall going on
+    wall_probe_sigmas: float = 3.0
+    wall_probe_tolerance_frac: float = 0.05  # under a table top's edge (``under.py``)
     wall_probe_max_depth_m: float = 4.5  # no return where the plane would be nearer: nothing there
     wall_probe_min_columns: int = 3
     wall_open_share: float = 0.5  # of the columns with evidence, this share open: not a wall
     # a vertical plane seen up to the image's top and down to an occluder in front is as tall
     # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
     wall_view_bounded: bool = True
+    # a view whose depth noise (cell_noise_m times its range squared) exceeds this starts no
+    # wall, it only extends one a nearer view mapped (``wall_range.py``; 4.2 m with the
+    # default noise model; 0: off)
+    wall_view_max_noise_m: float = 0.045
     # a furniture front stands before a wall (``fronts.py``): past a side edge the camera sees a
     # plane parallel to it this far behind; deeper than a door's recess in its wall (a wall's
     # thickness), no deeper than furniture (wardrobes, fridges, shelves: 0.3-0.8 m)
