@@ -7,7 +7,8 @@ is 0.1-0.5 m off each chair's. ``drop_unseen_tables`` finds such a table in a bl
 detection names (not furniture with tops of its own: ``unseen_table_skip_classes``): a
 horizontal slab at table height, of columns that end there (a person or a chair's back beside
 the table rises above it), whose footprint spans ``unseen_table_min_side_m`` along its minor
-axis (a chair's back or a shelf board is narrow). The slab and the legs under it
+axis (a chair's back or a shelf board is narrow), on legs (``on_legs``: the top of a cabinet,
+a counter or a book cube stands on a solid front and is no table). The slab and the legs under it
 (``legs.leg_points``) leave the blob, and what remains is clustered again as the segmentation
 does; parts smaller than ``min_cluster_points`` are dropped. A detection of a class with no top
 at table height (``unseen_table_lookalikes``: a bench's seat is lower) whose blob holds a table
@@ -39,7 +40,9 @@ from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.refine import TRIM_IOU
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
-__all__ = ["drop_unseen_tables", "one_board", "split_unseen_tables", "table_points", "unseen_table_top"]
+__all__ = [
+    "drop_unseen_tables", "on_legs", "one_board", "split_unseen_tables", "table_points", "unseen_table_top",
+]
 
 # Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
 UNSEEN_TABLE_MIN_SIDE_M: float = 0.3
@@ -154,6 +157,26 @@ def one_board(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
     return _minor_extent_m(blob.points_map[largest, :2]) >= UNSEEN_TABLE_MIN_SIDE_M
 
 
+def on_legs(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
+    """Whether what holds the top found in ``blob`` up is legs, not a solid front: the points
+    of the blob's columns that rise from low down to the top (``legs.leg_points``) stand, seen
+    from the camera, in narrow runs across the view, none ``unseen_table_min_side_m`` wide.
+    A table's legs are a few centimetres thick each, with free space between them; the front
+    of a cabinet, a counter or a shelf with things on its top is such a column in every cell
+    along its edge (a run 0.6-2 m wide on the degraded bookstore's counters and book cube).
+    Across the view (the camera's x), not in the map: depth noise spreads a leg at 4 m some
+    0.2 m along the ray, but moves its side little. No leg seen (chairs before it, its top
+    seen from below) is no evidence against a table."""
+    legs = leg_points(blob.points_map, [top], config)
+    if not legs.any():
+        return True
+    cells = np.unique(np.floor(blob.points_cam[legs, 0] / TABLE_LEG_CELL_M).astype(np.int64))
+    breaks = np.flatnonzero(np.diff(cells) != 1)
+    starts, ends = np.r_[0, breaks + 1], np.r_[breaks, len(cells) - 1]
+    widest_m = float(np.max(cells[ends] - cells[starts] + 1)) * TABLE_LEG_CELL_M
+    return widest_m < UNSEEN_TABLE_MIN_SIDE_M
+
+
 def drop_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
     width: int, height: int,
@@ -189,7 +212,7 @@ def split_unseen_tables(
             named = iou[k] >= TRIM_IOU
             if (named and classes[k] not in UNSEEN_TABLE_SKIP_CLASSES) or (not named and holds):
                 top = unseen_table_top(blob.points_map, config)
-                if top is not None and not one_board(blob, top, config):
+                if top is not None and not (one_board(blob, top, config) and on_legs(blob, top, config)):
                     top = None
         if top is None:
             out.append(blob)
