@@ -160,13 +160,14 @@ def one_board(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
 def on_legs(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
     """Whether what holds the top found in ``blob`` up is legs, not a solid front: the points
     of the blob's columns that rise from low down to the top (``legs.leg_points``) stand, seen
-    from the camera, in narrow runs across the view, none ``unseen_table_min_side_m`` wide.
-    A table's legs are a few centimetres thick each, with free space between them; the front
-    of a cabinet, a counter or a shelf with things on its top is such a column in every cell
-    along its edge (a run 0.6-2 m wide on the degraded bookstore's counters and book cube).
-    Across the view (the camera's x), not in the map: depth noise spreads a leg at 4 m some
-    0.2 m along the ray, but moves its side little. No leg seen (chairs before it, its top
-    seen from below) is no evidence against a table."""
+    from the camera, in runs across the view narrower than ``unseen_table_min_side_m`` or than
+    half the top's width across the view. A table's legs are a few centimetres thick each,
+    with free space between them; the front of a cabinet, a counter or a shelf with things on
+    its top is such a column in every cell along its edge (runs of 0.54-1.5 times the top's
+    width on the degraded bookstore's counters and book cube; 0.26-0.33, at most 0.3 m, under
+    office 62's tables seen from 4 m). Across the view (the camera's x), not in the map: depth
+    noise spreads a leg at 4 m some 0.2 m along the ray, but moves its side little. No leg
+    seen (chairs before it, its top seen from below) is no evidence against a table."""
     legs = leg_points(blob.points_map, [top], config)
     if not legs.any():
         return True
@@ -174,7 +175,9 @@ def on_legs(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
     breaks = np.flatnonzero(np.diff(cells) != 1)
     starts, ends = np.r_[0, breaks + 1], np.r_[breaks, len(cells) - 1]
     widest_m = float(np.max(cells[ends] - cells[starts] + 1)) * TABLE_LEG_CELL_M
-    return widest_m < UNSEEN_TABLE_MIN_SIDE_M
+    across = blob.points_cam[_top_points(blob.points_map, top, config), 0]
+    top_m = float(np.ptp(np.percentile(across, [3, 97]))) if len(across) else 0.0
+    return widest_m < max(UNSEEN_TABLE_MIN_SIDE_M, top_m / 2.0)
 
 
 def drop_unseen_tables(
