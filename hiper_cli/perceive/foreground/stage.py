@@ -224,9 +224,9 @@ class ForegroundStage:
         clock.append(time.perf_counter())
         dets, detect_s = self._detections(frame, future)
         clock.append(time.perf_counter())
-        blobs, found, dets = self._split_and_refine(frame, scene, blobs, dets)
+        blobs, found_tables, dets = self._split_and_refine(frame, scene, blobs, dets)
         clock.append(time.perf_counter())
-        observations, measurements, surfaces = self._measure(frame, scene, blobs, dets, found)
+        observations, measurements, surfaces = self._measure(frame, scene, blobs, dets, found_tables)
         clock.append(time.perf_counter())
         instances, merged = self._track(frame, scene, (observations, measurements, surfaces))
         clock.append(time.perf_counter())
@@ -293,21 +293,18 @@ class ForegroundStage:
 
     def _split_and_refine(
         self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections
-    ) -> tuple[list[Blob], tuple[list[Blob], list[Blob]], Detections]:
+    ) -> tuple[list[Blob], list[Blob], Detections]:
         """The blobs split from the tables the background has not mapped (``tables.py``), and
-        trimmed and joined with the detections (``refine.py``); those tables' blobs and those of
-        the tops found on solid fronts; the detections without those that named a table (none
-        names what remains of its blob)."""
+        trimmed and joined with the detections (``refine.py``); those tables' blobs; the
+        detections without those that named a table (none names what remains of its blob)."""
         cfg = self.config
         width, height = frame.camera.width, frame.camera.height
         ok = dets.scores >= cfg.min_detection_score if len(dets) else np.zeros(0, dtype=bool)
         usable = dets.xyxy[ok] if len(dets) else np.zeros((0, 4))
         names = [n for n, keep in zip(dets.class_names, ok, strict=True) if keep]
         found_tables: list[Blob] = []
-        solid: list[Blob] = []
         if cfg.background_filter:
-            blobs, found_tables, lookalikes, solid = split_unseen_tables(
-                blobs, usable, names, cfg, width, height)
+            blobs, found_tables, lookalikes = split_unseen_tables(blobs, usable, names, cfg, width, height)
             if lookalikes:
                 dets, ok, usable, names = _without(dets, ok, np.flatnonzero(ok)[lookalikes])
             if TABLE_RIM_DEPTH_M > 0:
@@ -315,17 +312,14 @@ class ForegroundStage:
         if cfg.detection_split or cfg.detection_join:
             blobs = refine_blobs(blobs, usable, cfg, width, height, scene.supports, classes=names,
                                  size_tolerance=CLASS_SIZE_TOLERANCE if cfg.class_sizes else None)
-        return blobs, (found_tables, solid), dets
+        return blobs, found_tables, dets
 
     def _measure(
-        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections,
-        found: tuple[list[Blob], list[Blob]],
+        self, frame: Frame, scene: _Background, blobs: list[Blob], dets: Detections, found_tables: list[Blob]
     ) -> tuple[list[Observation], list[Measurement], list[FloatArray | None]]:
         """Per blob kept: its observation, its measurement for the tracker and its map points
-        (None for a walker's: no surface is kept of what moves). ``found``: the tables found
-        by shape, and the tops on solid fronts (``tables.py``: unknown, a solid thing)."""
+        (None for a walker's: no surface is kept of what moves)."""
         cfg = self.config
-        found_tables, solid = found
         matches = assign_classes(
             np.array([b.image_box_xyxy for b in blobs]).reshape(-1, 4),
             dets,
@@ -333,8 +327,6 @@ class ForegroundStage:
             min_score=cfg.min_detection_score,
             unknown=UNKNOWN,
         )
-        blobs = [*blobs, *solid]
-        matches = [*matches, *(Match(UNKNOWN, 0.0, None, 0.0) for _ in solid)]
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []

@@ -192,20 +192,20 @@ def drop_unseen_tables(
 def split_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
     width: int, height: int,
-) -> tuple[list[Blob], list[Blob], list[int], list[Blob]]:
+) -> tuple[list[Blob], list[Blob], list[int]]:
     """(``blobs`` without the tops and legs of tables found in them, one blob per table found:
     its top and legs, the indices of the detections of an ``unseen_table_lookalikes`` class that
-    name a blob holding a table: they named the table, one blob per top found on a solid front
-    (not ``on_legs``: a cabinet, a counter), its top and front, what stands on it apart as on a
-    table); ``boxes_xyxy`` (K, 4) and ``classes`` are this frame's detections."""
+    name a blob holding a table: they named the table); ``boxes_xyxy`` (K, 4) and ``classes``
+    are this frame's detections. A top found on a solid front (not ``on_legs``: a cabinet, a
+    counter) leaves its blob with its front as a table's does, so what stands on it is apart,
+    but is no table: it is dropped, as the background filter drops a mapped top."""
     tables: list[Blob] = []
     lookalikes: list[int] = []
-    solid: list[Blob] = []
     if UNSEEN_TABLE_MIN_SIDE_M <= 0 or not blobs:
-        return blobs, tables, lookalikes, solid
+        return blobs, tables, lookalikes
     boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     if len(boxes) == 0:
-        return blobs, tables, lookalikes, solid
+        return blobs, tables, lookalikes
     out: list[Blob] = []
     blob_boxes = np.array([blob.image_box_xyxy for blob in blobs])
     ious = iou_matrix(blob_boxes, boxes)
@@ -227,14 +227,13 @@ def split_unseen_tables(
             lookalikes.extend(j for j in np.flatnonzero(iou >= TRIM_IOU).tolist()
                               if classes[j] in UNSEEN_TABLE_LOOKALIKES)
         on_table = table_points(blob.points_map, top, config)
-        if np.count_nonzero(on_table) >= config.min_cluster_points:
-            (tables if legs else solid).append(
-                sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
+        if legs and np.count_nonzero(on_table) >= config.min_cluster_points:
+            tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):
             if len(part) >= config.min_cluster_points:
                 out.append(_part(blob, rest[part], top, config, width, height))
-    return out, tables, lookalikes, solid
+    return out, tables, lookalikes
 
 
 def _held(
