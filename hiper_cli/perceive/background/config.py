@@ -90,12 +90,11 @@ class BackgroundConfig:
     wall_probe_gap_px: float = 8.0
     wall_probe_reach_px: float = 48.0  # probes walk out to this, over occluders in front
     wall_probe_tolerance_m: float = 0.05
-    # a probe lies on the plane within wall_probe_tolerance_m + wall_probe_sigmas depth noise
-    # sigmas at its range (cell_noise_m times depth squared, the segmenter's model: 0.15 m at
-    # 4 m); a tolerance growing as 5 % of the depth was as deep as a shelf (0.25 m) at 4 m, so a
-    # free-standing shelf a 4 m view saw read as a wall going on
-    wall_probe_sigmas: float = 3.0
-    wall_probe_tolerance_frac: float = 0.05  # under a table top's edge (``under.py``)
+    # a probe lies on the plane within wall_probe_tolerance_m + wall_probe_tolerance_frac times
+    # its depth, but no deeper than wall_front_min_m less the depth noise there (cell_noise_m
+    # times depth squared): 5 % of 4.1-4.6 m (0.25-0.28 m) took a free-standing shelf's book
+    # rows, 0.2-0.25 m behind its frame, for the plane going on (``bounds._probe``)
+    wall_probe_tolerance_frac: float = 0.05
     wall_probe_max_depth_m: float = 4.5  # no return where the plane would be nearer: nothing there
     wall_probe_min_columns: int = 3
     wall_open_share: float = 0.5  # of the columns with evidence, this share open: not a wall
