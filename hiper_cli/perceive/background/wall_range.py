@@ -7,12 +7,16 @@ and the tests that tell a furniture front from a wall (``bounds.py``, ``fronts.p
 step. On the degraded bookstore the planes seen as walls only from 4.5-4.7 m were a shelf
 front and the storefront door (and one real wall); every wall of the other logs has a view
 within 4 m. So a view whose noise exceeds ``wall_view_max_noise_m`` starts no wall: it only
-extends a wall that a nearer view mapped (it matches one, Algorithm 2's criteria).
+extends a wall that a nearer view mapped (it matches one, Algorithm 2's criteria, or lies on
+its plane further along: the degraded house 61's wall seen near at one end and from 4.45 m
+at the other; dropped, its far end became foreground clutter).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+
+import numpy as np
 
 from hiper_cli.model import Instance, Observation
 from hiper_cli.perceive.background.config import BackgroundConfig
@@ -34,10 +38,22 @@ def _depth_m(obs: Observation) -> float:
     return float(obs.data.get("centroid_cam", obs.box.center_m)[2])
 
 
+def _on_plane(mo: MapObservation, inst: Instance, cfg: BackgroundConfig) -> bool:
+    """Whether ``mo`` lies on the plane of ``inst`` (Algorithm 2's alignment: normals within
+    ``merge_angle_deg``, its centroid within ``merge_offset_m`` of the plane), anywhere along it."""
+    plane = np.asarray(inst.data.get("plane_map", ()), dtype=np.float64)
+    if plane.shape != (4,):
+        return False
+    cos = abs(float(plane[:3] @ mo.plane_map[:3]))
+    offset = abs(float(plane[:3] @ mo.centroid_map + plane[3]))
+    return cos >= np.cos(np.radians(cfg.merge_angle_deg)) and offset <= cfg.merge_offset_m
+
+
 def unconfirmed_far_wall(mo: MapObservation, live: Iterable[Instance], cfg: BackgroundConfig) -> bool:
     """Whether ``mo`` is a wall seen only from too far (``beyond_wall_range``) that no mapped
-    wall in ``live`` takes."""
+    wall in ``live`` takes: it matches none, nor lies on one's plane further along it (the far
+    end of a wall whose near end a nearer view mapped)."""
     if mo.obs.class_name != "wall" or not beyond_wall_range(_depth_m(mo.obs), cfg):
         return False
     walls = [inst for inst in live if inst.class_name == "wall"]
-    return not match_instances(mo, walls, cfg)
+    return not (match_instances(mo, walls, cfg) or any(_on_plane(mo, w, cfg) for w in walls))

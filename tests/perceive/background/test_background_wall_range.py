@@ -64,3 +64,18 @@ def test_a_shelf_front_with_its_books_recessed_seen_from_4_1_m_is_no_wall():
     assert _walls_at_y(_run([*room, *shelf], [facing_shelf], noise_m=0.0), 6.0) == []
     facing_wall = look_at((3.0, 5.9, 1.2), (3.0, 10.0, 1.2 - tilt))
     assert len(_walls_at_y(_run(room, [facing_wall], noise_m=0.0), 10.0)) == 1
+
+
+def test_a_far_view_along_a_mapped_wall_plane_continues_the_wall():
+    """The degraded house 61: a wall seen near at one end and only from 4.45 m at the other.
+    The far end lies on the near end's plane: it is that wall going on, not a plane to doubt
+    (dropped, its points became foreground clutter in the object map)."""
+    room = box_room(size=(12.0, 8.0, 3.0))
+    tilt = np.tan(np.radians(15.0))
+    near = look_at((1.5, 6.0, 1.2), (1.5, 8.0, 1.2 - 2.0 * tilt))  # 2 m from its left end
+    far = look_at((10.0, 3.4, 1.2), (10.0, 8.0, 1.2 - 4.6 * tilt))  # 4.6 m from its right end
+    walls = _walls_at_y(_run(room, [near, far]), 8.0)
+    assert len(walls) >= 1
+    x_max = max(float(np.max(np.asarray(w.data["contour_map"])[:, 0])) for w in walls)
+    assert x_max > 9.0  # the far end is mapped too
+    assert _walls_at_y(_run(room, [far]), 8.0) == []  # alone, the far view starts none
