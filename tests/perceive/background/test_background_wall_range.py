@@ -23,9 +23,12 @@ def _walls_at_y(world, y, tol=0.1):
             and i.data["plane_map"][1] < -0.9 and abs(abs(i.data["plane_map"][3]) - y) < tol]
 
 
+FAR_RULE = {"wall_view_max_noise_m": 0.045}  # off by default (``BackgroundConfig``): 4.2 m
+
+
 def _run(boxes, poses, noise_m=0.001, **options):
     frames = [make_frame(boxes, T, pose_id=i, noise_m=noise_m) for i, T in enumerate(poses)]
-    world, _ = run_stages(frames, [BackgroundStage(**options)])
+    world, _ = run_stages(frames, [BackgroundStage(**{**FAR_RULE, **options})])
     return world
 
 
@@ -43,10 +46,11 @@ def test_a_far_view_extends_the_wall_a_near_view_mapped():
 
 
 def test_the_range_follows_the_noise_model():
-    cfg = BackgroundConfig()  # sigma(z) = cell_noise_m z^2, at most wall_view_max_noise_m
+    cfg = BackgroundConfig(**FAR_RULE)  # sigma(z) = cell_noise_m z^2, at most wall_view_max_noise_m
     assert not beyond_wall_range(4.0, cfg)  # 0.040 m
     assert beyond_wall_range(4.5, cfg)  # 0.051 m
-    assert not beyond_wall_range(9.0, BackgroundConfig(cell_noise_m=0.0005))  # a better sensor
+    assert not beyond_wall_range(9.0, BackgroundConfig(cell_noise_m=0.0005, **FAR_RULE))  # a better sensor
+    assert not beyond_wall_range(9.0, BackgroundConfig())  # off by default
 
 
 def test_a_shelf_front_with_its_books_recessed_seen_from_4_1_m_is_no_wall():
