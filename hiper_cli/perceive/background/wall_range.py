@@ -9,7 +9,9 @@ front and the storefront door (and one real wall); every wall of the other logs 
 within 4 m. So a view whose noise exceeds ``wall_view_max_noise_m`` starts no wall: it only
 extends a wall that a nearer view mapped (it matches one, Algorithm 2's criteria, or lies on
 its plane further along: the degraded house 61's wall seen near at one end and from 4.45 m
-at the other; dropped, its far end became foreground clutter).
+at the other; dropped, its far end became foreground clutter). Off by default: a plane it
+keeps out of the walls is foreground to the object map, and on office 62 that clutter
+named a couch a bed (docs/results/2026-12-07-degraded-background.md).
 """
 
 from __future__ import annotations
