@@ -56,7 +56,12 @@ def _probe(grid: SampleGrid, camera: CameraIntrinsics, plane_cam: NDArray[np.flo
         z_plane = np.where(facing < -1e-6, -plane_cam[3] / facing, np.inf)
     z = grid.points_cam[rows, cols, 2]
     valid = grid.valid[rows, cols]
-    tol = cfg.wall_probe_tolerance_m + cfg.wall_probe_tolerance_frac * z_plane
+    # no deeper than a furniture front's least depth less the depth noise there (``planes.py``'s
+    # model, sigma = cell_noise_m z^2): past 3.6 m, 5 % of the depth would take a shelf's book
+    # rows, 0.2-0.25 m behind its frame, for the plane going on
+    sigma_m = cfg.cell_noise_m * np.clip(z_plane, 1.0, cfg.max_depth_m) ** 2
+    tol = np.minimum(cfg.wall_probe_tolerance_m + cfg.wall_probe_tolerance_frac * z_plane,
+                     cfg.wall_front_min_m - sigma_m)
     out = np.full(len(rows), _UNKNOWN, dtype=np.int64)
     seen = valid & np.isfinite(z_plane)
     out[seen & (z > z_plane + tol)] = _OPEN

@@ -90,6 +90,10 @@ class BackgroundConfig:
     wall_probe_gap_px: float = 8.0
     wall_probe_reach_px: float = 48.0  # probes walk out to this, over occluders in front
     wall_probe_tolerance_m: float = 0.05
+    # a probe lies on the plane within wall_probe_tolerance_m + wall_probe_tolerance_frac times
+    # its depth, but no deeper than wall_front_min_m less the depth noise there (cell_noise_m
+    # times depth squared): 5 % of 4.1-4.6 m (0.25-0.28 m) took a free-standing shelf's book
+    # rows, 0.2-0.25 m behind its frame, for the plane going on (``bounds._probe``)
     wall_probe_tolerance_frac: float = 0.05
     wall_probe_max_depth_m: float = 4.5  # no return where the plane would be nearer: nothing there
     wall_probe_min_columns: int = 3
@@ -97,6 +101,12 @@ class BackgroundConfig:
     # a vertical plane seen up to the image's top and down to an occluder in front is as tall
     # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
     wall_view_bounded: bool = True
+    # a view whose depth noise (cell_noise_m times its range squared) exceeds this starts no
+    # wall, it only extends one a nearer view mapped (``wall_range.py``; 0.045: 4.2 m with the
+    # default noise model). Off (0): on the degraded bookstore it takes the background's
+    # semantic precision from 0.78 to 1.00, but the planes it leaves out become foreground
+    # clutter on office 62 and the degraded house 61 (docs/results/2026-12-07-degraded-background.md)
+    wall_view_max_noise_m: float = 0.0
     # a furniture front stands before a wall (``fronts.py``): past a side edge the camera sees a
     # plane parallel to it this far behind; deeper than a door's recess in its wall (a wall's
     # thickness), no deeper than furniture (wardrobes, fridges, shelves: 0.3-0.8 m)

@@ -34,6 +34,7 @@ from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extra
 from hiper_cli.perceive.background.sighting import sighted
 from hiper_cli.perceive.background.table_votes import TableVotes
 from hiper_cli.perceive.background.under import under_evidence
+from hiper_cli.perceive.background.wall_range import unconfirmed_far_wall
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Frame
 
@@ -216,6 +217,8 @@ class BackgroundStage:
             mo = to_map(obs, frame.T_map_cam)
             if obs.class_name == "wall" and self._not_walls.covers(mo):
                 continue  # a plane seen ending in the room before: not a wall
+            if unconfirmed_far_wall(mo, live.values(), self.config):
+                continue  # seen from too far to tell a wall from a front or a door
             if "under" in obs.data and not self._table_votes.vote(mo, obs.data["under"]):
                 continue  # a top most views saw on a solid front: not a table
             kept.append(mo)

@@ -7,7 +7,8 @@ is 0.1-0.5 m off each chair's. ``drop_unseen_tables`` finds such a table in a bl
 detection names (not furniture with tops of its own: ``unseen_table_skip_classes``): a
 horizontal slab at table height, of columns that end there (a person or a chair's back beside
 the table rises above it), whose footprint spans ``unseen_table_min_side_m`` along its minor
-axis (a chair's back or a shelf board is narrow). The slab and the legs under it
+axis (a chair's back or a shelf board is narrow), on legs (``on_legs``: the top of a cabinet,
+a counter or a book cube stands on a solid front and is no table). The slab and the legs under it
 (``legs.leg_points``) leave the blob, and what remains is clustered again as the segmentation
 does; parts smaller than ``min_cluster_points`` are dropped. A detection of a class with no top
 at table height (``unseen_table_lookalikes``: a bench's seat is lower) whose blob holds a table
@@ -39,7 +40,9 @@ from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.refine import TRIM_IOU
 from hiper_cli.perceive.foreground.segment import Blob, cell_inverse, grid_components, sub_blob
 
-__all__ = ["drop_unseen_tables", "one_board", "split_unseen_tables", "table_points", "unseen_table_top"]
+__all__ = [
+    "drop_unseen_tables", "on_legs", "one_board", "split_unseen_tables", "table_points", "unseen_table_top",
+]
 
 # Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
 UNSEEN_TABLE_MIN_SIDE_M: float = 0.3
@@ -154,6 +157,29 @@ def one_board(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
     return _minor_extent_m(blob.points_map[largest, :2]) >= UNSEEN_TABLE_MIN_SIDE_M
 
 
+def on_legs(blob: Blob, top: Box3D, config: SegmentConfig) -> bool:
+    """Whether what holds the top found in ``blob`` up is legs, not a solid front: the points
+    of the blob's columns that rise from low down to the top (``legs.leg_points``) stand, seen
+    from the camera, in runs across the view narrower than ``unseen_table_min_side_m`` or than
+    half the top's width across the view. A table's legs are a few centimetres thick each,
+    with free space between them; the front of a cabinet, a counter or a shelf with things on
+    its top is such a column in every cell along its edge (runs of 0.54-1.5 times the top's
+    width on the degraded bookstore's counters and book cube; 0.26-0.33, at most 0.3 m, under
+    office 62's tables seen from 4 m). Across the view (the camera's x), not in the map: depth
+    noise spreads a leg at 4 m some 0.2 m along the ray, but moves its side little. No leg
+    seen (chairs before it, its top seen from below) is no evidence against a table."""
+    legs = leg_points(blob.points_map, [top], config)
+    if not legs.any():
+        return True
+    cells = np.unique(np.floor(blob.points_cam[legs, 0] / TABLE_LEG_CELL_M).astype(np.int64))
+    breaks = np.flatnonzero(np.diff(cells) != 1)
+    starts, ends = np.r_[0, breaks + 1], np.r_[breaks, len(cells) - 1]
+    widest_m = float(np.max(cells[ends] - cells[starts] + 1)) * TABLE_LEG_CELL_M
+    across = blob.points_cam[_top_points(blob.points_map, top, config), 0]
+    top_m = float(np.ptp(np.percentile(across, [3, 97]))) if len(across) else 0.0
+    return widest_m < max(UNSEEN_TABLE_MIN_SIDE_M, top_m / 2.0)
+
+
 def drop_unseen_tables(
     blobs: list[Blob], boxes_xyxy: FloatArray, classes: Sequence[str], config: RefineConfig,
     width: int, height: int,
@@ -170,7 +196,9 @@ def split_unseen_tables(
     """(``blobs`` without the tops and legs of tables found in them, one blob per table found:
     its top and legs, the indices of the detections of an ``unseen_table_lookalikes`` class that
     name a blob holding a table: they named the table); ``boxes_xyxy`` (K, 4) and ``classes``
-    are this frame's detections."""
+    are this frame's detections. A top found on a solid front (not ``on_legs``: a cabinet, a
+    counter) leaves its blob with its front as a table's does, so what stands on it is apart,
+    but is no table: it is dropped, as the background filter drops a mapped top."""
     tables: list[Blob] = []
     lookalikes: list[int] = []
     if UNSEEN_TABLE_MIN_SIDE_M <= 0 or not blobs:
@@ -194,10 +222,12 @@ def split_unseen_tables(
         if top is None:
             out.append(blob)
             continue
-        lookalikes.extend(j for j in np.flatnonzero(iou >= TRIM_IOU).tolist()
-                          if classes[j] in UNSEEN_TABLE_LOOKALIKES)
+        legs = on_legs(blob, top, config)
+        if legs:
+            lookalikes.extend(j for j in np.flatnonzero(iou >= TRIM_IOU).tolist()
+                              if classes[j] in UNSEEN_TABLE_LOOKALIKES)
         on_table = table_points(blob.points_map, top, config)
-        if np.count_nonzero(on_table) >= config.min_cluster_points:
+        if legs and np.count_nonzero(on_table) >= config.min_cluster_points:
             tables.append(sub_blob(blob, np.flatnonzero(on_table), config.pixel_step, width, height))
         rest = np.flatnonzero(~on_table)
         for part in grid_components(blob, rest, config.pixel_step, config):

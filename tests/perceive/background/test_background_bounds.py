@@ -80,6 +80,7 @@ def test_a_far_wall_over_shelves_is_as_tall_as_the_view_shows_it():
 
     assert len(far_walls()) == 1
     assert far_walls(wall_view_bounded=False) == []
+    assert far_walls(wall_view_max_noise_m=0.045) == []  # the range rule (``wall_range.py``, off)
 
 
 def _wall_edges(frame, offset_m):
