@@ -226,7 +226,8 @@ _FUSE = frozenset({"confirm_hits", "unknown_confirm_whole", "min_class_observati
                    "unknown_vote_weight", "refused_min_views", "class_sizes"})
 _TRACK = frozenset({"motion_model", "measurement_noise_m", "accel_noise_mps2", "walker_classes",
                     "dynamic_speed_mps", "stitch", "reidentify"})
-_DETECT = frozenset({"detector", "min_detection_score", "detector_threads", "classes", "exclude_classes"})
+_DETECT = frozenset({"detector", "min_detection_score", "detector_threads", "detector_hz", "classes",
+                     "exclude_classes"})
 _CLASSIFY = _own(MatchConfig, None) | _own(TrackerConfig, None) - _ASSOCIATE - _FUSE - _TRACK | _DETECT
 
 

@@ -14,14 +14,16 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_VELOCITY
+import numpy as np
+
+from hiper_cli.model import ROW_POSITION, ROW_STAMP, ROW_VELOCITY, Box3D
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.config import TrackerConfig
 
 if TYPE_CHECKING:
     from hiper_cli.perceive.foreground.track import Track
 
-__all__ = ["has_moved", "is_dynamic", "is_static", "note_travel", "was_moving"]
+__all__ = ["at_rest", "has_moved", "is_dynamic", "is_static", "note_travel", "was_moving"]
 
 # Tuned once on the worlds; fixed values, not options (``ForegroundConfig`` holds those).
 MOVING_SPEED_MPS: float = 0.3
@@ -109,7 +111,7 @@ def has_moved(track: Track, config: TrackerConfig) -> bool:
     walking class, its observed surface left where it was (``SeenBox.moved``: the boxes of its
     first and last blobs apart, no view reaching both) even if its filter never showed it
     travelling (a part of a walker tracked as ``unknown``). Anything else is ``static`` and
-    stores no motion (``stage.at_rest``): the filter's velocity alone is no evidence."""
+    stores no motion (``at_rest``): the filter's velocity alone is no evidence."""
     if is_dynamic(track, config):
         return True
     return track.class_name not in config.walker_classes and track.seen.moved()
@@ -130,3 +132,14 @@ def _moving_rows(rows: list[list[float]], config: TrackerConfig) -> bool:
     (x_end, y_end), (x_start, y_start) = rows[-1][ROW_POSITION][:2], start[ROW_POSITION][:2]
     dx, dy = x_end - x_start, y_end - y_start
     return math.hypot(dx, dy) / span > MOVING_SPEED_MPS
+
+
+def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
+    """Trajectory rows of an object that did not move: one per row of ``rows`` (the stamps it was
+    seen at), each at the centre of ``box`` with no velocity."""
+    if not rows:
+        return []
+    out = np.zeros((len(rows), len(rows[0])), dtype=np.float64)
+    out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
+    out[:, ROW_POSITION] = box.center_m
+    return out.tolist()

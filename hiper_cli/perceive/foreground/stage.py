@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiper_cli.errors import PerceptionError
-from hiper_cli.model import ROW_POSITION, ROW_STAMP, Box3D, Instance, Observation
+from hiper_cli.model import Box3D, Instance, Observation
 from hiper_cli.perceive.detect import Detector, check_class_names, make_detector
 from hiper_cli.perceive.foreground.amodal import (
     COMPLETE_FOOTPRINTS,
@@ -30,11 +30,12 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.geometry_only import geometry_only
 from hiper_cli.perceive.foreground.held import HeldDetections
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
-from hiper_cli.perceive.foreground.moving import has_moved, is_static
+from hiper_cli.perceive.foreground.moving import at_rest, has_moved, is_static
 from hiper_cli.perceive.foreground.plausible import (
     CLASS_SIZE_TOLERANCE,
     FIXTURE_CLASSES,
@@ -56,9 +57,9 @@ from hiper_cli.perceive.foreground.reidentify import (
     still_seen,
 )
 from hiper_cli.perceive.foreground.segment import Blob, segment
-from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart, is_solid, overlap_share
+from hiper_cli.perceive.foreground.solid_map import SolidMap, is_solid, overlap_share
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
-from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes, table_bodies
+from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
@@ -108,11 +109,7 @@ FloatArray = NDArray[np.float64]
 # Named constants (not the paper's): chosen so that they never bind on the simulated worlds.
 OCCLUSION_MARGIN_M = 0.5  # a predicted centre this far behind the measured depth is hidden
 HIDDEN_MARGIN_M = 0.1  # a point on a surface this far behind the measured depth is hidden
-VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
 PIECE_SHARE = 0.8  # a named box this much inside another's is a piece of that object
-STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
-STRUCTURE_HEIGHT_M = 100.0  # ... so their boxes hold every voxel above and below them
-WALL_NOISE_M = 0.05  # ... and across their face a further depth noise of a wall seen from 3-4 m
 
 
 @lru_cache(maxsize=4096)
@@ -526,25 +523,11 @@ class ForegroundStage:
         return folded, [i for i in grown if i.uuid not in folded]
 
     def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
-        """The ``unknown`` instances of the solid things no track became (``solid_map.py``):
-        standing on the floor or a support, outside the background and every instance."""
-        background = list(world.background.values())
-        taken = [i.box for i in (*world.foreground.values(), *self._instances.values(), *instances)
-                 if i.layer == "foreground"]
-        grown = [_grown(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
-        ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
-        floor_z_m = floor_height_m(background)
-        parts = [_solid_instance(p) for p in self._solid.parts(
-            floor_z_m, support_boxes(background), taken, grown, min(ceilings) if ceilings else None)]
-        # the tables whose tops the background maps: objects too, unless an instance holds them
-        pieces = [i.box for i in (*self._instances.values(), *instances, *parts)
-                  if i.layer == "foreground" and i.class_name in (UNKNOWN, TABLE_CLASS)]
-        bodies = table_bodies(background, floor_z_m, [*taken, *(i.box for i in parts)], pieces)
-        parts += [_solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
-                                            np.round(top, 3).tolist())) for t, box, top in bodies]
-        # and the objects hung on the walls (``wall_relief.py``)
-        hung = self._relief.parts(floor_z_m, [*taken, *(i.box for i in parts)])
-        return parts + [_solid_instance(p) for p in hung]
+        """The ``unknown`` instances of what the depth shows solid and no instance holds
+        (``geometry_only.py``)."""
+        own = [*self._instances.values(), *instances]
+        taken = [i.box for i in (*world.foreground.values(), *own) if i.layer == "foreground"]
+        return geometry_only(list(world.background.values()), taken, own, self._solid, self._relief)
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a
@@ -757,40 +740,6 @@ def _timings(clock: list[float], detect_s: float, seg: Any) -> dict[str, float]:
         }
     )
     return timings
-
-
-def at_rest(rows: list[list[float]], box: Box3D) -> list[list[float]]:
-    """Trajectory rows of an object that did not move: one per row of ``rows`` (the stamps it was
-    seen at), each at the centre of ``box`` with no velocity."""
-    if not rows:
-        return []
-    out = np.zeros((len(rows), len(rows[0])), dtype=np.float64)
-    out[:, ROW_STAMP] = [r[ROW_STAMP] for r in rows]
-    out[:, ROW_POSITION] = box.center_m
-    return out.tolist()
-
-
-def _grown(box: Box3D, tall: bool) -> Box3D:
-    """``box`` grown by ``VOXEL_MARGIN_M`` on each side; ``tall``, up and down without end along
-    its most vertical axis (a wall stands from the floor to the ceiling, whatever part of it the
-    background saw), and across its face by ``WALL_NOISE_M`` more: a wall seen from afar puts
-    points of its face that far in front of it, which fill the voxels along it (a sheet that
-    joined a table to the wall behind it up to the ceiling)."""
-    extent = box.extent_m + 2.0 * VOXEL_MARGIN_M
-    if tall:
-        extent[int(np.argmax(np.abs(box.R[2, :])))] = STRUCTURE_HEIGHT_M
-        extent[int(np.argmin(box.extent_m))] += 2.0 * WALL_NOISE_M
-    return Box3D(box.center_m, extent, box.R)
-
-
-def _solid_instance(part: SolidPart) -> Instance:
-    """The ``unknown`` instance of a geometry-only object: static, at rest at its box's centre."""
-    rows = [[stamp_s, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0] for stamp_s in (part.first_seen_s, part.last_seen_s)]
-    return Instance(layer="foreground", class_name=UNKNOWN, box=part.box, first_seen_s=part.first_seen_s,
-                    last_seen_s=part.last_seen_s, confidence=part.seen_share,
-                    observation_uuids=part.observation_uuids,
-                    data={"trajectory": at_rest(rows, part.box), "closed": True, "geometry_only": True,
-                          "surface_map": part.surface_m})  # a later session's empty-place test
 
 
 def _wall_boxes(world: World) -> list[Box3D]:

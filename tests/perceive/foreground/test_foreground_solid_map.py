@@ -231,15 +231,15 @@ def test_a_thing_reaching_well_below_its_support_is_no_part() -> None:
 def test_the_noise_in_front_of_a_mapped_wall_joins_no_table_to_it(monkeypatch) -> None:
     # a wall mapped with its face at y = 0.46 (its box 2 cm thick); seen from afar the face puts
     # points 6-8 cm in front of it, up to 2.1 m: not the ceiling (2.6 m), so no building column
-    from hiper_cli.perceive.foreground import stage
+    from hiper_cli.perceive.foreground import geometry_only
 
     wall_box = Box3D(np.array([0.0, 0.47, 1.3]), np.array([3.0, 0.02, 2.6]))
     face = box_surface([-1.5, 0.46, 0.0], [1.5, 0.48, 2.6])
     noise = box_surface([-1.2, 0.38, 0.0], [1.2, 0.40, 2.1], step_m=0.03)
     table = box_surface([-0.6, -0.35, 0.0], [0.6, 0.3, 0.75])
     solid = drive_past([face, noise, table, floor_points()], unnamed=[0, 1, 2])
-    (part,) = solid.parts(0.0, [FLOOR], [], [stage._grown(wall_box, tall=True)], ceiling_z_m=2.6)
+    (part,) = solid.parts(0.0, [FLOOR], [], [geometry_only.grown_box(wall_box, tall=True)], ceiling_z_m=2.6)
     assert part.box.aabb()[1][2] < 1.0  # the table's height
-    monkeypatch.setattr(stage, "WALL_NOISE_M", 0.0)  # the wall's box alone: the sheet joins the table
-    (joined,) = solid.parts(0.0, [FLOOR], [], [stage._grown(wall_box, tall=True)], ceiling_z_m=2.6)
+    monkeypatch.setattr(geometry_only, "WALL_NOISE_M", 0.0)  # the wall's box alone: the sheet joins the table
+    (joined,) = solid.parts(0.0, [FLOOR], [], [geometry_only.grown_box(wall_box, tall=True)], ceiling_z_m=2.6)
     assert joined.box.aabb()[1][2] > 2.0
