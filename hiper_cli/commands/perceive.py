@@ -38,11 +38,10 @@ def perceive_command(
     """
     from hiper_cli.pipeline import perceive_log
 
-    options = o.perceive_options(
-        stages=stages, option=option, env=env, resume=resume, replace=replace, again=again, align=align,
-        keep_observations=keep_observations, detector=detector, no_background_filter=no_background_filter,
-        classes=classes, exclude_classes=exclude_classes, mapping_hz=mapping_hz, max_hz=max_hz,
-        detector_hz=detector_hz)
+    options = o.perceive_options(stages=stages, option=option, env=env, resume=resume, replace=replace,
+        again=again, align=align, keep_observations=keep_observations, detector=detector,
+        no_background_filter=no_background_filter, classes=classes, exclude_classes=exclude_classes,
+        mapping_hz=mapping_hz, max_hz=max_hz, detector_hz=detector_hz)
     o.check_source_flags(is_live(log), log, idle_timeout=idle_timeout, queue=queue, look_ahead=look_ahead,
                          stats=stats, resume=resume, replace=replace, again=again, view=view, max_hz=max_hz)
     if is_live(log):
