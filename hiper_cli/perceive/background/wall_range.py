@@ -2,16 +2,12 @@
 
 A depth camera's noise grows with the square of the range (σ(z) ≈ ``cell_noise_m`` z², the
 segmenter's model; docs/sensors.md). Far enough, a plane's relief hides in it: the book rows
-of a shelf front (some 0.1 m deep) fit one flat plane, a glass door lies flush with its wall,
-and the tests that tell a furniture front from a wall (``bounds.py``, ``fronts.py``) see no
-step. On the degraded bookstore the planes seen as walls only from 4.5-4.7 m were a shelf
-front and the storefront door (and one real wall); every wall of the other logs has a view
-within 4 m. So a view whose noise exceeds ``wall_view_max_noise_m`` starts no wall: it only
-extends a wall that a nearer view mapped (it matches one, Algorithm 2's criteria, or lies on
-its plane further along: the degraded house 61's wall seen near at one end and from 4.45 m
-at the other; dropped, its far end became foreground clutter). Off by default: a plane it
-keeps out of the walls is foreground to the object map, and on office 62 that clutter
-named a couch a bed (docs/results/2026-12-07-degraded-background.md).
+of a shelf front fit one flat plane, a glass door lies flush with its wall, and the tests that
+tell a furniture front from a wall (``bounds.py``, ``fronts.py``) see no step. So a view whose
+noise exceeds ``wall_view_max_noise_m`` starts no wall: it only extends a wall that a nearer
+view mapped (it matches one, Algorithm 2's criteria, or lies on its plane further along).
+Off by default: a plane it keeps out of the walls becomes foreground to the object map, where
+its clutter costs more than the wall it removes (docs/results/2026-12-07-degraded-background.md).
 """
 
 from __future__ import annotations
