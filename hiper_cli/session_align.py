@@ -30,8 +30,9 @@ from hiper_cli.graph import KnowledgeBase
 from hiper_cli.graph.sessions import Alignment
 from hiper_cli.model import Environment
 from hiper_cli.perceive.align import BackgroundCloud, register
-from hiper_cli.perceive.align_path import PathCorrection, correct_path
+from hiper_cli.perceive.align_path import PathCorrection, correct_path, motion_m
 from hiper_cli.perceive.align_start import refine_at_start
+from hiper_cli.perceive.logs.trajectory import rotation_angle_rad
 from hiper_cli.perceive.static_cloud import StaticCloud
 from hiper_cli.types import Frame
 
@@ -44,7 +45,6 @@ START_MOTION_M = 3.0  # the start's cloud: frames until the log moved this far (
 START_STEP_M = 0.1  # ... one frame per this much motion
 START_MIN_INLIERS = 0.3  # below this share of the start's points on the map, the start is not used
 START_MAX_CHANGE = (0.25, 3.0)  # metres, degrees: a larger correction of the whole-log fit is refused
-METRES_PER_RADIAN = 0.5
 
 
 def _read_matrix(path: Path) -> np.ndarray:
@@ -75,12 +75,6 @@ def log_cloud(reader: Any, n: int = ALIGN_FRAMES) -> np.ndarray:
     return cloud.points()
 
 
-def _motion_m(T_a: np.ndarray, T_b: np.ndarray) -> float:
-    step = np.linalg.inv(T_a) @ T_b
-    angle = float(np.arccos(np.clip((np.trace(step[:3, :3]) - 1) / 2, -1.0, 1.0)))
-    return float(np.linalg.norm(step[:3, 3])) + METRES_PER_RADIAN * angle
-
-
 def start_cloud(reader: Any) -> np.ndarray:
     """The background cloud (log frame) of the log's first ``START_MOTION_M`` of motion, one
     frame per ``START_STEP_M``: where the log's poses have drifted least."""
@@ -89,7 +83,7 @@ def start_cloud(reader: Any) -> np.ndarray:
     travelled, since, last = 0.0, np.inf, None
     for k in range(len(reader)):
         if poses is not None and last is not None:
-            moved = _motion_m(poses[last], poses[k])
+            moved = motion_m(poses[last], poses[k])
             travelled, since = travelled + moved, since + moved
         if travelled > START_MOTION_M:
             break
@@ -105,7 +99,7 @@ def _refined(reader: Any, place: np.ndarray, found: Any) -> tuple[np.ndarray, st
     fit = refine_at_start(start_cloud(reader), place, found.T_map_log)
     change = np.linalg.inv(found.T_map_log) @ fit.T_map_log
     metres = float(np.linalg.norm(change[:3, 3]))
-    degrees = float(np.degrees(np.arccos(np.clip((np.trace(change[:3, :3]) - 1) / 2, -1.0, 1.0))))
+    degrees = float(np.degrees(rotation_angle_rad(change[:3, :3])))
     if fit.inliers < START_MIN_INLIERS or fit.constrained == 0:
         return found.T_map_log, (f"kept the whole log's fit: its first {START_MOTION_M:g} m show too little "
                                  f"of the map ({fit.inliers:.0%} of their points on it)")

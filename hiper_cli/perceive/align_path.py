@@ -28,9 +28,10 @@ from numpy.typing import NDArray
 from hiper_cli.errors import LogError
 from hiper_cli.perceive.align import BackgroundCloud
 from hiper_cli.perceive.align_start import MapSurface, refine
-from hiper_cli.perceive.logs.trajectory import rotation_about
+from hiper_cli.perceive.logs.trajectory import rotation_about, rotation_angle_rad, rotation_vector
 
-__all__ = ["MAX_SEGMENT_CHANGE", "SEGMENT_M", "WINDOW_M", "PathCorrection", "correct_path", "travelled_m"]
+__all__ = ["MAX_SEGMENT_CHANGE", "METRES_PER_RADIAN", "SEGMENT_M", "WINDOW_M", "PathCorrection",
+           "correct_path", "motion_m", "travelled_m"]
 
 FloatArray = NDArray[np.float64]
 
@@ -42,27 +43,17 @@ MAX_SEGMENT_CHANGE = (0.1, 1.0)  # metres (at the keyframe), degrees from the pr
 METRES_PER_RADIAN = 0.5
 
 
-def _angle_rad(R: FloatArray) -> float:
-    return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
-
-
-def _rotvec(R: FloatArray) -> FloatArray:
-    """The rotation vector of ``R`` (axis × angle), for angles well under 180°."""
-    angle = _angle_rad(R)
-    if angle < 1e-12:
-        return np.zeros(3)
-    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    out: FloatArray = w * (angle / (2.0 * np.sin(angle)))
-    return out
+def motion_m(T_a: FloatArray, T_b: FloatArray) -> float:
+    """The motion from pose ``T_a`` to ``T_b``: metres plus ``METRES_PER_RADIAN`` per radian."""
+    step = np.linalg.inv(T_a) @ T_b
+    return float(np.linalg.norm(step[:3, 3])) + METRES_PER_RADIAN * rotation_angle_rad(step[:3, :3])
 
 
 def travelled_m(T_log_cam: FloatArray) -> FloatArray:
     """Per pose, the motion since the first: metres plus ``METRES_PER_RADIAN`` per radian."""
     out = np.zeros(len(T_log_cam))
     for k in range(1, len(T_log_cam)):
-        step = np.linalg.inv(T_log_cam[k - 1]) @ T_log_cam[k]
-        turned = METRES_PER_RADIAN * _angle_rad(step[:3, :3])
-        out[k] = out[k - 1] + float(np.linalg.norm(step[:3, 3])) + turned
+        out[k] = out[k - 1] + motion_m(T_log_cam[k - 1], T_log_cam[k])
     return out
 
 
@@ -70,7 +61,7 @@ def _change(T_a: FloatArray, T_b: FloatArray, at_log: FloatArray) -> tuple[float
     """How far ``T_b`` carries the log point ``at_log`` from where ``T_a`` does (m), and the
     angle between them (degrees)."""
     moved = T_b[:3, :3] @ at_log + T_b[:3, 3] - (T_a[:3, :3] @ at_log + T_a[:3, 3])
-    return float(np.linalg.norm(moved)), float(np.degrees(_angle_rad(T_a[:3, :3].T @ T_b[:3, :3])))
+    return float(np.linalg.norm(moved)), float(np.degrees(rotation_angle_rad(T_a[:3, :3].T @ T_b[:3, :3])))
 
 
 @dataclass(frozen=True)
@@ -95,7 +86,7 @@ class PathCorrection:
         a = (s - self.keys_m[k]) / max(self.keys_m[k + 1] - self.keys_m[k], 1e-12)
         T0, T1 = self.T_keys[k], self.T_keys[k + 1]
         T = np.eye(4)
-        T[:3, :3] = T0[:3, :3] @ rotation_about(a * _rotvec(T0[:3, :3].T @ T1[:3, :3]))
+        T[:3, :3] = T0[:3, :3] @ rotation_about(a * rotation_vector(T0[:3, :3].T @ T1[:3, :3]))
         T[:3, 3] = (1 - a) * T0[:3, 3] + a * T1[:3, 3]
         return T
 

@@ -22,6 +22,8 @@ __all__ = [
     "quat_xyzw_to_matrix",
     "read_tum_trajectory",
     "rotation_about",
+    "rotation_angle_rad",
+    "rotation_vector",
     "write_tum_trajectory",
 ]
 
@@ -42,6 +44,22 @@ def rotation_about(rotvec: FloatArray) -> FloatArray:
     K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
     R: FloatArray = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
     return R
+
+
+def rotation_angle_rad(R: FloatArray) -> float:
+    """The angle (radians) of the 3×3 rotation ``R``."""
+    return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
+
+
+def rotation_vector(R: FloatArray) -> FloatArray:
+    """The rotation vector of ``R`` (axis × angle; the inverse of ``rotation_about``), for
+    angles well under 180°."""
+    angle = rotation_angle_rad(R)
+    if angle < 1e-12:
+        return np.zeros(3)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    out: FloatArray = w * (angle / (2.0 * np.sin(angle)))
+    return out
 
 
 def quat_xyzw_to_matrix(quat_xyzw: FloatArray) -> FloatArray:

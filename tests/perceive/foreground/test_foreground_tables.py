@@ -99,10 +99,10 @@ def test_a_bottle_on_an_unmapped_table_comes_apart_from_it(monkeypatch):
         assert (_ids(with_bottle, ids) == {bottle_id}) == apart, holding
 
 
-def _named_whole(boxes, part_ids, class_name):
-    """The blobs of ``boxes`` seen from above; ``split_unseen_tables`` of them with one detection
-    of ``class_name`` around every sample of ``part_ids``; and the frame's instance ids."""
-    frame = make_frame(boxes, pose_looking_x(z=1.6), 0.0, 0)
+def _split_seen_from(T_map_cam, boxes, part_ids, class_name):
+    """The blobs of ``boxes`` seen from ``T_map_cam``; ``split_unseen_tables`` of them with one
+    detection of ``class_name`` around every sample of ``part_ids``; and the frame's instance ids."""
+    frame = make_frame(boxes, T_map_cam, 0.0, 0)
     bg = [i.box for i in background_instances(boxes).values()]
     cfg = ForegroundConfig(pixel_step=2)
     blobs, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
@@ -110,6 +110,11 @@ def _named_whole(boxes, part_ids, class_name):
     ys, xs = np.nonzero(np.isin(ids, part_ids))
     box = np.array([[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]], dtype=np.float64)
     return blobs, split_unseen_tables(blobs, box, [class_name], cfg, CAMERA.width, CAMERA.height), ids
+
+
+def _named_whole(boxes, part_ids, class_name):
+    """``_split_seen_from`` a camera looking at ``boxes`` from above."""
+    return _split_seen_from(pose_looking_x(z=1.6), boxes, part_ids, class_name)
 
 
 def test_a_table_named_bench_comes_apart_but_a_bench_stays_whole():
@@ -255,14 +260,8 @@ def _pitched_split(boxes, part_ids, class_name, down_deg=25.0):
     T = np.eye(4)
     T[:3, :3] = np.column_stack([[0.0, -1.0, 0.0], [-s, 0.0, -c], [c, 0.0, -s]])  # x right, y down, z ahead
     T[:3, 3] = [0.2, 0.0, 1.3]
-    frame = make_frame(boxes, T, 0.0, 0)
-    bg = [i.box for i in background_instances(boxes).values()]
-    cfg = ForegroundConfig(pixel_step=2)
-    blobs, _ = segment(frame.depth_m, CAMERA, frame.T_map_cam, bg, cfg)
-    ids = frame.extras["ids"]
-    ys, xs = np.nonzero(np.isin(ids, part_ids))
-    box = np.array([[xs.min(), ys.min(), xs.max() + 1, ys.max() + 1]], dtype=np.float64)
-    return split_unseen_tables(blobs, box, [class_name], cfg, CAMERA.width, CAMERA.height), ids
+    _, split, ids = _split_seen_from(T, boxes, part_ids, class_name)
+    return split, ids
 
 
 def test_a_cabinet_with_a_bottle_on_it_is_no_table_but_a_table_on_legs_is():
