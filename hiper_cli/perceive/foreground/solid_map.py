@@ -13,11 +13,16 @@ the camera looked through it (expected, not seen). A voxel found there in ``MIN_
 of the keyframes that could tell is evidence; a passing person, flying pixels at a depth edge
 and a drifting fragment are seen through from the next viewpoint and are not.
 
-At the end of the log the evidence voxels outside the background, and outside the columns
-that reach the mapped ceiling (a wall or a pillar the background missed), are grouped into
-parts: neighbours (voxels one above the other across a gap of ``STACK_GAP_M`` too: a rack's
-boards) join unless the keyframes' blobs held them apart as often as together or more (a
-chair at a desk, two stacks side by side). A part longer than ``MAX_EXTENT_M`` is several
+At the end of the log the evidence voxels outside the background, above the floor (nothing
+stands inside it: deeper voxels are depth noise at range), and outside the columns that reach
+the mapped ceiling (a wall or a pillar the background missed), are grouped into parts:
+neighbours (voxels one above the other across a gap of ``STACK_GAP_M`` too: a rack's boards)
+join unless the keyframes' blobs held them apart as often as together or more (a chair at a
+desk, two stacks side by side). Where the depth is poor the blobs run touching things
+together, and stray points at their depth edges bridge the gap between them: a voxel found
+at fewer than ``FIRM_SEEN`` keyframes is weak evidence, which joins a part but never two. A
+part whose firm voxels fall into bodies that touch through a neck of at most
+``NECK_VOXELS``, stand side by side and are each an object by themselves is those bodies. A part longer than ``MAX_EXTENT_M`` is several
 things run together (a row of shelves): it is parted into compact pieces. A part is an
 object when its voxels were found there at ``MIN_SEEN_PART`` keyframes (median), it is solid
 (not one sheet of voxels), large enough, stands on the floor or a support over its footprint
@@ -46,8 +51,11 @@ KEYFRAME_TURN_RAD = np.deg2rad(10.0)  # ... and whenever the camera turned this 
 KEYFRAME_MOVE_M = 0.3  # ... or moved this far
 VOXEL_M = 0.1  # edge of a voxel of the map
 MIN_SEEN_SHARE = 0.6  # of the keyframes that could tell, the share that found a voxel's surface
-MIN_SEEN_PART = 2  # a part: its voxels found there at this many keyframes (median)
+MIN_SEEN_PART = 3  # a part: its voxels found there at this many keyframes (median)
 NOISE_M = 0.02  # depth noise at 1 m; a surface is "there" within VOXEL_M + NOISE_M · z² of it
+FIRM_SEEN = 4  # a voxel found at fewer keyframes is weak evidence: it joins a part, never two
+NECK_VOXELS = 4  # ... and the bodies they part it into touch through this many voxels each at most
+ATTACH_STEPS = 4  # ... the part of a firm voxel at most this many steps away (else its own)
 STACK_GAP_M = 0.4  # voxels one above the other across at most this gap are one part
 MIN_VOXELS = 10  # a part with fewer is debris, not an object (0.01 m³ of surface at 0.1 m)
 MIN_HEIGHT_M = 0.15  # ... or lower than this
@@ -187,6 +195,16 @@ class SolidMap:
         self._seen[idx[there]] += 1
         self._free[idx[through]] += 1
 
+    def confirmed(self, box: Box3D) -> bool:
+        """Whether a second view confirmed what lies in ``box`` (map frame): False only when the
+        map holds voxels there and no keyframe but the one that found each saw it again (a
+        passer-by's piece, a smear of stray points); nothing there tells nothing."""
+        lo, hi = box.aabb()
+        keys = self._keys
+        centres = _centres(keys)
+        inside = np.all((centres >= lo - VOXEL_M / 2.0) & (centres <= hi + VOXEL_M / 2.0), axis=1)
+        return not np.any(inside) or int(self._seen[inside].max()) >= 2
+
     def parts(self, floor_z_m: float, supports: Sequence[Box3D], taken: Sequence[Box3D],
               background: Sequence[Box3D], ceiling_z_m: float | None = None) -> list[SolidPart]:
         """The geometry-only objects: evidence voxels outside the ``background`` boxes, grouped
@@ -202,12 +220,15 @@ class SolidMap:
                 local = (centres - box.center_m) @ box.R
                 inside |= np.all(np.abs(local) <= box.extent_m / 2.0, axis=1)
             idx = idx[~inside]
+        # nothing stands inside the floor: what lies deeper than its noise is depth noise at range
+        idx = idx[_centres(self._keys[idx])[:, 2] >= floor_z_m - SUNK_M]
         if ceiling_z_m is not None and len(idx):
             idx = idx[~_building_columns(_unpack(self._keys[idx]), ceiling_z_m)]
         if not len(idx):
             return []
         labels = np.full(len(self._keys), -1, dtype=np.int64)
-        labels[idx] = self._grouped(idx)
+        bodies = np.full(len(self._keys), -1, dtype=np.int64)
+        labels[idx], bodies[idx] = self._grouped(idx)
         held = self._held_by(labels)
         # what a part may stand on: the supports' tops over their footprints; the floor's height
         # anywhere while the background has mapped no support
@@ -222,12 +243,26 @@ class SolidMap:
             for piece in _pieces(members, _centres(self._keys[members])):
                 if np.median(self._seen[piece]) < MIN_SEEN_PART:
                     continue
-                part = self._part(piece, (tops, ceiling_z_m), taken, uuids)
-                if part is not None:
-                    out.append(part)
+                out += self._bodies(piece, bodies[piece], (tops, ceiling_z_m), taken, uuids)
         return out
 
-    def _grouped(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
+    def _bodies(self, piece: NDArray[np.int64], body: NDArray[np.int64],
+                levels: tuple[Sequence[_Support], float | None], taken: Sequence[Box3D],
+                uuids: list[str]) -> list[SolidPart]:
+        """The objects of one piece (voxel indices): the bodies its firm voxels part it into
+        (``body``: their labels) when each of them is an object by itself, standing where it
+        is; else the piece as one object."""
+        split = [piece[body == b] for b in np.unique(body)]
+        split = [s for s in split if len(s) >= MIN_VOXELS and np.median(self._seen[s]) >= MIN_SEEN_PART]
+        if len(split) >= 2 and _necked(self._keys, split):
+            parts = [self._part(s, levels, taken, uuids) for s in split]
+            kept = [p for p in parts if p is not None]
+            if len(kept) == len(parts) and _side_by_side([p.box for p in kept]):
+                return kept
+        whole = self._part(piece, levels, taken, uuids)
+        return [] if whole is None else [whole]
+
+    def _grouped(self, idx: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Labels 0..k-1 of the parts of the voxels ``idx``: neighbours (26-connected, or one above
         the other across ``STACK_GAP_M``) are one part unless the keyframes' blobs held them apart
         as often as together or more (a chair at a desk, a box beside a bucket: the segmenter parts
@@ -237,11 +272,14 @@ class SolidMap:
         a, b = _neighbour_pairs(_unpack(self._keys[idx]))
         together, apart, between = self._votes(idx, a, b)
         keep = ((together > apart) | (together + apart == 0)) & ~between[a] & ~between[b]
+        weak = self._seen[idx] < FIRM_SEEN
         labels = _labels(len(idx), a, b, keep)
+        bodies = _attached(_labels(len(idx), a, b, keep & ~weak[a] & ~weak[b]), weak, a[keep], b[keep])
         for x, y in ((a, b), (b, a)):  # a voxel between two things takes a neighbour's part
             join = between[x] & ~between[y]
             labels[x[join]] = labels[y[join]]
-        return np.asarray(labels, dtype=np.int64)
+            bodies[x[join]] = bodies[y[join]]
+        return np.asarray(labels, dtype=np.int64), bodies
 
     def _votes(self, idx: NDArray[np.int64], a: NDArray[np.int64], b: NDArray[np.int64]
                ) -> tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.bool_]]:
@@ -367,6 +405,54 @@ def _building_columns(ijk: NDArray[np.int64], ceiling_z_m: float) -> NDArray[np.
     top_k = np.maximum.reduceat(ijk[order, 2], starts)
     column_of = np.searchsorted(ordered[starts], columns)
     return np.asarray((top_k[column_of] + 1) * VOXEL_M >= ceiling_z_m - CEILING_REACH_M, dtype=bool)
+
+
+def _necked(keys: NDArray[np.int64], bodies: Sequence[NDArray[np.int64]]) -> bool:
+    """Whether the ``bodies`` (voxel indices into ``keys``) touch one another, if at all, through
+    at most ``NECK_VOXELS`` voxels each: a bridge of stray points between two things, not the
+    cross-section of one thing whose middle the views saw less."""
+    members = np.concatenate(bodies)
+    body = np.concatenate([np.full(len(b), n) for n, b in enumerate(bodies)])
+    a, b = _neighbour_pairs(_unpack(keys[members]))
+    cross = body[a] != body[b]
+    for x in range(len(bodies)):
+        for y in range(x + 1, len(bodies)):
+            pair = cross & (((body[a] == x) & (body[b] == y)) | ((body[a] == y) & (body[b] == x)))
+            if len(np.unique(np.r_[a[pair], b[pair]])) > 2 * NECK_VOXELS:
+                return False
+    return True
+
+
+def _side_by_side(boxes: Sequence[Box3D]) -> bool:
+    """Whether no two ``boxes`` share more than ``COVERED_SHARE`` of the smaller one's footprint:
+    bodies that stand beside one another, not the storeys of one."""
+    for n, a in enumerate(boxes):
+        alo, ahi = a.aabb()
+        for b in boxes[n + 1:]:
+            blo, bhi = b.aabb()
+            inter = np.clip(np.minimum(ahi[:2], bhi[:2]) - np.maximum(alo[:2], blo[:2]), 0.0, None)
+            smaller = min(float(np.prod(ahi[:2] - alo[:2])), float(np.prod(bhi[:2] - blo[:2])))
+            if float(np.prod(inter)) > COVERED_SHARE * smaller:
+                return False
+    return True
+
+
+def _attached(labels: NDArray[np.int64], weak: NDArray[np.bool_], a: NDArray[np.int64],
+              b: NDArray[np.int64]) -> NDArray[np.int64]:
+    """``labels`` with each ``weak`` voxel in the part of the nearest firm voxel it is joined to
+    through the pairs (``a``, ``b``); weak voxels joined to no firm one keep parts of their own."""
+    out = np.where(weak, -1, labels)
+    for _ in range(ATTACH_STEPS):
+        for x, y in ((a, b), (b, a)):
+            take = (out[x] >= 0) & (out[y] < 0)
+            out[y[take]] = out[x[take]]
+    left = out < 0
+    if np.any(left):
+        rest = _labels(len(out), a, b, left[a] & left[b])
+        _, rest = np.unique(rest[left], return_inverse=True)
+        out[left] = int(out.max()) + 1 + rest.ravel()
+    _, out = np.unique(out, return_inverse=True)
+    return np.asarray(out.ravel(), dtype=np.int64)
 
 
 def _labels(n: int, a: NDArray[np.int64], b: NDArray[np.int64], keep: NDArray[np.bool_]) -> NDArray[np.int64]:

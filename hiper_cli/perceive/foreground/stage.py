@@ -486,6 +486,9 @@ class ForegroundStage:
         gone = [u for u in self.tracker.withdrawn if self._instances.pop(u, None) is not None]
         self._walls = _wall_boxes(world)
         instances = [self._instance(t) for t in closed]
+        unconfirmed = self._unconfirmed()
+        instances = [i for i in instances if i.uuid not in unconfirmed]
+        gone += [u for u in unconfirmed if self._instances.pop(u, None) is not None]
         folded, grown = self._fold_pieces()
         instances = [i for i in instances if i.uuid not in folded]
         instances += [i for i in grown if all(i is not j for j in instances)]
@@ -521,6 +524,12 @@ class ForegroundStage:
         for uuid in folded:
             del self._instances[uuid]
         return folded, [i for i in grown if i.uuid not in folded]
+
+    def _unconfirmed(self) -> set[str]:
+        """The static ``unknown`` instances whose surface no second keyframe of the map of solid
+        things saw again (``SolidMap.confirmed``): no existence evidence for something unnamed."""
+        return {i.uuid for i in self._instances.values()
+                if i.class_name == UNKNOWN and i.state == "static" and not self._solid.confirmed(i.box)}
 
     def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
         """The ``unknown`` instances of what the depth shows solid and no instance holds
