@@ -22,8 +22,9 @@ desk, two stacks side by side). Where the depth is poor the blobs run touching t
 together, and stray points at their depth edges bridge the gap between them: a voxel found
 at fewer than ``FIRM_SEEN`` keyframes is weak evidence, which joins a part but never two. A
 part whose firm voxels fall into bodies that touch through a neck of at most
-``NECK_VOXELS``, stand side by side and are each an object by themselves is those bodies. A part longer than ``MAX_EXTENT_M`` is several
-things run together (a row of shelves): it is parted into compact pieces. A part is an
+``NECK_VOXELS``, stand side by side and are each an object by themselves is those bodies.
+A part longer than ``MAX_EXTENT_M`` is several things run together (a row of shelves): it
+is parted into compact pieces. A part is an
 object when its voxels were found there at ``MIN_SEEN_PART`` keyframes (median), it is solid
 (not one sheet of voxels), large enough, stands on the floor or a support over its footprint
 (``BASE_REACH_M``), and no instance of the session (any class) covers it. Its box is the box
@@ -196,14 +197,16 @@ class SolidMap:
         self._free[idx[through]] += 1
 
     def confirmed(self, box: Box3D) -> bool:
-        """Whether a second view confirmed what lies in ``box`` (map frame): False only when the
-        map holds voxels there and no keyframe but the one that found each saw it again (a
-        passer-by's piece, a smear of stray points); nothing there tells nothing."""
+        """Whether what lies in ``box`` (map frame) may exist: False only when the map holds
+        voxels there, no keyframe but the one that found each saw it again, and a later one
+        looked through where it was (a passer-by's piece, a smear of stray points). Nothing
+        there, or nothing seen since, tells nothing."""
         lo, hi = box.aabb()
-        keys = self._keys
-        centres = _centres(keys)
+        centres = _centres(self._keys)
         inside = np.all((centres >= lo - VOXEL_M / 2.0) & (centres <= hi + VOXEL_M / 2.0), axis=1)
-        return not np.any(inside) or int(self._seen[inside].max()) >= 2
+        if not np.any(inside):
+            return True
+        return int(self._seen[inside].max()) >= 2 or int(self._free[inside].sum()) == 0
 
     def parts(self, floor_z_m: float, supports: Sequence[Box3D], taken: Sequence[Box3D],
               background: Sequence[Box3D], ceiling_z_m: float | None = None) -> list[SolidPart]:

@@ -527,7 +527,8 @@ class ForegroundStage:
 
     def _unconfirmed(self) -> set[str]:
         """The static ``unknown`` instances whose surface no second keyframe of the map of solid
-        things saw again (``SolidMap.confirmed``): no existence evidence for something unnamed."""
+        things saw again, and a later one saw through (``SolidMap.confirmed``): the evidence
+        says something unnamed is not there."""
         return {i.uuid for i in self._instances.values()
                 if i.class_name == UNKNOWN and i.state == "static" and not self._solid.confirmed(i.box)}
 
