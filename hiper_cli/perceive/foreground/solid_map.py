@@ -13,9 +13,8 @@ the camera looked through it (expected, not seen). A voxel found there in ``MIN_
 of the keyframes that could tell is evidence; a passing person, flying pixels at a depth edge
 and a drifting fragment are seen through from the next viewpoint and are not.
 
-At the end of the log the evidence voxels outside the background, above the floor (nothing
-stands inside it: deeper voxels are depth noise at range), and outside the columns that reach
-the mapped ceiling (a wall or a pillar the background missed), are grouped into parts:
+At the end of the log the evidence voxels outside the background, and outside the columns
+that reach the mapped ceiling (a wall or a pillar the background missed), are grouped into parts:
 neighbours (voxels one above the other across a gap of ``STACK_GAP_M`` too: a rack's boards)
 join unless the keyframes' blobs held them apart as often as together or more (a chair at a
 desk, two stacks side by side). Where the depth is poor the blobs run touching things
@@ -27,7 +26,10 @@ A part longer than ``MAX_EXTENT_M`` is several things run together (a row of she
 is parted into compact pieces. A part is an
 object when its voxels were found there at ``MIN_SEEN_PART`` keyframes (median), it is solid
 (not one sheet of voxels), large enough, stands on the floor or a support over its footprint
-(``BASE_REACH_M``), and no instance of the session (any class) covers it. Its box is the box
+(``BASE_REACH_M``), and no instance of the session (any class) covers it. Nothing stands inside
+the floor: a part with ``SUNK_SHARE`` of its voxels deeper than ``SUNK_M`` under it is the
+floor seen at range (depth noise spreads below the surface as above it); a part with fewer
+is a thing with stray points under it, judged without them. Its box is the box
 of its voxels.
 """
 
@@ -52,7 +54,7 @@ KEYFRAME_TURN_RAD = np.deg2rad(10.0)  # ... and whenever the camera turned this 
 KEYFRAME_MOVE_M = 0.3  # ... or moved this far
 VOXEL_M = 0.1  # edge of a voxel of the map
 MIN_SEEN_SHARE = 0.6  # of the keyframes that could tell, the share that found a voxel's surface
-MIN_SEEN_PART = 3  # a part: its voxels found there at this many keyframes (median)
+MIN_SEEN_PART = 2  # a part: its voxels found there at this many keyframes (median)
 NOISE_M = 0.02  # depth noise at 1 m; a surface is "there" within VOXEL_M + NOISE_M · z² of it
 FIRM_SEEN = 4  # a voxel found at fewer keyframes is weak evidence: it joins a part, never two
 NECK_VOXELS = 4  # ... and the bodies they part it into touch through this many voxels each at most
@@ -63,6 +65,7 @@ MIN_HEIGHT_M = 0.15  # ... or lower than this
 MIN_THICKNESS_M = 0.05  # the spread of a part's voxels across their thinnest direction: a sheet
 BASE_REACH_M = 0.25  # its lowest voxel this near the floor or a support top: it stands there
 SUNK_M = 0.15  # ... and not further below it (depth noise): deeper, it is the floor seen at range
+SUNK_SHARE = 0.1  # a part with this share of its voxels deeper than SUNK_M under the floor is the floor
 CEILING_REACH_M = 0.3  # its top this near the ceiling: it is the building's, or joined to it
 MAX_EXTENT_M = 4.5  # a longer part is several things run together: it is parted in pieces
 MAX_PIECES = 8  # ... at most this many
@@ -223,8 +226,6 @@ class SolidMap:
                 local = (centres - box.center_m) @ box.R
                 inside |= np.all(np.abs(local) <= box.extent_m / 2.0, axis=1)
             idx = idx[~inside]
-        # nothing stands inside the floor: what lies deeper than its noise is depth noise at range
-        idx = idx[_centres(self._keys[idx])[:, 2] >= floor_z_m - SUNK_M]
         if ceiling_z_m is not None and len(idx):
             idx = idx[~_building_columns(_unpack(self._keys[idx]), ceiling_z_m)]
         if not len(idx):
@@ -246,6 +247,10 @@ class SolidMap:
             for piece in _pieces(members, _centres(self._keys[members])):
                 if np.median(self._seen[piece]) < MIN_SEEN_PART:
                     continue
+                below = _centres(self._keys[piece])[:, 2] < floor_z_m - SUNK_M
+                if np.mean(below) >= SUNK_SHARE:
+                    continue  # the floor seen at range: its noise spreads below it as above
+                piece = piece[~below]  # a few stray points under the floor: no part of the thing
                 out += self._bodies(piece, bodies[piece], (tops, ceiling_z_m), taken, uuids)
         return out
 
@@ -253,10 +258,10 @@ class SolidMap:
                 levels: tuple[Sequence[_Support], float | None], taken: Sequence[Box3D],
                 uuids: list[str]) -> list[SolidPart]:
         """The objects of one piece (voxel indices): the bodies its firm voxels part it into
-        (``body``: their labels) when each of them is an object by itself, standing where it
-        is; else the piece as one object."""
+        (``body``: their labels; a body is firm for the most part) when each of them
+        is an object by itself, standing where it is; else the piece as one object."""
         split = [piece[body == b] for b in np.unique(body)]
-        split = [s for s in split if len(s) >= MIN_VOXELS and np.median(self._seen[s]) >= MIN_SEEN_PART]
+        split = [s for s in split if len(s) >= MIN_VOXELS and np.median(self._seen[s]) >= FIRM_SEEN]
         if len(split) >= 2 and _necked(self._keys, split):
             parts = [self._part(s, levels, taken, uuids) for s in split]
             kept = [p for p in parts if p is not None]
