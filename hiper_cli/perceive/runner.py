@@ -53,7 +53,7 @@ def run_stages(
     each frame as soon as it is read, without waiting for the next (a live stream), and hands
     the frame itself to ``prepare`` first (its detector runs while the stages before run). A frame
     that cannot be read raises its error after the frames before it are processed and handed
-    to ``on_frame``; ``finish`` does not run then.
+    to ``on_frame``; ``finish`` does not run then. ``finish`` runs the stages in reverse order.
     """
     world = world if world is not None else World()
     stats = RunStats()
@@ -98,7 +98,9 @@ def run_stages(
     if unreadable is not None:
         raise unreadable
     final = FrameResult()
-    for stage in stages:
+    # last stage first: each flushes what it built on the stages before it while they still
+    # hold what they held during the log (the background withdraws its unconfirmed walls last)
+    for stage in reversed(stages):
         result = stage.finish(world)
         world.apply(result)
         final.extend(result)

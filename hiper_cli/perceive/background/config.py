@@ -101,12 +101,11 @@ class BackgroundConfig:
     # a vertical plane seen up to the image's top and down to an occluder in front is as tall
     # as the view shows it: the wall height test is waived (``bounds.view_bounded``)
     wall_view_bounded: bool = True
-    # a view whose depth noise (cell_noise_m times its range squared) exceeds this starts no
-    # wall, it only extends one a nearer view mapped (``wall_range.py``; 0.045: 4.2 m with the
-    # default noise model). Off (0): on the degraded bookstore it takes the background's
-    # semantic precision from 0.78 to 1.00, but the planes it leaves out become foreground
-    # clutter on office 62 and the degraded house 61 (docs/results/2026-12-07-degraded-background.md)
-    wall_view_max_noise_m: float = 0.0
+    # a view whose depth noise (cell_noise_m times its range squared) exceeds this is no
+    # evidence of a wall: a shelf front's rows and a door flush with its wall hide in it. A wall
+    # instance no nearer view joined is withdrawn when the log ends (``wall_range.py``; 0.045:
+    # 4.2 m with the default noise model; 0: every view counts)
+    wall_view_max_noise_m: float = 0.045
     # a furniture front stands before a wall (``fronts.py``): past a side edge the camera sees a
     # plane parallel to it this far behind; deeper than a door's recess in its wall (a wall's
     # thickness), no deeper than furniture (wardrobes, fridges, shelves: 0.3-0.8 m)

@@ -34,7 +34,7 @@ from hiper_cli.perceive.background.planes import PlaneSegment, SampleGrid, extra
 from hiper_cli.perceive.background.sighting import sighted
 from hiper_cli.perceive.background.table_votes import TableVotes
 from hiper_cli.perceive.background.under import under_evidence
-from hiper_cli.perceive.background.wall_range import unconfirmed_far_wall
+from hiper_cli.perceive.background.wall_range import FarWalls
 from hiper_cli.perceive.stage import FrameResult, World
 from hiper_cli.types import Frame
 
@@ -187,6 +187,7 @@ class BackgroundStage:
         self._next_seen: bool | None = None
         self._not_walls = NotWalls(self.config)
         self._table_votes = TableVotes(self.config)
+        self._far_walls = FarWalls(self.config)
         _warm_up(self.config.method)
 
     def is_keyframe(self, stamp_s: float) -> bool:
@@ -217,8 +218,7 @@ class BackgroundStage:
             mo = to_map(obs, frame.T_map_cam)
             if obs.class_name == "wall" and self._not_walls.covers(mo):
                 continue  # a plane seen ending in the room before: not a wall
-            if unconfirmed_far_wall(mo, live.values(), self.config):
-                continue  # seen from too far to tell a wall from a front or a door
+            self._far_walls.note(obs)  # seen from too far to tell a wall from a front or a door?
             if "under" in obs.data and not self._table_votes.vote(mo, obs.data["under"]):
                 continue  # a top most views saw on a solid front: not a table
             kept.append(mo)
@@ -244,4 +244,6 @@ class BackgroundStage:
         )
 
     def finish(self, world: World) -> FrameResult:
-        return FrameResult()
+        """Withdraw the walls no view saw near enough to tell from a door or a front
+        (``wall_range.py``)."""
+        return FrameResult(deleted_instances=self._far_walls.unconfirmed(world.background.values()))
