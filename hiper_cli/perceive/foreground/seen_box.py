@@ -50,6 +50,8 @@ class SeenBox:
     classes: list[str] = field(default_factory=list)  # per blob: the class its view gave it
     _cache: tuple[int, FloatArray, FloatArray] | None = field(default=None, repr=False)
     _moved: tuple[int, bool] | None = field(default=None, repr=False)
+    # per-blob lists as arrays (rows of the lists at their current length; ``_array``)
+    _arrays: dict[str, NDArray[Any]] = field(default_factory=dict, repr=False)
 
     def add(
         self,
@@ -77,6 +79,7 @@ class SeenBox:
             del self.tops_hidden[:-MAX_SEEN_BOXES]
             del self.bottoms_hidden[:-MAX_SEEN_BOXES]
             del self.classes[:-MAX_SEEN_BOXES]
+            self._arrays.clear()
         self._cache = None
         self._moved = None
 
@@ -94,35 +97,50 @@ class SeenBox:
         are trimmed in batches, so they may hold more)."""
         return per_blob[max(len(self.lower_m) - MAX_SEEN_BOXES, 0):]
 
-    def _used(self, per_blob: Sequence[Any]) -> NDArray[Any]:
-        """``per_blob`` (one value per blob) of the blobs the box is of: the latest
-        ``MAX_SEEN_BOXES``, the named ones alone when there are ``MIN_NAMED_BOXES`` of them."""
-        values = np.array(self._latest(per_blob))
-        named = np.array(self._latest(self.named), dtype=bool)
+    def _array(self, name: str) -> NDArray[Any]:
+        """The per-blob list ``name`` as one array, rows for the latest ``MAX_SEEN_BOXES``
+        blobs (``np.array`` of ``_latest``). Kept between calls and grown by the rows added
+        since: the box, its move and its viewpoint are read every frame, and converting up to
+        1200 small arrays each time cost more than the rest of the reading."""
+        values: list[Any] = getattr(self, name)
+        have = self._arrays.get(name)
+        if have is None or len(have) > len(values):
+            have = np.array(values)
+        elif len(have) < len(values):
+            have = np.concatenate([have, np.array(values[len(have):])]) if len(have) else np.array(values)
+        have.flags.writeable = False  # shared between calls: read only
+        self._arrays[name] = have
+        return have[max(len(values) - MAX_SEEN_BOXES, 0):]
+
+    def _used(self, per_blob: str) -> NDArray[Any]:
+        """The per-blob list ``per_blob`` (an attribute name) of the blobs the box is of: the
+        latest ``MAX_SEEN_BOXES``, the named ones alone when there are ``MIN_NAMED_BOXES`` of them."""
+        values = self._array(per_blob)
+        named = self._array("named").astype(bool, copy=False)
         return values[named] if int(named.sum()) >= MIN_NAMED_BOXES else values
 
     def _boxes(self) -> tuple[FloatArray, FloatArray]:
         """(lower, upper) corners (K, 3) of the blobs the box is of (``_used``)."""
-        return self._used(self.lower_m), self._used(self.upper_m)
+        return self._used("lower_m"), self._used("upper_m")
 
     def viewpoint(self) -> FloatArray | None:
         """The median camera position (map frame) of the blobs the box is of (``_used``); None
         when no blob had one."""
-        views = self._used(self.viewpoints_m).astype(np.float64).reshape(-1, 3)
+        views = self._used("viewpoints_m").astype(np.float64).reshape(-1, 3)
         views = views[np.isfinite(views).all(axis=1)]
         return np.median(views, axis=0) if len(views) else None
 
     def top_seen(self) -> bool:
         """Whether views showed the object's top: at least ``SEEN_BOX_QUANTILE`` of the blobs
         the box is of (``_used``), as many as its upper quantile needs, had it in view."""
-        return self._shown(self.tops_hidden)
+        return self._shown("tops_hidden")
 
     def bottom_seen(self) -> bool:
         """Whether views showed where the object stands: at least ``SEEN_BOX_QUANTILE`` of the
         blobs the box is of (``_used``), as many as its lower quantile needs, had its base in view."""
-        return self._shown(self.bottoms_hidden)
+        return self._shown("bottoms_hidden")
 
-    def _shown(self, hidden_per_blob: list[bool]) -> bool:
+    def _shown(self, hidden_per_blob: str) -> bool:
         """Whether at least ``SEEN_BOX_QUANTILE`` of the blobs the box is of (``_used``) were not
         hidden there (no blob: shown)."""
         hidden = self._used(hidden_per_blob).astype(bool)
@@ -162,7 +180,7 @@ class SeenBox:
         the horizontal (lower, upper) corners of the median box of the first quarter of them and
         of the last quarter."""
         if every_blob:
-            lower, upper = np.array(self._latest(self.lower_m)), np.array(self._latest(self.upper_m))
+            lower, upper = self._array("lower_m"), self._array("upper_m")
         else:
             lower, upper = self._boxes()
         k = max(len(lower) // 4, 1)

@@ -152,3 +152,34 @@ def test_a_walker_named_in_a_few_frames_only_went_its_way():
     assert track.class_name == "person"
     assert track.seen.shift_m() < 0.5 < track.seen.shift_m(every_blob=True)
     assert is_dynamic(track, tracker.config)
+
+
+def _readings(box):
+    """Everything a track reads from its seen box, as plain values."""
+    found = box.corners()
+    view = box.viewpoint()
+    return (None if found is None else (found[0].tolist(), found[1].tolist()),
+            None if view is None else view.tolist(), box.top_seen(), box.bottom_seen(), box.moved(),
+            box.shift_m(), box.shift_m(every_blob=True))
+
+
+def test_the_kept_arrays_read_as_the_lists_do_while_blobs_come_and_go():
+    """``SeenBox`` keeps its per-blob lists as arrays between reads (grown, reset on a trim):
+    after every blob, past two trims, a reused box reads exactly as one built afresh from its lists."""
+    from hiper_cli.perceive.foreground import seen_box
+
+    rng = np.random.default_rng(3)
+    box = SeenBox()
+    for k in range(2 * seen_box.MAX_SEEN_BOXES + 300):
+        lower = rng.normal(0.0, 0.05, 3) + (0.5 if k > 900 else 0.0)
+        view = None if k % 7 == 0 else rng.normal(0.0, 1.0, 3)
+        box.add(lower, lower + 1.0, named=k % 3 == 0, viewpoint_m=view, top_hidden=k % 4 == 0,
+                bottom_hidden=k % 5 == 0, class_name="chair")
+        if k % 37 and k not in (1, 2, 1200, 1201):
+            continue
+        fresh = SeenBox(box.lower_m, box.upper_m, box.named, box.viewpoints_m, box.tops_hidden,
+                        box.bottoms_hidden, box.classes)
+        assert _readings(box) == _readings(fresh)
+    assert len(box.lower_m) < 2 * seen_box.MAX_SEEN_BOXES  # trimmed on the way
+    with pytest.raises(ValueError):
+        box._array("lower_m")[0, 0] = 1.0  # shared between reads: read only
