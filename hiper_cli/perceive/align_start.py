@@ -36,7 +36,7 @@ MIN_CONSTRAINT = 0.03  # eigenvalue share of the weighted points under which a d
 KERNEL_M = 0.03  # Cauchy scale of the point-to-plane residuals
 DISTANCES_M = (0.2, 0.1, 0.05)  # correspondence gates, coarse to fine
 ITERATIONS = 100  # per gate at most; a gate ends when a step moves less than ``CONVERGED``
-CONVERGED = 1e-5  # metres, radians
+CONVERGED = 1e-4  # metres, radians: a step this small moves no point of a room by a millimetre
 NORMAL_NEIGHBOURS = 12
 MAX_CURVATURE = 0.1  # map points whose neighbourhood is not planar give no normal
 
