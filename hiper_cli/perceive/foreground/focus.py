@@ -30,9 +30,10 @@ from hiper_cli.types import Detections, Frame
 
 __all__ = ["FOCUS_MAX_LOOKS", "FOCUS_MIN_SIDE_PX", "FOCUS_PER_S", "FOCUS_SIDE", "FocusedLook", "focus_box"]
 
-FOCUS_PER_S: float = 2.0
-"""Focused looks per second of log, at most (0: none). One detector run each (YOLOX-Nano, about
-11 ms of CPU): two a second add under 1 ms a frame at 30 Hz."""
+FOCUS_PER_S: float = 6.0
+"""Focused looks per second of log, at most (0: none): a question is in view for a few seconds.
+One detector run each (YOLOX-Nano, about 11 ms of CPU); they run only while a track is a
+question, ``FOCUS_MAX_LOOKS`` at most each, so a log spends a few dozen in all."""
 FOCUS_MAX_LOOKS: int = 8
 """Focused looks per track, at most: enough to confirm or refuse its hypothesis."""
 FOCUS_SIDE: float = 2.0
