@@ -43,6 +43,14 @@ counts in a vote of its own: a known class named in at least ``CLOSER_MIN_LOOKS`
 ``unknown`` counts as much as a name), not too short for the class. A track the every-frame vote
 leaves ``unknown`` takes that vote's winner; the every-frame vote never sees the closer look.
 
+A focused look (``focus.py``) crops the image around a track the every-frame detector named a
+class the vote does not show (``is_question``) and runs the detector on the crop: the object at
+several times the pixels, whole, in the middle. Each focused look counts once in a vote of its
+own (``record_focus``, ``unknown`` for a crop that named nothing on the object): the track's
+every-frame hypothesis is named when ``FOCUS_MIN_LOOKS`` focused looks gave it too and it has
+``FOCUS_SHARE`` of them (two looks at different scales agreeing on the object). A class only the
+crops gave names nothing: a crop, enlarged, sees things in texture (a cart as a chair).
+
 The tallies live on the ``Track`` (``class_votes``, ``class_counts``, ...); these functions
 record, merge and read them. ``Track._class_name`` caches the winner; ``record`` and
 ``absorb_votes`` clear it.
@@ -54,7 +62,10 @@ from typing import Protocol
 
 from hiper_cli.perceive.foreground.plausible import min_longest_m
 
-__all__ = ["UNKNOWN", "absorb_votes", "named_object", "record", "search_class", "shown_class", "winner"]
+__all__ = [
+    "UNKNOWN", "absorb_votes", "is_question", "named_object", "record", "record_focus", "search_class",
+    "shown_class", "winner",
+]
 
 UNKNOWN = "unknown"
 CONTRADICTED_VIEWS: int = 1
@@ -105,6 +116,7 @@ class Track(Protocol):
     full_named: dict[str, int]
     detected_classes: set[str]
     closer_counts: dict[str, int]
+    focus_counts: dict[str, int]
     min_class_observations: int
     min_class_share: float
     size_tolerance: float | None
@@ -117,6 +129,10 @@ MIN_VOTE_WEIGHT = 1e-3  # a known-class detection of score 0 still counts a litt
 CLOSER_MIN_LOOKS = 3
 """Closer looks (keyframes, ``keyframes.py``) that named a class before it wins the closer look's
 vote: keyframes are seconds apart, so three are three views, where frames at 30 Hz are one."""
+FOCUS_MIN_LOOKS = 3
+"""Focused looks (``focus.py``) that gave the every-frame hypothesis before it is named."""
+FOCUS_SHARE = 0.5
+"""... and their share of the track's focused looks, silent ones included."""
 
 
 def record(track: Track, m: Vote, unknown_vote_weight: float) -> None:
@@ -154,7 +170,21 @@ def absorb_votes(old: Track, new: Track) -> None:
     old.detected_classes |= new.detected_classes
     for cls, count in new.closer_counts.items():
         old.closer_counts[cls] = old.closer_counts.get(cls, 0) + count
+    for cls, count in new.focus_counts.items():
+        old.focus_counts[cls] = old.focus_counts.get(cls, 0) + count
     old._class_name = None
+
+
+def record_focus(track: Track, class_name: str) -> None:
+    """Count a focused look's answer on the track (``focus.py``; ``unknown``: it named nothing)."""
+    track.focus_counts[class_name] = track.focus_counts.get(class_name, 0) + 1
+    track._class_name = None
+
+
+def is_question(track: Track) -> bool:
+    """Whether a focused look could decide the track: the every-frame detector named it a class
+    (``search_class``) that its instance does not show."""
+    return search_class(track) != UNKNOWN and shown_class(track) == UNKNOWN
 
 
 def winner(track: Track, judged: bool = True) -> str:
@@ -183,10 +213,27 @@ def _closer_winner(track: Track, judged: bool = True) -> str:
     views refused stays refused whichever look gave it (``judged``, as in ``winner``)."""
     known = {k: n for k, n in track.closer_counts.items() if k != UNKNOWN}
     if not known:
-        return UNKNOWN
+        return _focused_winner(track, judged)
     best = max(sorted(known), key=lambda k: known[k])
     looks = sum(track.closer_counts.values())
     if known[best] < max(CLOSER_MIN_LOOKS, track.min_class_share * looks) or not _long_enough(track, best):
+        return _focused_winner(track, judged)
+    if judged and _refused(track, best):
+        return _focused_winner(track, judged)
+    return best
+
+
+def _focused_winner(track: Track, judged: bool = True) -> str:
+    """The every-frame hypothesis when the focused looks confirm it (module docstring), else
+    ``unknown``; a class the full views refused stays refused (``judged``)."""
+    known = {k: n for k, n in track.focus_counts.items() if k != UNKNOWN}
+    if not known:
+        return UNKNOWN
+    best = max(sorted(known), key=lambda k: known[k])
+    looks = sum(track.focus_counts.values())
+    if known[best] < max(FOCUS_MIN_LOOKS, FOCUS_SHARE * looks):
+        return UNKNOWN
+    if track.class_counts.get(best, 0) < track.min_class_observations or not _long_enough(track, best):
         return UNKNOWN
     if judged and _refused(track, best):
         return UNKNOWN
@@ -200,7 +247,7 @@ def shown_class(track: Track) -> str:
     name, votes = track.class_name, track.class_votes
     if name == UNKNOWN or votes.get(name, 0.0) >= SUPPORT_MARGIN * votes.get(UNKNOWN, 0.0):
         return name
-    # a class the closer looks chose was weighed against their own ``unknown`` looks
+    # a class the closer or focused looks chose was weighed against their own ``unknown`` looks
     return name if _closer_winner(track) == name else UNKNOWN
 
 

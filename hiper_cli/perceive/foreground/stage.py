@@ -27,9 +27,10 @@ from hiper_cli.perceive.foreground.amodal import (
 from hiper_cli.perceive.foreground.appearance import histogram
 from hiper_cli.perceive.foreground.background_filter import TABLE_LEG_BAND_M, table_leg_boxes
 from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTAINMENT, drop_carried
-from hiper_cli.perceive.foreground.class_vote import UNKNOWN, shown_class
+from hiper_cli.perceive.foreground.class_vote import UNKNOWN, is_question, record_focus, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.focus import FocusedLook, Question
 from hiper_cli.perceive.foreground.geometry_only import geometry_only
 from hiper_cli.perceive.foreground.held import HeldDetections
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
@@ -167,6 +168,9 @@ class ForegroundStage:
         self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
         # the quick look at cfg.detector_hz, the closer look at the static scene at keyframes
         self._keyframes = KeyframeLook(self.detector, cfg.detector, cfg.detector_hz)
+        # a crop around a track the every-frame looks left a question, a few times a second
+        self._focus = FocusedLook(self.detector, self._keyframes.looks_at_images)
+        self._measured: list[Blob | None] = []  # this frame's blob per measurement (``_focused``)
         self._large: list[Blob] = []  # this frame's clusters too large for one object (``_segment``)
 
     def _stands(self, class_name: str, blob: Blob) -> bool:
@@ -347,6 +351,7 @@ class ForegroundStage:
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
+        self._measured = []
         keyframe = self._solid.due(frame.stamp_s, frame.T_map_cam)
         # a keyframe's solid blobs but walkers' (``SolidMap``), those too large for one object too
         # (their points within the sensor's range: the slack beyond is for objects across it)
@@ -364,12 +369,14 @@ class ForegroundStage:
             measurement = self._measurement(frame, blob, match, dets, (obs, longest))
             closer = self._closer_class(frame, scene, blob)  # a keyframe's closer look (``keyframes.py``)
             measurements.append(measurement if closer is None else replace(measurement, closer_class=closer))
+            self._measured.append(None if measurement.cut_by_border else blob)
         for blob in found_tables if UNSEEN_TABLE_INSTANCES else []:
             obs = self._observation(frame, blob, table_match(), dets)
             observations.append(obs)
             surfaces.append(blob.points_map)
             measurements.append(Measurement(blob.center_map_m, blob.extent_map_m, TABLE_CLASS, TABLE_SCORE,
                                             obs.uuid, bounds_map_m=_corners(blob)))
+            self._measured.append(None)
         if keyframe:
             self._solid.add(frame, held)
             self._relief.add(frame, self._walls)
@@ -438,8 +445,11 @@ class ForegroundStage:
         """The class a keyframe's closer look gives ``blob`` when its tile held it whole
         (``keyframes.py``), by the same matching and checks as every frame's; None: no such look."""
         dets = self._keyframes.closer_detections(frame, blob.image_box_xyxy)
-        if dets is None:
-            return None
+        return None if dets is None else self._class_from(frame, scene, blob, dets)
+
+    def _class_from(self, frame: Frame, scene: _Background, blob: Blob, dets: Detections) -> str:
+        """The class a look's detections ``dets`` give ``blob``, by the same matching and checks
+        as every frame's."""
         cfg = self.config  # the classes the stage names, one name per box (as ``_detections``)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
@@ -448,6 +458,26 @@ class ForegroundStage:
         (match,) = assign_classes(blob.image_box_xyxy.reshape(1, 4), dets, iou_threshold=cfg.iou_threshold,
                                   min_score=cfg.min_detection_score, unknown=UNKNOWN)
         return self._judged(frame, scene, blob, match)[0].class_name
+
+    def _focused(self, frame: Frame, scene: _Background, joined: list[str | None]) -> None:
+        """The focused looks this frame may spend (``focus.py``), on the tracks that are a
+        question and whose blob this frame shows inside the image; their answers counted."""
+        budget = self._focus.due(frame.stamp_s)
+        if not budget:
+            return
+        tracks = {t.uuid: t for t in self.tracker.tracks}
+        questions: list[Question] = []
+        blobs: dict[str, Blob] = {}
+        for blob, uuid in zip(self._measured, joined, strict=True):
+            track = tracks.get(uuid) if uuid is not None and blob is not None else None
+            if track is not None and blob is not None and is_question(track):
+                questions.append(Question(track.uuid, sum(track.focus_counts.values()), blob.image_box_xyxy))
+                blobs[track.uuid] = blob
+        for question in self._focus.pick(questions, budget):
+            dets = self._focus.look(frame, question.xyxy)
+            if dets is not None:
+                class_name = self._class_from(frame, scene, blobs[question.uuid], dets)
+                record_focus(tracks[question.uuid], class_name)
 
     def _track(
         self, frame: Frame, scene: _Background,
@@ -458,6 +488,7 @@ class ForegroundStage:
         track stitched into another, one whose evidence failed, a table the background mapped)."""
         observations, measurements, surfaces = measured
         changed, joined = self.tracker.step(frame.stamp_s, measurements, self._visibility(frame))
+        self._focused(frame, scene, joined)
         tables_withdrawn = (
             withdraw_mapped(self.tracker, scene.tables, TABLE_LEG_REACH_M)
             if UNSEEN_TABLE_INSTANCES else []

@@ -147,6 +147,8 @@ class Track:
     detected_classes: set[str] = field(default_factory=set)  # classes a detection gave it
     # the vote of the keyframes' closer looks alone (``Measurement.closer_class``)
     closer_counts: dict[str, int] = field(default_factory=dict)
+    # the vote of the focused looks at it (``focus.py``, ``class_vote.record_focus``)
+    focus_counts: dict[str, int] = field(default_factory=dict)
     refused_min_views: int = 0  # ``TrackerConfig.refused_min_views`` (0: off)
     min_class_observations: int = 1
     min_class_share: float = 0.0

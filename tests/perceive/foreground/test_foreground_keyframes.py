@@ -126,7 +126,7 @@ def _tallies():
     return SimpleNamespace(
         class_votes={}, class_counts={}, class_longest_m={}, full_views=0, full_named={},
         detected_classes=set(),
-        closer_counts={}, min_class_observations=4, min_class_share=0.6, size_tolerance=None,
+        closer_counts={}, focus_counts={}, min_class_observations=4, min_class_share=0.6, size_tolerance=None,
         refused_min_views=0, refused_max_share=0.0, _class_name=None)
 
 
