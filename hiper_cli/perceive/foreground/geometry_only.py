@@ -4,6 +4,11 @@ Three sources, each kept as one static ``unknown`` instance with its box (issue 
 the solid things no track became (``solid_map.py``: standing on the floor or a support, outside
 the background and every instance), the tables whose tops the background maps but no instance
 holds (``supports.table_bodies``), and what stands proud of the walls (``wall_relief.py``).
+
+A mapped table's body is the same real object as the background's table instance: it carries
+that instance's uuid (``data["same_object_as"]``, so the query layer counts the table once),
+and the name its views give it (``table_views.py``: ``table`` when the detector named it in
+``min_views`` views, else ``unknown``).
 """
 
 from __future__ import annotations
@@ -17,10 +22,13 @@ from hiper_cli.perceive.foreground.class_vote import UNKNOWN
 from hiper_cli.perceive.foreground.moving import at_rest
 from hiper_cli.perceive.foreground.solid_map import SolidMap, SolidPart
 from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes, table_bodies
+from hiper_cli.perceive.foreground.table_views import TableViews
 from hiper_cli.perceive.foreground.unmapped_tables import TABLE_CLASS
 from hiper_cli.perceive.foreground.wall_relief import WallRelief
 
-__all__ = ["geometry_only", "grown_box", "solid_instance"]
+__all__ = ["SAME_OBJECT_KEY", "geometry_only", "grown_box", "solid_instance"]
+
+SAME_OBJECT_KEY = "same_object_as"  # data key: the uuid of the other layer's instance of this object
 
 VOXEL_MARGIN_M = 0.1  # a background box grown by this on each side holds the voxels of its surface
 STRUCTURE_CLASSES = ("wall", "door")  # background pieces that stand from the floor to the ceiling
@@ -29,10 +37,12 @@ WALL_NOISE_M = 0.05  # ... and across their face a further depth noise of a wall
 
 
 def geometry_only(background: Sequence[Instance], taken: Sequence[Box3D], own: Sequence[Instance],
-                  solid: SolidMap, relief: WallRelief) -> list[Instance]:
-    """The ``unknown`` instances of the solid things, mapped tables and wall relief no instance
-    holds: ``taken``, the boxes of every foreground instance; ``own``, this session's instances
-    (their unnamed and table pieces may continue a mapped table's top)."""
+                  solid: SolidMap, relief: WallRelief, views: TableViews | None = None,
+                  min_views: int = 1) -> list[Instance]:
+    """The instances of the solid things, mapped tables and wall relief no instance holds:
+    ``taken``, the boxes of every foreground instance; ``own``, this session's instances
+    (their unnamed and table pieces may continue a mapped table's top); ``views``, the views
+    that named tables (a mapped table's body named in ``min_views`` of them is a ``table``)."""
     grown = [grown_box(i.box, tall=i.class_name in STRUCTURE_CLASSES) for i in background]
     ceilings = [float(i.box.aabb()[0][2]) for i in background if i.class_name == "ceiling"]
     floor_z_m = floor_height_m(background)
@@ -42,8 +52,15 @@ def geometry_only(background: Sequence[Instance], taken: Sequence[Box3D], own: S
     pieces = [i.box for i in (*own, *parts)
               if i.layer == "foreground" and i.class_name in (UNKNOWN, TABLE_CLASS)]
     bodies = table_bodies(background, floor_z_m, [*taken, *(i.box for i in parts)], pieces)
-    parts += [solid_instance(SolidPart(box, t.first_seen_s, t.last_seen_s, [], t.confidence,
-                                       np.round(top, 3).tolist())) for t, box, top in bodies]
+    named = views.named_views([(box, top) for _, box, top in bodies]) if views else [0] * len(bodies)
+    for (table, box, top), n_named in zip(bodies, named, strict=True):
+        body = solid_instance(SolidPart(box, table.first_seen_s, table.last_seen_s, [], table.confidence,
+                                        np.round(top, 3).tolist()))
+        body.data[SAME_OBJECT_KEY] = table.uuid
+        body.data["named_views"] = n_named
+        if n_named >= min_views:
+            body.class_name = TABLE_CLASS
+        parts.append(body)
     # and the objects hung on the walls
     hung = relief.parts(floor_z_m, [*taken, *(i.box for i in parts)])
     return parts + [solid_instance(p) for p in hung]
