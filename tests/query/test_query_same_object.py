@@ -13,7 +13,7 @@ import pytest
 from hiper_cli.graph import open_kb
 from hiper_cli.graph.exchange import export_kb, import_kb
 from hiper_cli.model import Box3D, FrameResult, Instance, Observation
-from hiper_cli.query import ask
+from hiper_cli.query import ask, count
 
 
 def _top(x_m: float) -> Instance:
@@ -58,6 +58,8 @@ def test_a_table_found_by_both_layers_is_counted_once(kb_path):
     assert _ask(kb_path, "how many tables").count == 3
     assert _ask(kb_path, "how many chairs").count == 1
     assert _ask(kb_path, "how many unknown objects").count == 0  # the unnamed body is its table
+    with open_kb(kb_path) as kb:  # the agent's and MCP's count verb
+        assert count(kb, "table") == 3
 
 
 def test_the_closest_table_answers_the_table_once(kb_path):
