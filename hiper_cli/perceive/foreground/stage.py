@@ -499,7 +499,7 @@ class ForegroundStage:
             earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
-        instances += self._geometry_only(world, instances)
+        instances += [i for i in self._geometry_only(world, instances) if all(i is not j for j in instances)]
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
 
     def _fold_pieces(self) -> tuple[list[str], list[Instance]]:

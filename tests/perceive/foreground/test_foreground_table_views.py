@@ -116,3 +116,20 @@ def test_the_stage_keeps_the_views_its_detector_named_a_table_in() -> None:
     dets, _ = stage._detections(_frame(0.0), None)
     assert len(stage._table_views) == 1
     assert TABLE_DETECTOR_CLASSES[0] not in dets.class_names  # the frame's own detections drop it
+
+
+def test_an_unnamed_instance_that_holds_the_table_is_that_table() -> None:
+    stage = ForegroundStage(detector="log")
+    world = World(background={i.uuid: i for i in (FLOOR, TABLE)})
+    ((_, body_box, _),) = table_bodies([FLOOR, TABLE], 0.0, [], [])
+    held = Instance("foreground", "unknown", Box3D(body_box.center_m, body_box.extent_m * 0.95), 1.0, 9.0)
+    chair_box = Box3D(np.array([2.0, 2.3, 0.45]), np.array([0.5, 0.5, 0.9]))
+    chair = Instance("foreground", "chair", chair_box, 1.0, 9.0)
+    stage._table_views = _views(stage.config.min_class_observations)
+    (back,) = stage._geometry_only(world, [held, chair])  # no body of its own: the instance holds it
+    assert back is held and held.class_name == "table" and held.data["same_object_as"] == TABLE.uuid
+    assert chair.class_name == "chair" and "same_object_as" not in chair.data
+    stage._table_views = TableViews(min_score=0.3)  # no view named it: the same object, unnamed
+    other = Instance("foreground", "unknown", Box3D(body_box.center_m, body_box.extent_m * 0.95), 1.0, 9.0)
+    (back,) = stage._geometry_only(world, [other])
+    assert back.class_name == "unknown" and back.data["same_object_as"] == TABLE.uuid
