@@ -228,6 +228,8 @@ def json_export(kb: KnowledgeBase, *, observations: bool = False) -> dict[str, A
             "observation_count": len(d.get("observation_uuids", [])),
             "speed_mps": speed_mps(d),
             "vacated_s": (d.get("data") or {}).get("vacated_s"),
+            # the other layer's instance of the same real object: count it once
+            "same_object_as": (d.get("data") or {}).get("same_object_as"),
             **({"observation_uuids": d["observation_uuids"]} if observations else {}),
             "data": d.get("data", {}) if observations else None,
         })
@@ -269,7 +271,8 @@ def _docs_from_json(data: Any, source: Path) -> list[tuple[str, dict[str, Any]]]
             "confidence": 1.0 if i.get("confidence") is None else i["confidence"],
             "observation_uuids": i.get("observation_uuids", []), "frame_id": i.get("frame", "map"),
             "data": {**(i.get("data") or {}),
-                     **({"vacated_s": i["vacated_s"]} if i.get("vacated_s") is not None else {})},
+                     **({"vacated_s": i["vacated_s"]} if i.get("vacated_s") is not None else {}),
+                     **({"same_object_as": i["same_object_as"]} if i.get("same_object_as") else {})},
         }))
     for k, a in enumerate(data.get("analyses", [])):
         out.append((f"analyses[{k}]", {**a, "type": "analysis"}))
@@ -330,7 +333,7 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, 
                 "instance_uuid": None, "data": {},
             })
         elif kind == "Instance":
-            env, vacated = one(p, "inEnvironment"), one(p, "vacatedS")
+            env, vacated, same = one(p, "inEnvironment"), one(p, "vacatedS"), one(p, "sameObjectAs")
             out.append({
                 "uuid": uuid, "type": "instance", "layer": layer, "class": one(p, "className"),
                 "box": {"center_m": _vec(one(p, "boxCenterM")), "extent_m": _vec(one(p, "boxExtentM"))},
@@ -338,7 +341,8 @@ def _docs_from_props(props: dict[str, dict[str, list[str]]]) -> list[tuple[str, 
                 "last_seen_s": float(one(p, "lastSeenS", 0.0)),
                 "state": one(p, "state", "static"), "confidence": float(one(p, "confidence", 1.0)),
                 "observation_uuids": links.get(iri, []), "frame_id": one(p, "frame", "map"),
-                "data": {} if vacated is None else {"vacated_s": float(vacated)},
+                "data": {**({} if vacated is None else {"vacated_s": float(vacated)}),
+                         **({"same_object_as": same.removeprefix("urn:uuid:")} if same else {})},
                 **({"env_uuid": env.removeprefix("urn:uuid:")} if env else {}),
             })
         elif kind == "Analysis":

@@ -163,6 +163,11 @@ def _check(doc: dict[str, Any]) -> None:
     data = doc.get("data", {})
     if isinstance(data, dict) and data.get("vacated_s") is not None:
         _finite(data["vacated_s"], "data.vacated_s")
+    if isinstance(data, dict) and data.get("same_object_as") is not None:
+        try:
+            _uuid(data, "same_object_as")
+        except _Bad as bad:
+            raise _Bad("data.same_object_as", bad.problem) from None
     if kind == "environment":
         _text(doc, "name")
     elif kind in ("instance", "observation"):

@@ -155,6 +155,9 @@ def doc_quads(kb_id: str, doc: dict[str, Any], detail: str = "summary") -> list[
             t.append((h("validToS"), _dbl(vacated)))
         t += [(h("validFromS"), _dbl(doc["first_seen_s"])),
               (h("presence"), ox.Literal("present" if vacated is None else "removed"))]
+        same = (doc.get("data") or {}).get("same_object_as")
+        if same:  # the other layer's instance of this real object (a mapped table's body: its top)
+            t.append((h("sameObjectAs"), node(str(same))))
         if doc.get("env_uuid"):
             t.append((h("inEnvironment"), node(doc["env_uuid"])))
     elif kind == "change":  # an event (``history.py``): PROV-O activity over the instance

@@ -9,6 +9,7 @@ detections of every frame before refinement and matching (so ``hiper perceive`` 
   (vehicles, street furniture, farm and wild animals, outdoor sports gear), plus
   ``dining table``: hiper's background layer already models tables (their top planes), so a
   table detection would only name the table's legs or a chair beside it as a foreground object;
+  the stage keeps those boxes apart to name the bodies of the mapped tables (``table_views.py``);
 - ``classes`` (default empty: all): an allow-list for one environment, e.g. the classes a
   house can contain; when given, every other class is dropped.
 

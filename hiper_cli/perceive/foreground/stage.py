@@ -62,6 +62,7 @@ from hiper_cli.perceive.foreground.solid_map import SolidMap, is_solid, overlap_
 from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
+from hiper_cli.perceive.foreground.table_views import TableViews
 from hiper_cli.perceive.foreground.tables import split_unseen_tables
 from hiper_cli.perceive.foreground.tracking import Measurement, Track, Tracker, object_box
 from hiper_cli.perceive.foreground.unmapped_tables import (
@@ -166,6 +167,7 @@ class ForegroundStage:
         self._surfaces = SurfaceSamples()  # per track, points of its blobs: ``data["surface_map"]``
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
         self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
+        self._table_views = TableViews(cfg.min_detection_score)  # names for the mapped tables' bodies
         # the quick look at cfg.detector_hz, the closer look at the static scene at keyframes
         self._keyframes = KeyframeLook(self.detector, cfg.detector, cfg.detector_hz)
         # a crop around a track the every-frame looks left a question, a few times a second
@@ -275,6 +277,7 @@ class ForegroundStage:
             dets = self._held.at(frame)
         else:
             self._held.keep(frame, dets)
+            self._table_views.add(frame, dets)
         self._keyframes.join(frame, dets)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
@@ -530,7 +533,7 @@ class ForegroundStage:
             earlier, absorbed, counts = self._reidentify(world, static)
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
-        instances += self._geometry_only(world, instances)
+        instances += [i for i in self._geometry_only(world, instances) if all(i is not j for j in instances)]
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
 
     def _fold_pieces(self) -> tuple[list[str], list[Instance]]:
@@ -564,11 +567,12 @@ class ForegroundStage:
                 if i.class_name == UNKNOWN and i.state == "static" and not self._solid.confirmed(i.box)}
 
     def _geometry_only(self, world: World, instances: list[Instance]) -> list[Instance]:
-        """The ``unknown`` instances of what the depth shows solid and no instance holds
-        (``geometry_only.py``)."""
+        """The instances of what the depth shows solid and no instance holds: ``unknown``, or
+        ``table`` for a mapped table's body the detector named (``geometry_only.py``)."""
         own = [*self._instances.values(), *instances]
         taken = [i.box for i in (*world.foreground.values(), *own) if i.layer == "foreground"]
-        return geometry_only(list(world.background.values()), taken, own, self._solid, self._relief)
+        return geometry_only(list(world.background.values()), taken, own, self._solid, self._relief,
+                             self._table_views, self.config.min_class_observations)
 
     def _stays(self, inst: Instance) -> bool:
         """An object that stays where it was left: not a walker, nor an ``unknown`` that walked (a

@@ -66,21 +66,14 @@ def table_bodies(background: Iterable[Instance], floor_z_m: float, taken: Sequen
     background's box) never see. An instance holds it when its box (``taken``) covers
     ``COVERED_SHARE`` of the table's, or when a piece of an unnamed or table instance (``pieces``)
     continues the top (``_touches``): the table's other part."""
-    tables = [inst for inst in background if inst.class_name == "table"]
-    tables.sort(key=lambda inst: -float(np.prod(inst.box.extent_m[:2])))
     held, near = list(taken), list(pieces)
     out: list[tuple[Instance, Box3D, FloatArray]] = []
-    for inst in tables:
-        top = support_boxes([inst])[0]
-        lo, hi = top.aabb()
-        top_z = float(hi[2])
-        if top_z <= floor_z_m:
-            continue
-        lo = np.array([lo[0], lo[1], floor_z_m])
-        box = Box3D((lo + hi) / 2.0, hi - lo)
+    for inst, box in mapped_tables(background, floor_z_m):
+        lo, hi = box.aabb()
         if any(overlap_share(box, other) >= COVERED_SHARE for other in held) or any(
                 _touches(piece, lo, hi) for piece in near):
             continue
+        top_z = float(hi[2])
         inner = (hi[:2] - lo[:2]) * TOP_INSET
         u, v = np.meshgrid(np.linspace(lo[0] + inner[0], hi[0] - inner[0], TOP_GRID),
                            np.linspace(lo[1] + inner[1], hi[1] - inner[1], TOP_GRID))
@@ -90,6 +83,30 @@ def table_bodies(background: Iterable[Instance], floor_z_m: float, taken: Sequen
         held.append(box)
         near.append(box)
     return out
+
+
+def mapped_tables(background: Iterable[Instance], floor_z_m: float) -> list[tuple[Instance, Box3D]]:
+    """The background's tables, largest top first, each with its body's box: from the floor up
+    to its top, over the top's footprint (none for a top at or below the floor)."""
+    tables = [inst for inst in background if inst.class_name == "table"]
+    tables.sort(key=lambda inst: -float(np.prod(inst.box.extent_m[:2])))
+    out: list[tuple[Instance, Box3D]] = []
+    for inst in tables:
+        lo, hi = support_boxes([inst])[0].aabb()
+        if float(hi[2]) <= floor_z_m:
+            continue
+        lo = np.array([lo[0], lo[1], floor_z_m])
+        out.append((inst, Box3D((lo + hi) / 2.0, hi - lo)))
+    return out
+
+
+def holds(piece: Box3D, body: Box3D) -> float:
+    """How much ``piece`` is the table whose body is ``body``: the share of the body's volume it
+    covers when that reaches ``COVERED_SHARE``, or when it continues the top (``_touches``);
+    else 0."""
+    lo, hi = body.aabb()
+    share = overlap_share(body, piece)
+    return share if share >= COVERED_SHARE or _touches(piece, lo, hi) else 0.0
 
 
 def _touches(piece: Box3D, lo: FloatArray, hi: FloatArray) -> bool:
