@@ -181,7 +181,7 @@ class FreeBefore:
         support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
         if support >= self.SUPPORT_POINTS:
             return support, inside
-        below = np.sort(z[z < lo[2] - self.SUPPORT_M])[::-1]  # highest first
+        below = np.sort(z[z < lo[2] + margin])[::-1]  # highest first
         for n, top in enumerate(below):  # the first level (from the top) that holds most of them
             support = int(np.searchsorted(-below, -(top - self.SUPPORT_M), side="right")) - n
             if support >= max(self.SUPPORT_POINTS, 0.5 * len(below)):
