@@ -18,7 +18,10 @@ named no blob by IoU names the blob that is its visible part:
   something larger, or a small thing in a box of something else);
 - **the box fits the class at the blob's depth**: the box's size in metres at the blob's
   median depth is at most the class's largest size (``plausible.max_longest_m``): a thing far
-  behind a near bottle's box would make a bottle metres tall.
+  behind a near bottle's box would make a bottle metres tall), and the object stands at that
+  depth: the box's bottom edge placed at the blob's depth lies no lower than the mapped floor
+  (``FLOOR_SLACK_M``); a patch of floor seen past a bed, in the bed's box, would put the bed's
+  base under the floor.
 
 - **its top, across the box**: the blob reaches the box's top (``TOP_BAND``) and spans a
   third of its width (``ACROSS_SHARE``). What hides an object stands in front of it on the same
@@ -39,7 +42,7 @@ from numpy.typing import NDArray
 from hiper_cli.perceive.foreground.match import Match, iou_matrix
 from hiper_cli.perceive.foreground.plausible import CLASS_SIZE_TOLERANCE, max_longest_m
 from hiper_cli.perceive.foreground.segment import JOIN_CONTAINMENT, pixels_in_boxes
-from hiper_cli.types import CameraIntrinsics, Detections
+from hiper_cli.types import CameraIntrinsics, Detections, Frame
 
 __all__ = ["HIDDEN_DEPTH_GAP_M", "HIDDEN_PARTS", "HIDDEN_SHARE", "name_hidden"]
 
@@ -54,6 +57,8 @@ TOP_BAND: float = 0.15
 """The visible part's top lies within this share of the box's height from the box's top ..."""
 ACROSS_SHARE: float = 1.0 / 3.0
 """... and it spans at least this share of the box's width."""
+FLOOR_SLACK_M: float = 0.25
+"""The box's bottom, placed at the blob's depth, lies at most this below the mapped floor."""
 BEHIND_SHARE: float = 0.5
 """A blob with this share of its pixels in the box, behind the candidate, is the box's object."""
 
@@ -65,15 +70,18 @@ def name_hidden(
     pixels_uv: Sequence[NDArray[np.int32]],
     depths_m: Sequence[FloatArray],
     detections: Detections,
-    view: tuple[NDArray[np.float32], CameraIntrinsics, int],
+    frame: Frame,
+    step: int,
     *,
     min_score: float,
+    floor_z_m: float | None = None,
     min_inside: float = JOIN_CONTAINMENT,
 ) -> list[Match]:
     """``matches`` (one per blob; ``pixels_uv`` (N, 2) full-resolution pixels and ``depths_m``
     (N,) camera depths of each blob's points) with the unnamed blobs that a detection holds as
-    the visible part of a hidden object named by it (see the module docstring). ``view``: the
-    frame's depth image (metres), its camera and the segmentation's pixel step."""
+    the visible part of a hidden object named by it (see the module docstring). ``frame``: the
+    depth image, camera and pose; ``step``: the segmentation's pixel step; ``floor_z_m``: the
+    mapped floor's height (None: no floor mapped, no test of the base)."""
     out = list(matches)
     if len(detections) == 0 or not out:
         return out
@@ -87,8 +95,10 @@ def name_hidden(
         if (
             i is not None
             and _top_across(box, pixels_uv[i])
-            and _fits(box, medians[i], detections.class_names[k], view[1])
-            and _hidden_share(box, pixels_uv[i], medians[i], view) >= HIDDEN_SHARE
+            and _fits(box, medians[i], detections.class_names[k], frame.camera)
+            and (floor_z_m is None or _base_z_m(box, medians[i], frame) >= floor_z_m - FLOOR_SLACK_M)
+            and _hidden_share(box, pixels_uv[i], medians[i], (frame.depth_m, frame.camera, step))
+            >= HIDDEN_SHARE
         ):
             lo, hi = pixels_uv[i].min(axis=0), pixels_uv[i].max(axis=0)
             blob_box = np.array([lo[0], lo[1], hi[0] + 1, hi[1] + 1], dtype=np.float64)
@@ -132,6 +142,15 @@ def _fits(box: FloatArray, depth_m: float, class_name: str, camera: CameraIntrin
     width_m = (box[2] - box[0]) * depth_m / camera.fx
     height_m = (box[3] - box[1]) * depth_m / camera.fy
     return bool(max(width_m, height_m) <= max_longest_m(class_name, CLASS_SIZE_TOLERANCE))
+
+
+def _base_z_m(box: FloatArray, depth_m: float, frame: Frame) -> float:
+    """The map height of the box's bottom edge (its middle) placed at ``depth_m``: where the
+    object stands if it lies at the blob's depth."""
+    camera = frame.camera
+    u, v = 0.5 * (box[0] + box[2]), box[3]
+    point = np.array([(u - camera.cx) / camera.fx * depth_m, (v - camera.cy) / camera.fy * depth_m, depth_m])
+    return float((frame.T_map_cam[:3, :3] @ point + frame.T_map_cam[:3, 3])[2])
 
 
 def _hidden_share(

@@ -348,7 +348,8 @@ class ForegroundStage:
         if HIDDEN_PARTS:  # the visible part of an object hidden in part (``hidden.py``)
             matches = name_hidden(
                 matches, [b.pixels_uv for b in blobs], [b.points_cam[:, 2] for b in blobs], dets,
-                (frame.depth_m, frame.camera, cfg.pixel_step), min_score=cfg.min_detection_score,
+                frame, cfg.pixel_step, min_score=cfg.min_detection_score,
+                floor_z_m=self._floor_z_m if self._floor_mapped else None,
             )
         observations: list[Observation] = []
         measurements: list[Measurement] = []

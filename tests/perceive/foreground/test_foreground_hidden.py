@@ -4,12 +4,15 @@ import numpy as np
 
 from hiper_cli.perceive.foreground.hidden import name_hidden
 from hiper_cli.perceive.foreground.match import Match
-from hiper_cli.types import CameraIntrinsics, Detections
+from hiper_cli.types import CameraIntrinsics, Detections, Frame
 
 CAMERA = CameraIntrinsics(width=640, height=480, fx=525.0, fy=525.0, cx=319.5, cy=239.5)
 STEP = 4
 CHAIR_BOX = [300.0, 200.0, 380.0, 360.0]  # 0.6 m x 1.2 m at 4 m
 UNKNOWN = Match("unknown", 0.0, None, 0.0)
+T_MAP_CAM = np.array([[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0],
+                      [0.0, -1.0, 0.0, 1.0], [0.0, 0.0, 0.0, 1.0]])
+"""The camera 1 m above the floor (z = 0), looking along the map's x axis."""
 
 
 def _grid(u0, v0, u1, v1):
@@ -31,12 +34,14 @@ def _scene(front_m=3.0, back_m=4.0, wall_m=6.0):
     return depth, back
 
 
-def _name(blobs, depth, boxes=(("chair", CHAIR_BOX),), matches=None):
+def _name(blobs, depth, boxes=(("chair", CHAIR_BOX),), matches=None, floor_z_m=None):
     dets = Detections.from_records([{"xyxy": b, "class": c, "score": 0.9} for c, b in boxes])
     uvs = [uv for uv, _ in blobs]
     depths = [np.full(len(uv), z) for uv, z in blobs]
-    return name_hidden(matches or [UNKNOWN] * len(blobs), uvs, depths, dets, (depth, CAMERA, STEP),
-                       min_score=0.3)
+    rgb = np.zeros((CAMERA.height, CAMERA.width, 3), dtype=np.uint8)
+    frame = Frame(0.0, rgb, depth, CAMERA, T_MAP_CAM, 0)
+    return name_hidden(matches or [UNKNOWN] * len(blobs), uvs, depths, dets, frame, STEP, min_score=0.3,
+                       floor_z_m=floor_z_m)
 
 
 def test_a_chair_back_above_a_table_takes_the_chairs_box():
@@ -87,3 +92,10 @@ def test_a_blob_in_two_boxes_takes_the_one_it_fills_most():
     couch = [280.0, 190.0, 420.0, 400.0]  # a larger box around the chair's
     out = _name([(back, 4.0)], depth, boxes=(("couch", couch), ("chair", CHAIR_BOX)))
     assert out[0].class_name == "chair" and out[0].detection_index == 1
+
+
+def test_the_box_placed_at_the_blobs_depth_stands_no_lower_than_the_floor():
+    depth, back = _scene()  # the box's bottom at 4 m lies 0.08 m above the floor
+    assert _name([(back, 4.0)], depth, floor_z_m=0.0)[0].class_name == "chair"
+    # a floor 0.5 m higher: the object would stand 0.42 m under it (a patch of floor past a bed)
+    assert _name([(back, 4.0)], depth, floor_z_m=0.5)[0].class_name == "unknown"
