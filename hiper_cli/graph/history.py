@@ -119,11 +119,11 @@ def session_changes(
 
 class FreeBefore:
     """Whether the place's earlier sessions saw an object's space free: their background cloud
-    (``mapcloud.py``) holds the support under its footprint (``SUPPORT_POINTS`` points within
-    ``SUPPORT_M`` of its box's bottom) and hardly anything inside its box (at most
-    ``INSIDE_POINTS`` above the support band: ``SUPPORT_M``, or 30 % of a small object's
-    height). A space never seen, or one where something stood that was not recognised then,
-    is not free: an object found there is not an addition."""
+    (``mapcloud.py``) holds a support under its footprint (``SUPPORT_POINTS`` points within
+    ``SUPPORT_M`` of one level at or below its box's bottom: the floor, a table top) and hardly
+    anything between that support and the box's top (at most ``INSIDE_POINTS``). A space never
+    seen, or one where something stood that was not recognised then, is not free: an object
+    found there is not an addition."""
 
     SUPPORT_M = 0.08
     SUPPORT_POINTS = 2
@@ -162,7 +162,14 @@ class FreeBefore:
         return float(np.mean(np.isfinite(dist))) >= self.SURFACE_SHARE
 
     def _counts(self, inst: Instance) -> tuple[int, int]:
-        """Points of the earlier cloud over the box's footprint: in its support band, inside it."""
+        """Points of the earlier cloud over the box's footprint: in its support band, and in the
+        space from the support up to the box's top. The support is at the box's bottom (within
+        ``SUPPORT_M`` below it) or, when no points lie there, the highest level under the box
+        (a band ``SUPPORT_M`` thick) that holds most of the points under it (the floor, a table
+        top): a fused box need not reach what the object stands on (a plant whose pot no view
+        showed whole), and the space it stands in was free when nothing lay between that
+        support and the box's top. Points under the box spread over heights (the side of
+        something standing there) make no support."""
         if len(self.points) == 0:
             return 0, 0
         lo, hi = inst.box.aabb()
@@ -170,6 +177,13 @@ class FreeBefore:
         over = (p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0]) & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1])
         z = p[over, 2]
         margin = min(self.SUPPORT_M, 0.3 * float(hi[2] - lo[2]))  # a cup is barely taller than this
-        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
         inside = int(((z >= lo[2] + margin) & (z <= hi[2])).sum())
-        return support, inside
+        support = int(((z >= lo[2] - self.SUPPORT_M) & (z < lo[2] + margin)).sum())
+        if support >= self.SUPPORT_POINTS:
+            return support, inside
+        below = np.sort(z[z < lo[2] + margin])[::-1]  # highest first
+        for n, top in enumerate(below):  # the first level (from the top) that holds most of them
+            support = int(np.searchsorted(-below, -(top - self.SUPPORT_M), side="right")) - n
+            if support >= max(self.SUPPORT_POINTS, 0.5 * len(below)):
+                return support, inside + n  # what lay above the support and below the box
+        return 0, inside

@@ -137,3 +137,22 @@ def test_json_export_lists_changes_and_validity_and_imports_them_back(tmp_path):
     with open_kb(tmp_path / "copy") as copy:
         assert [c["kind"] for c in copy.changes()] == ["removed"]
         assert copy.instance(chair.uuid).state == "static"
+
+
+def test_an_addition_whose_box_misses_its_base_tests_the_space_down_to_its_support():
+    """A plant stored without its pot (box 0.5-0.8 m) was added where the floor was seen bare,
+    from the floor up; not where something stood under it, nor where nothing was seen below."""
+    floor = np.array([[x, y, 0.0] for x in np.arange(-0.5, 4.51, 0.08) for y in np.arange(-0.5, 0.51, 0.08)])
+    pot = np.array([[3.0 + 0.1 * np.cos(a), 0.1 * np.sin(a), z]
+                    for a in np.linspace(0, np.pi, 6) for z in np.arange(0.0, 0.41, 0.05)])
+    seen = FreeBefore(np.concatenate([floor[floor[:, 0] < 3.6], pot]))
+
+    def leaves(x):
+        return Instance(layer="foreground", class_name="potted plant", uuid=f"p{x}", first_seen_s=1.0,
+                        last_seen_s=5.0, box=Box3D(np.array([x, 0.0, 0.65]), np.array([0.3, 0.3, 0.3])))
+
+    assert seen(leaves(1.0))  # bare floor 0.5 m below the box
+    assert not seen(leaves(3.0))  # a pot stood there, unrecognised: its side spreads over heights
+    assert not seen(leaves(4.0))  # nothing seen under it
+    on_top = np.concatenate([floor, np.array([[1.0, 0.0, 0.3], [1.05, 0.02, 0.45]])])
+    assert not FreeBefore(on_top)(leaves(1.0))  # something between the floor and the box

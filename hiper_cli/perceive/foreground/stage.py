@@ -33,6 +33,7 @@ from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.focus import FocusedLook, Question
 from hiper_cli.perceive.foreground.geometry_only import geometry_only
 from hiper_cli.perceive.foreground.held import HeldDetections
+from hiper_cli.perceive.foreground.hidden import HIDDEN_PARTS, name_hidden
 from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
@@ -351,6 +352,12 @@ class ForegroundStage:
             min_score=cfg.min_detection_score,
             unknown=UNKNOWN,
         )
+        if HIDDEN_PARTS:  # the visible part of an object hidden in part (``hidden.py``)
+            matches = name_hidden(
+                matches, [b.pixels_uv for b in blobs], [b.points_cam[:, 2] for b in blobs], dets,
+                frame, cfg.pixel_step, min_score=cfg.min_detection_score,
+                floor_z_m=self._floor_z_m if self._floor_mapped else None,
+            )
         observations: list[Observation] = []
         measurements: list[Measurement] = []
         surfaces: list[FloatArray | None] = []
