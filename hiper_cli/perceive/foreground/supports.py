@@ -17,6 +17,7 @@ HORIZONTAL_PLANE_MIN_NZ = 0.9  # a support plane this close to horizontal (|n_z|
 SUPPORT_TOP_BELOW_BOX_M = 0.05  # ... when the plane's height lies this far below its box at most
 TOUCH_M = 0.1  # an unnamed piece reaching a table's top this near its footprint ... (``table_bodies``)
 ALONG_SHARE = 0.5  # ... and along this share of its side at least holds it: it is the table's other part
+UNDER_TOP_SHARE = 0.5  # a piece that is the table itself has this share of its footprint under the top
 TOP_GRID = 5  # a table's stored surface: TOP_GRID × TOP_GRID points on its top ...
 TOP_INSET = 0.1  # ... this share of its sides inside its edges (the background's extent is an estimate)
 
@@ -102,9 +103,16 @@ def mapped_tables(background: Iterable[Instance], floor_z_m: float) -> list[tupl
 
 def holds(piece: Box3D, body: Box3D) -> float:
     """How much ``piece`` is the table whose body is ``body``: the share of the body's volume it
-    covers when that reaches ``COVERED_SHARE``, or when it continues the top (``_touches``);
-    else 0."""
+    covers when that reaches ``COVERED_SHARE``, or when it continues the top (``_touches``),
+    and it lies mostly under the top (``UNDER_TOP_SHARE`` of its footprint within ``TOUCH_M``
+    of the top's: chairs in a row beside the table reach its side but stand beside it); else 0."""
     lo, hi = body.aabb()
+    p_lo, p_hi = piece.aabb()
+    inside = np.clip(np.minimum(p_hi[:2], hi[:2] + TOUCH_M) - np.maximum(p_lo[:2], lo[:2] - TOUCH_M),
+                     0.0, None)
+    footprint = float(np.prod(p_hi[:2] - p_lo[:2]))
+    if footprint <= 0.0 or float(np.prod(inside)) < UNDER_TOP_SHARE * footprint:
+        return 0.0
     share = overlap_share(body, piece)
     return share if share >= COVERED_SHARE or _touches(piece, lo, hi) else 0.0
 

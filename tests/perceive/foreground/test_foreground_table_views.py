@@ -133,3 +133,15 @@ def test_an_unnamed_instance_that_holds_the_table_is_that_table() -> None:
     other = Instance("foreground", "unknown", Box3D(body_box.center_m, body_box.extent_m * 0.95), 1.0, 9.0)
     (back,) = stage._geometry_only(world, [other])
     assert back.class_name == "unknown" and back.data["same_object_as"] == TABLE.uuid
+
+
+def test_chairs_in_a_row_beside_the_table_are_not_the_table() -> None:
+    # a piece along the table's side (reaching its top's height there) that stands mostly
+    # beside the top: the row of chairs at the table, fused as one unnamed piece
+    stage = ForegroundStage(detector="log")
+    world = World(background={i.uuid: i for i in (FLOOR, TABLE)})
+    row = Instance("foreground", "unknown", Box3D(np.array([2.0, 2.15, 0.45]), np.array([1.6, 1.0, 0.9])),
+                   1.0, 9.0)
+    stage._table_views = _views(stage.config.min_class_observations)
+    assert stage._geometry_only(world, [row]) == []  # the row holds no body, nor is it the table
+    assert row.class_name == "unknown" and "same_object_as" not in row.data
