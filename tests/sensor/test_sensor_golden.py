@@ -6,7 +6,8 @@ colour shifted 3, 2 px, 1.5 cm RMS pose drift), truth detector and truth backgro
 instances seen, classified centre error 0.016 m) the degraded one loses one chair to
 ``unknown`` and the drift adds about 4 cm of centre error: 2 chairs, 3 unknown, 6 seen, 0.058 m.
 The two tables the truth background maps are ``unknown`` objects too (``supports.table_bodies``):
-5 unknown.
+5 unknown. Chairs seen only in part behind nearer things are named by their boxes
+(``hidden.py``): 2 -> 4 chairs, 5 -> 4 unknown, 6 -> 7 seen, centre error 0.058 -> 0.078 m.
 """
 
 import pytest
@@ -29,8 +30,8 @@ def degraded(tmp_path_factory):
 
 def test_golden_table_iii_on_the_degraded_fixture(degraded):
     ours = evaluate_foreground(degraded, detector="truth", ablation=False, background="truth").ours
-    assert ours["classification"] == {"chair": {"tp": 2, "fp": 0}, "person": {"tp": 1, "fp": 0}}
-    assert ours["unknown_instances"] == 5 and ours["truth_instances_seen"] == 6
+    assert ours["classification"] == {"chair": {"tp": 4, "fp": 0}, "person": {"tp": 1, "fp": 0}}
+    assert ours["unknown_instances"] == 4 and ours["truth_instances_seen"] == 7
     assert ours["identity_switches"] == 0
-    assert ours["localisation_classified_m"][0] == pytest.approx(0.058, abs=0.015)
-    assert ours["localisation_box_centre_m"][0] == pytest.approx(0.133, abs=0.03)
+    assert ours["localisation_classified_m"][0] == pytest.approx(0.078, abs=0.015)
+    assert ours["localisation_box_centre_m"][0] == pytest.approx(0.135, abs=0.03)
