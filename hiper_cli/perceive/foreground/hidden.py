@@ -17,12 +17,11 @@ named no blob by IoU names the blob that is its visible part:
   object in plain view whose box its blob does not fill is no occluded object (a part of
   something larger, or a small thing in a box of something else);
 - **the box fits the class at the blob's depth**: the box's size in metres at the blob's
-  median depth is at most the class's largest size (``plausible.max_longest_m``): a thing far
+  median depth is at most the class's largest size (``plausible.max_longest_m``: a thing far
   behind a near bottle's box would make a bottle metres tall), and the object stands at that
   depth: the box's bottom edge placed at the blob's depth lies no lower than the mapped floor
   (``FLOOR_SLACK_M``); a patch of floor seen past a bed, in the bed's box, would put the bed's
-  base under the floor.
-
+  base under the floor;
 - **its top, across the box**: the blob reaches the box's top (``TOP_BAND``) and spans a
   third of its width (``ACROSS_SHARE``). What hides an object stands in front of it on the same
   floor and hides its lower part: its top shows, across the box. A patch of floor behind a
