@@ -12,7 +12,10 @@ standing in front of a chair's back is cut out of the chair's blob by its detect
 (``carve.py``, in one view): 5 -> 7 truth instances seen, one more ``unknown`` instance.
 Issue 53: the two tables the (truth) background maps are objects too (``supports.table_bodies``):
 2 -> 4 ``unknown`` instances, 6 -> 8 instances, with no new observation; and the picture on
-the wall at y = 0 stands proud of it (``wall_relief.py``): 5 ``unknown``, 9 instances.
+the wall at y = 0 stands proud of it (``wall_relief.py``): 5 ``unknown``, 9 instances. At
+commit 2638438 the fixture already gave chair 4/0, 10 instances, 8 truth instances seen and a
+classified localisation of 0.047 m (this test failed there); an unnamed object takes the name
+its views give it (``object_views.py``): a potted plant, 5 -> 4 ``unknown``.
 """
 
 import pytest
@@ -27,9 +30,10 @@ def test_golden_table_iii_on_the_fixture():
     report = evaluate_foreground(FIXTURE, detector="truth", ablation=False, background="truth")
     ours = report.ours
     assert report.to_dict()["ours"] is ours
-    assert ours["classification"] == {"chair": {"tp": 3, "fp": 0}, "person": {"tp": 1, "fp": 0}}
-    assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (5, 9, 104)
-    assert ours["identity_switches"] == 0 and ours["truth_instances_seen"] == 7
-    assert ours["localisation_classified_m"][0] == pytest.approx(0.0161, abs=0.003)
+    assert ours["classification"] == {"chair": {"tp": 4, "fp": 0}, "potted plant": {"tp": 1, "fp": 0},
+                                      "person": {"tp": 1, "fp": 0}}
+    assert (ours["unknown_instances"], ours["sum_i"], ours["sum_o"]) == (4, 10, 104)
+    assert ours["identity_switches"] == 0 and ours["truth_instances_seen"] == 8
+    assert ours["localisation_classified_m"][0] == pytest.approx(0.0467, abs=0.003)
     assert ours["localisation_visible_median_m"] == pytest.approx(0.0103, abs=0.003)
     assert ours["localisation_box_centre_m"][0] == pytest.approx(0.152, abs=0.03)
