@@ -45,9 +45,11 @@ from hiper_cli.perceive.foreground.table_views import (
     MIN_DEPTH_M,
     NAMED_IOU,
     SEEN_SHARE,
+    TABLE_DETECTOR_CLASSES,
     View,
     project,
 )
+from hiper_cli.perceive.foreground.unmapped_tables import TABLE_CLASS
 from hiper_cli.perceive.stage import World
 from hiper_cli.types import Detections, Frame
 
@@ -81,22 +83,24 @@ class ObjectViews:
     def __len__(self) -> int:
         return len(self._views)
 
-    def add(self, frame: Frame, detections: Detections, looked: bool = True) -> None:
+    def add(self, frame: Frame, detections: Detections, looked: bool = True,
+            tables: Detections | None = None) -> None:
         """Keep ``frame`` with the boxes of ``detections`` scored ``min_score`` or more (walkers
-        left out: a person names nothing that stays), when the detector ``looked`` at it and
-        ``step_s`` passed since the last kept; a view without boxes is kept too (it showed
-        objects the detector did not name)."""
+        left out: a person names nothing that stays), and the table boxes of ``tables`` (as
+        ``table``), when the detector ``looked`` at it and ``step_s`` passed since the last
+        kept; a view without boxes is kept too (it showed objects the detector did not name)."""
         if not looked or frame.stamp_s - self._last_s < self.step_s - STAMP_SLACK_S:
             return
         self._last_s = frame.stamp_s
-        names, scores = detections.class_names, detections.scores
-        keep = [k for k, (name, score) in enumerate(zip(names, scores, strict=True))
-                if score >= self.min_score and name not in self.walker_classes]
+        found = [(box, name, score) for box, name, score in _boxes(detections)
+                 if score >= self.min_score and name not in self.walker_classes]
+        found += [(box, TABLE_CLASS, score) for box, name, score in _boxes(tables)
+                  if score >= self.min_score and name in TABLE_DETECTOR_CLASSES]
         depth = np.ascontiguousarray(frame.depth_m[::DEPTH_STEP_PX, ::DEPTH_STEP_PX])
         T_cam_map = np.asarray(np.linalg.inv(frame.T_map_cam), dtype=np.float64)
-        boxes = np.asarray(detections.xyxy, dtype=np.float64).reshape(-1, 4)[keep]
-        self._views.append((View(T_cam_map, frame.camera, depth, boxes), tuple(names[k] for k in keep),
-                            np.asarray(scores, dtype=np.float64)[keep], frame.stamp_s))
+        boxes = np.array([box for box, _, _ in found], dtype=np.float64).reshape(-1, 4)
+        self._views.append((View(T_cam_map, frame.camera, depth, boxes), tuple(name for _, name, _ in found),
+                            np.array([score for _, _, score in found], dtype=np.float64), frame.stamp_s))
         if len(self._views) > MAX_VIEWS:
             self._views = self._views[::2]
             self.step_s *= 2.0
@@ -166,6 +170,15 @@ class _Scene:
         shown &= (front.sum(axis=1) >= 2) & (x1 > x0) & (y1 > y0) & (self.sizes > 0)
         whole = np.all(front & (cu >= 0) & (cu < cam.width) & (cv >= 0) & (cv < cam.height), axis=1)
         return np.column_stack([x0, y0, x1, y1]), shown, whole
+
+
+def _boxes(detections: Detections | None) -> list[tuple[FloatArray, str, float]]:
+    """The (box, class, score) of each detection (none for None)."""
+    if detections is None:
+        return []
+    xyxy = np.asarray(detections.xyxy, dtype=np.float64).reshape(-1, 4)
+    return [(xyxy[k], name, float(score))
+            for k, (name, score) in enumerate(zip(detections.class_names, detections.scores, strict=True))]
 
 
 def _named(view: View, classes: tuple[str, ...], scores: FloatArray, shown: list[int],

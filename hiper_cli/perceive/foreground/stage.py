@@ -282,11 +282,12 @@ class ForegroundStage:
             self._held.keep(frame, dets)
             self._table_views.add(frame, dets)
         self._keyframes.join(frame, dets)
+        tables = dets  # the table boxes the class filters drop name unnamed objects too (``object_views``)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
         dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
                             cfg.min_detection_score)
-        self._views.add(frame, dets, self._looked)
+        self._views.add(frame, dets, self._looked, tables)
         return dets, detect_s
 
     def _read_background(self, world: World) -> _Background:

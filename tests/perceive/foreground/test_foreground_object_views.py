@@ -142,3 +142,19 @@ def test_the_stage_names_its_unknowns_at_the_end_of_the_session() -> None:
     stage._instances[unknown.uuid] = unknown  # closed earlier: the world holds it already
     result = stage.finish(World(foreground={unknown.uuid: unknown}))
     assert [(i.uuid, i.class_name) for i in result.instances] == [(unknown.uuid, "chair")]  # written anew
+
+
+def test_the_table_boxes_the_class_filters_drop_name_an_unnamed_table() -> None:
+    class Tables:
+        name = "tables"
+
+        def detect(self, frame: Frame) -> Detections:
+            desk = _image_box(_object("unknown", 3.0, (1.2, 0.7, 0.75)))
+            return Detections(desk.reshape(1, 4), ("dining table",), np.array([0.8]))
+
+    stage = ForegroundStage(detector="log", detector_instance=Tables(), detector_threads=False)
+    for k in range(4 * NEED):
+        dets, _ = stage._detections(_frame(0.1 * k, 0.0), None)
+        assert len(dets) == 0  # no track takes a table box
+    desk = _object("unknown", 3.0, (1.2, 0.7, 0.75))
+    assert _named(stage._views, desk) == ["table"]
