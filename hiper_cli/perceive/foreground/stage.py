@@ -38,6 +38,7 @@ from hiper_cli.perceive.foreground.keyframes import KeyframeLook
 from hiper_cli.perceive.foreground.legs import TABLE_LEG_REACH_M, TABLE_RIM_DEPTH_M, drop_table_legs
 from hiper_cli.perceive.foreground.match import Match, assign_classes, named_within
 from hiper_cli.perceive.foreground.moving import at_rest, has_moved, is_static
+from hiper_cli.perceive.foreground.object_views import ObjectViews, name_by_views
 from hiper_cli.perceive.foreground.plausible import (
     CLASS_SIZE_TOLERANCE,
     FIXTURE_CLASSES,
@@ -169,6 +170,7 @@ class ForegroundStage:
         self._solid = SolidMap()  # solid surfaces fused at keyframes: geometry-only objects
         self._relief = WallRelief()  # ... and what stands proud of the walls: objects hung there
         self._table_views = TableViews(cfg.min_detection_score)  # names for the mapped tables' bodies
+        self._views = ObjectViews(cfg.min_detection_score, cfg.walker_classes)  # ... and unnamed objects'
         # the quick look at cfg.detector_hz, the closer look at the static scene at keyframes
         self._keyframes = KeyframeLook(self.detector, cfg.detector, cfg.detector_hz)
         # a crop around a track the every-frame looks left a question, a few times a second
@@ -280,10 +282,12 @@ class ForegroundStage:
             self._held.keep(frame, dets)
             self._table_views.add(frame, dets)
         self._keyframes.join(frame, dets)
+        tables = dets  # the table boxes the class filters drop name unnamed objects too (``object_views``)
         dets = filter_classes(dets, cfg.classes, cfg.exclude_classes)
         dets = one_name_per_box(dets, SAME_BOX_IOU, cfg.walker_classes)
         dets = drop_carried(dets, CARRIED_CLASSES, cfg.walker_classes, CARRIED_CONTAINMENT,
                             cfg.min_detection_score)
+        self._views.add(frame, dets, self._looked, tables)
         return dets, detect_s
 
     def _read_background(self, world: World) -> _Background:
@@ -541,6 +545,9 @@ class ForegroundStage:
             instances = [i for i in instances if i.uuid not in absorbed] + earlier
             gone += absorbed
         instances += [i for i in self._geometry_only(world, instances) if all(i is not j for j in instances)]
+        renamed = name_by_views(self._views, [*self._instances.values(), *instances], world, gone,
+                                self.config)  # the unnamed objects, by their views
+        instances += [i for i in renamed if all(i is not j for j in instances)]
         return FrameResult(instances=instances, deleted_instances=gone, counts=counts)
 
     def _fold_pieces(self) -> tuple[list[str], list[Instance]]:

@@ -25,7 +25,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.types import CameraIntrinsics, Detections, Frame
 
-__all__ = ["TABLE_DETECTOR_CLASSES", "TableViews"]
+__all__ = ["TABLE_DETECTOR_CLASSES", "TableViews", "View", "image_box", "project"]
 
 FloatArray = NDArray[np.float64]
 
@@ -39,7 +39,9 @@ MIN_DEPTH_M = 0.1  # points nearer than this to the camera are behind it
 
 
 @dataclass(frozen=True)
-class _View:
+class View:
+    """A kept detector frame: its camera, pose (map to camera), coarse depth and boxes."""
+
     T_cam_map: FloatArray
     camera: CameraIntrinsics
     depth_m: NDArray[np.float32]  # every DEPTH_STEP_PX-th pixel
@@ -51,7 +53,7 @@ class TableViews:
 
     def __init__(self, min_score: float) -> None:
         self.min_score = min_score
-        self._views: list[_View] = []
+        self._views: list[View] = []
 
     def __len__(self) -> int:
         return len(self._views)
@@ -68,7 +70,7 @@ class TableViews:
             return
         depth = np.ascontiguousarray(frame.depth_m[::DEPTH_STEP_PX, ::DEPTH_STEP_PX])
         T_cam_map = np.asarray(np.linalg.inv(frame.T_map_cam), dtype=np.float64)
-        self._views.append(_View(T_cam_map, frame.camera, depth,
+        self._views.append(View(T_cam_map, frame.camera, depth,
                                  np.asarray(detections.xyxy[keep], dtype=np.float64)))
 
     def named_views(self, bodies: Sequence[tuple[Box3D, FloatArray]]) -> list[int]:
@@ -77,7 +79,7 @@ class TableViews:
         in front of another is not evidence for both."""
         counts = [0] * len(bodies)
         for view in self._views:
-            image_boxes = [_image_box(view, box, points) for box, points in bodies]
+            image_boxes = [image_box(view, box, points) for box, points in bodies]
             shown = [k for k, b in enumerate(image_boxes) if b is not None]
             if not shown:
                 continue
@@ -92,11 +94,11 @@ class TableViews:
         return counts
 
 
-def _image_box(view: _View, box: Box3D, points: FloatArray) -> FloatArray | None:
+def image_box(view: View, box: Box3D, points: FloatArray) -> FloatArray | None:
     """The box (x0, y0, x1, y1, pixels, clipped to the image) of ``box`` seen in ``view``, or None
     when fewer than ``SEEN_SHARE`` of ``points`` are in the image and not hidden."""
     cam = view.camera
-    u, v, z = _project(view.T_cam_map, cam, points)
+    u, v, z = project(view.T_cam_map, cam, points)
     inside = (z > MIN_DEPTH_M) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
     if not inside.any():
         return None
@@ -106,7 +108,7 @@ def _image_box(view: _View, box: Box3D, points: FloatArray) -> FloatArray | None
     seen = (measured <= 0) | (z[inside] <= measured + HIDDEN_MARGIN_M)
     if int(seen.sum()) < SEEN_SHARE * len(points):
         return None
-    cu, cv, cz = _project(view.T_cam_map, cam, box.corners())
+    cu, cv, cz = project(view.T_cam_map, cam, box.corners())
     front = cz > MIN_DEPTH_M
     if int(front.sum()) < 2:
         return None
@@ -115,7 +117,7 @@ def _image_box(view: _View, box: Box3D, points: FloatArray) -> FloatArray | None
     return np.array([x0, y0, x1, y1]) if x1 > x0 and y1 > y0 else None
 
 
-def _project(T_cam_map: FloatArray, cam: CameraIntrinsics, points_map: FloatArray) -> tuple[
+def project(T_cam_map: FloatArray, cam: CameraIntrinsics, points_map: FloatArray) -> tuple[
         FloatArray, FloatArray, FloatArray]:
     """Pixel columns, rows and depths (m) of map points; points behind the camera get -1 pixels."""
     p = points_map @ T_cam_map[:3, :3].T + T_cam_map[:3, 3]
