@@ -30,6 +30,7 @@ from hiper_cli.perceive.foreground.carried import CARRIED_CLASSES, CARRIED_CONTA
 from hiper_cli.perceive.foreground.class_vote import UNKNOWN, is_question, record_focus, shown_class
 from hiper_cli.perceive.foreground.classes import filter_classes, one_name_per_box
 from hiper_cli.perceive.foreground.config import ForegroundConfig
+from hiper_cli.perceive.foreground.earlier import meet_earlier
 from hiper_cli.perceive.foreground.focus import FocusedLook, Question
 from hiper_cli.perceive.foreground.geometry_only import geometry_only
 from hiper_cli.perceive.foreground.held import HeldDetections
@@ -50,18 +51,8 @@ from hiper_cli.perceive.foreground.plausible import (
 )
 from hiper_cli.perceive.foreground.priors import LearnedPriors
 from hiper_cli.perceive.foreground.refine import refine_blobs
-from hiper_cli.perceive.foreground.reidentify import (
-    REIDENTIFY_MOVED_M,
-    cosighted_pairs,
-    fold,
-    fold_mover,
-    moved_pairs,
-    pairs,
-    still_seen,
-)
 from hiper_cli.perceive.foreground.segment import Blob, segment
 from hiper_cli.perceive.foreground.solid_map import SolidMap, is_solid, overlap_share
-from hiper_cli.perceive.foreground.stitch import STITCH_DUPLICATE_M, STITCH_MIN_OVERLAP, STITCH_OVERLAP_M
 from hiper_cli.perceive.foreground.supports import floor_height_m, support_boxes
 from hiper_cli.perceive.foreground.surface_samples import SurfaceSamples
 from hiper_cli.perceive.foreground.table_views import TableViews
@@ -603,53 +594,15 @@ class ForegroundStage:
             self._empty.look(self._projector(frame), frame.T_map_cam[:3, 3], frame.stamp_s)
 
     def _reidentify(self, world: World, static: set[str]) -> tuple[list[Instance], list[str], dict[str, int]]:
-        """Earlier sessions' instances that absorbed one of this session's static ones or a
-        walker seen at the same times (``reidentify.py``), or whose place this session saw
-        empty (``vacated.py``), the uuids of the instances absorbed, and how many were found
-        again, moved and vacated."""
-        earlier = {u: i for u, i in world.foreground.items() if u not in self._instances and self._stays(i)}
-        new = [i for u, i in self._instances.items() if u in static and self._stays(i)]
-        found = pairs(new, earlier.values(), min_share=STITCH_MIN_OVERLAP, max_gap_m=STITCH_OVERLAP_M)
-        paired = {u for e, n in found for u in (e.uuid, n.uuid)}
-        vacated = self._empty.vacated() if self._empty is not None else {}
-        # seen empty now, or by an earlier session: gone from where it was
-        gone = [i for u, i in earlier.items() if u not in paired and (u in vacated or "vacated_s" in i.data)]
-        # what was present until now left in the gap before this session: not for a place the
-        # earlier sessions saw occupied (``occupied_before``); one an earlier session already
-        # found gone may have gone anywhere then
-        occupied = self.occupied_before or (lambda _: False)
-        free = [n for n in new if n.uuid not in paired and not occupied(n)]
-        moved = moved_pairs([n for n in new if n.uuid not in paired],
-                            [i for i in gone if "vacated_s" in i.data], max_m=REIDENTIFY_MOVED_M)
-        taken = {u for e, n in moved for u in (e.uuid, n.uuid)}
-        moved += moved_pairs([n for n in free if n.uuid not in taken],
-                             [i for i in gone if "vacated_s" not in i.data], max_m=REIDENTIFY_MOVED_M)
-        found += moved
-        for old, absorbed in found:
-            fold(old, absorbed)
-            del self._instances[absorbed.uuid]
+        """Earlier sessions' instances found again, moved or vacated (``earlier.py``), the uuids
+        of this session's instances they absorbed, and the counts of each."""
         tracking = self.tracker.config
-        walkers = tracking.walker_classes
-        cosighted = cosighted_pairs(
-            [i for i in self._instances.values() if i.class_name in walkers],
-            [i for u, i in world.foreground.items() if u not in self._instances and i.class_name in walkers],
-            max_m=STITCH_DUPLICATE_M, min_common=tracking.confirm_hits,
+        return meet_earlier(
+            self._instances, world.foreground, static, stays=self._stays,
+            vacated=self._empty.vacated() if self._empty is not None else {},
+            occupied=self.occupied_before or (lambda _: False),
+            walkers=tracking.walker_classes, confirm_hits=tracking.confirm_hits,
         )
-        for old, absorbed in cosighted:
-            fold_mover(old, absorbed)
-            del self._instances[absorbed.uuid]
-        found += cosighted
-        joined = {old.uuid for old, _ in found}
-        left = [i for i in gone if i.uuid not in joined and "vacated_s" not in i.data]
-        # seen empty by its old points, yet seen at its place (not by another object found again)
-        there = still_seen(left, new, found_again=[n for _, n in found])
-        marked = [i for i in left if i.uuid not in there]
-        for inst in marked:
-            # never before it was last seen (logs whose stamps all start at 0 overlap in time)
-            inst.data["vacated_s"] = max(vacated[inst.uuid], inst.last_seen_s)
-        earlier_joined = list({old.uuid: old for old, _ in found}.values())
-        counts = {"found_again": len(earlier_joined), "moved": len(moved), "vacated": len(marked)}
-        return earlier_joined + marked, [absorbed.uuid for _, absorbed in found], counts
 
     # --- conversions ------------------------------------------------------------------------
     def _observation(self, frame: Frame, blob: Blob, match: Match, dets: Detections) -> Observation:
