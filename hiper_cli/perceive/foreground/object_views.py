@@ -31,7 +31,6 @@ from hiper_cli.model import Instance
 from hiper_cli.perceive.foreground.class_vote import CUT_VIEW_WEIGHT, SUPPORT_MARGIN, UNKNOWN
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.geometry_only import SAME_OBJECT_KEY
-from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.perceive.foreground.plausible import (
     CLASS_SIZE_TOLERANCE,
     FIXTURE_CLASSES,
@@ -41,13 +40,10 @@ from hiper_cli.perceive.foreground.plausible import (
 )
 from hiper_cli.perceive.foreground.table_views import (
     DEPTH_STEP_PX,
-    HIDDEN_MARGIN_M,
-    MIN_DEPTH_M,
-    NAMED_IOU,
-    SEEN_SHARE,
     TABLE_DETECTOR_CLASSES,
+    Scene,
     View,
-    project,
+    best_overlaps,
 )
 from hiper_cli.perceive.foreground.unmapped_tables import TABLE_CLASS
 from hiper_cli.perceive.stage import World
@@ -114,14 +110,14 @@ class ObjectViews:
         named it nothing, times ``CUT_VIEW_WEIGHT`` where the image's border cut it. Every
         instance takes part: each box names the one instance it overlaps most (``NAMED_IOU``).
         Third, per class the log time (s) from the first view that named it so to the last."""
-        scene = _Scene(instances)
+        scene = Scene([(i.box, _surface(i)) for i in instances])
         counts: list[dict[str, int]] = [{"seen": 0, "whole": 0} for _ in instances]
         votes: list[dict[str, float]] = [{UNKNOWN: 0.0} for _ in instances]
         spans: list[dict[str, tuple[float, float]]] = [{} for _ in instances]
         for view, classes, scores, stamp_s in self._views:
             boxes, shown_mask, whole_mask = scene.seen_in(view)
             shown = [int(k) for k in np.flatnonzero(shown_mask)]
-            named = _named(view, classes, scores, shown, boxes)
+            named = _named(view, classes, scores, boxes, shown_mask)
             for k in shown:
                 whole = bool(whole_mask[k])
                 weight = 1.0 if whole else CUT_VIEW_WEIGHT
@@ -137,41 +133,6 @@ class ObjectViews:
                 for c, v, f, a in zip(counts, votes, spans, asked, strict=True) if a]
 
 
-class _Scene:
-    """The instances' surfaces (``SURFACE_SAMPLES`` points each) and box corners, stacked, to
-    project them into a view at once (as ``table_views.image_box`` does one by one)."""
-
-    def __init__(self, instances: Sequence[Instance]) -> None:
-        surfaces = [_surface(i) for i in instances]
-        self.n = len(instances)
-        self.points = np.concatenate([*surfaces, np.zeros((0, 3))])
-        self.owner = np.repeat(np.arange(self.n), [len(p) for p in surfaces])
-        self.sizes = np.array([len(p) for p in surfaces], dtype=np.float64)
-        self.corners = np.concatenate([*(i.box.corners() for i in instances), np.zeros((0, 3))])
-
-    def seen_in(self, view: View) -> tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
-        """Per instance its image box (x0, y0, x1, y1, clipped to the image), whether ``view``
-        shows it (``SEEN_SHARE`` of its surface in the image, not hidden, its box in front) and
-        whether its whole box lies inside the image."""
-        cam = view.camera
-        u, v, z = project(view.T_cam_map, cam, self.points)
-        inside = (z > MIN_DEPTH_M) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
-        rows = np.clip((v / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[0] - 1)
-        cols = np.clip((u / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[1] - 1)
-        measured = view.depth_m[rows, cols]
-        seen = inside & ((measured <= 0) | (z <= measured + HIDDEN_MARGIN_M))
-        shown = np.bincount(self.owner, weights=seen, minlength=self.n) >= SEEN_SHARE * self.sizes
-        cu, cv, cz = (a.reshape(self.n, 8) for a in project(view.T_cam_map, cam, self.corners))
-        front = cz > MIN_DEPTH_M
-        x0 = np.clip(np.where(front, cu, np.inf).min(axis=1), 0, cam.width)
-        x1 = np.clip(np.where(front, cu, -np.inf).max(axis=1), 0, cam.width)
-        y0 = np.clip(np.where(front, cv, np.inf).min(axis=1), 0, cam.height)
-        y1 = np.clip(np.where(front, cv, -np.inf).max(axis=1), 0, cam.height)
-        shown &= (front.sum(axis=1) >= 2) & (x1 > x0) & (y1 > y0) & (self.sizes > 0)
-        whole = np.all(front & (cu >= 0) & (cu < cam.width) & (cv >= 0) & (cv < cam.height), axis=1)
-        return np.column_stack([x0, y0, x1, y1]), shown, whole
-
-
 def _boxes(detections: Detections | None) -> list[tuple[FloatArray, str, float]]:
     """The (box, class, score) of each detection (none for None)."""
     if detections is None:
@@ -181,18 +142,13 @@ def _boxes(detections: Detections | None) -> list[tuple[FloatArray, str, float]]
             for k, (name, score) in enumerate(zip(detections.class_names, detections.scores, strict=True))]
 
 
-def _named(view: View, classes: tuple[str, ...], scores: FloatArray, shown: list[int],
-           boxes: FloatArray) -> dict[int, dict[str, float]]:
-    """Per instance of ``shown`` (their image ``boxes``) that a box of ``view`` names, per class
-    the best score: each box names the instance it overlaps most, by ``NAMED_IOU`` at least."""
+def _named(view: View, classes: tuple[str, ...], scores: FloatArray, boxes: FloatArray,
+           shown: NDArray[np.bool_]) -> dict[int, dict[str, float]]:
+    """Per instance a box of ``view`` names (``best_overlaps``), per class the best score."""
     named: dict[int, dict[str, float]] = {}
-    if not shown or not classes:
-        return named
-    iou = iou_matrix(view.boxes_xyxy, boxes[shown])
-    for row, name, score in zip(iou, classes, scores, strict=True):
-        best = int(np.argmax(row))
-        if row[best] >= NAMED_IOU:
-            mine = named.setdefault(shown[best], {})
+    for k, name, score in zip(best_overlaps(view.boxes_xyxy, boxes, shown), classes, scores, strict=True):
+        if k >= 0:
+            mine = named.setdefault(k, {})
             mine[name] = max(mine.get(name, 0.0), float(score))
     return named
 

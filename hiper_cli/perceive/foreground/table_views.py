@@ -25,7 +25,7 @@ from hiper_cli.model import Box3D
 from hiper_cli.perceive.foreground.match import iou_matrix
 from hiper_cli.types import CameraIntrinsics, Detections, Frame
 
-__all__ = ["TABLE_DETECTOR_CLASSES", "TableViews", "View", "image_box", "project"]
+__all__ = ["TABLE_DETECTOR_CLASSES", "Scene", "TableViews", "View", "best_overlaps", "project"]
 
 FloatArray = NDArray[np.float64]
 
@@ -78,43 +78,58 @@ class TableViews:
         box named it. Each box names at most one body, the one it overlaps most: a table seen
         in front of another is not evidence for both."""
         counts = [0] * len(bodies)
+        scene = Scene(bodies)
         for view in self._views:
-            image_boxes = [image_box(view, box, points) for box, points in bodies]
-            shown = [k for k, b in enumerate(image_boxes) if b is not None]
-            if not shown:
-                continue
-            iou = iou_matrix(view.boxes_xyxy, np.array([image_boxes[k] for k in shown]))
-            named: set[int] = set()
-            for row in iou:
-                best = int(np.argmax(row))
-                if row[best] >= NAMED_IOU:
-                    named.add(shown[best])
-            for k in named:
+            boxes, shown, _ = scene.seen_in(view)
+            for k in {k for k in best_overlaps(view.boxes_xyxy, boxes, shown) if k >= 0}:
                 counts[k] += 1
         return counts
 
 
-def image_box(view: View, box: Box3D, points: FloatArray) -> FloatArray | None:
-    """The box (x0, y0, x1, y1, pixels, clipped to the image) of ``box`` seen in ``view``, or None
-    when fewer than ``SEEN_SHARE`` of ``points`` are in the image and not hidden."""
-    cam = view.camera
-    u, v, z = project(view.T_cam_map, cam, points)
-    inside = (z > MIN_DEPTH_M) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
-    if not inside.any():
-        return None
-    rows = np.clip((v[inside] / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[0] - 1)
-    cols = np.clip((u[inside] / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[1] - 1)
-    measured = view.depth_m[rows, cols]
-    seen = (measured <= 0) | (z[inside] <= measured + HIDDEN_MARGIN_M)
-    if int(seen.sum()) < SEEN_SHARE * len(points):
-        return None
-    cu, cv, cz = project(view.T_cam_map, cam, box.corners())
-    front = cz > MIN_DEPTH_M
-    if int(front.sum()) < 2:
-        return None
-    x0, x1 = np.clip([cu[front].min(), cu[front].max()], 0, cam.width)
-    y0, y1 = np.clip([cv[front].min(), cv[front].max()], 0, cam.height)
-    return np.array([x0, y0, x1, y1]) if x1 > x0 and y1 > y0 else None
+class Scene:
+    """Objects' boxes and surface points (map frame), stacked to project them into a view at
+    once."""
+
+    def __init__(self, bodies: Sequence[tuple[Box3D, FloatArray]]) -> None:
+        surfaces = [np.asarray(points, dtype=np.float64).reshape(-1, 3) for _, points in bodies]
+        self.n = len(bodies)
+        self.points = np.concatenate([*surfaces, np.zeros((0, 3))])
+        self.owner = np.repeat(np.arange(self.n), [len(p) for p in surfaces])
+        self.sizes = np.array([len(p) for p in surfaces], dtype=np.float64)
+        self.corners = np.concatenate([*(box.corners() for box, _ in bodies), np.zeros((0, 3))])
+
+    def seen_in(self, view: View) -> tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
+        """Per object its image box (x0, y0, x1, y1, pixels, clipped to the image), whether
+        ``view`` shows it (``SEEN_SHARE`` of its points in the image and not hidden, its box in
+        front of the camera) and whether its whole box lies inside the image."""
+        cam = view.camera
+        u, v, z = project(view.T_cam_map, cam, self.points)
+        inside = (z > MIN_DEPTH_M) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+        rows = np.clip((v / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[0] - 1)
+        cols = np.clip((u / DEPTH_STEP_PX).astype(np.int64), 0, view.depth_m.shape[1] - 1)
+        measured = view.depth_m[rows, cols]
+        seen = inside & ((measured <= 0) | (z <= measured + HIDDEN_MARGIN_M))
+        shown = np.bincount(self.owner, weights=seen, minlength=self.n) >= SEEN_SHARE * self.sizes
+        cu, cv, cz = (a.reshape(self.n, 8) for a in project(view.T_cam_map, cam, self.corners))
+        front = cz > MIN_DEPTH_M
+        x0 = np.clip(np.where(front, cu, np.inf).min(axis=1), 0, cam.width)
+        x1 = np.clip(np.where(front, cu, -np.inf).max(axis=1), 0, cam.width)
+        y0 = np.clip(np.where(front, cv, np.inf).min(axis=1), 0, cam.height)
+        y1 = np.clip(np.where(front, cv, -np.inf).max(axis=1), 0, cam.height)
+        shown &= (front.sum(axis=1) >= 2) & (x1 > x0) & (y1 > y0) & (self.sizes > 0)
+        whole = np.all(front & (cu >= 0) & (cu < cam.width) & (cv >= 0) & (cv < cam.height), axis=1)
+        return np.column_stack([x0, y0, x1, y1]), shown, whole
+
+
+def best_overlaps(view_boxes: FloatArray, boxes: FloatArray, shown: NDArray[np.bool_]) -> list[int]:
+    """Per box of ``view_boxes`` the object it names: of the objects ``shown`` (their image
+    ``boxes``), the one it overlaps most, by ``NAMED_IOU`` at least; -1 for none."""
+    index = np.flatnonzero(shown)
+    if len(index) == 0 or len(view_boxes) == 0:
+        return [-1] * len(view_boxes)
+    iou = iou_matrix(view_boxes, boxes[index])
+    best = np.argmax(iou, axis=1)
+    return [int(index[b]) if row[b] >= NAMED_IOU else -1 for row, b in zip(iou, best, strict=True)]
 
 
 def project(T_cam_map: FloatArray, cam: CameraIntrinsics, points_map: FloatArray) -> tuple[

@@ -11,7 +11,7 @@ from hiper_cli.model import Box3D, Instance
 from hiper_cli.perceive.foreground import ForegroundStage
 from hiper_cli.perceive.foreground.config import ForegroundConfig
 from hiper_cli.perceive.foreground.object_views import ObjectViews, name_by_views
-from hiper_cli.perceive.foreground.table_views import View, image_box
+from hiper_cli.perceive.foreground.table_views import Scene, View
 from hiper_cli.perceive.stage import World
 from hiper_cli.types import CameraIntrinsics, Detections, Frame
 
@@ -46,9 +46,9 @@ def _object(name: str, ahead_m: float, size_m: tuple[float, float, float] = (0.5
 
 def _image_box(inst: Instance) -> np.ndarray:
     view = View(np.linalg.inv(_looking_along_y()), CAMERA, np.zeros((60, 80), np.float32), np.zeros((0, 4)))
-    xyxy = image_box(view, inst.box, inst.box.corners())
-    assert xyxy is not None
-    return xyxy
+    boxes, shown, _ = Scene([(inst.box, inst.box.corners())]).seen_in(view)
+    assert shown[0]
+    return boxes[0]
 
 
 def _frame(stamp_s: float, depth_m: float) -> Frame:
